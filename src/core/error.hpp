@@ -1,0 +1,20 @@
+// Error types. Every message says what was wrong and what to change.
+#pragma once
+#include <stdexcept>
+#include <string>
+
+namespace ff {
+// Base for all fracflow errors.
+struct Error : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+// Bad user input: scenario file, command line, geometry file.
+struct InputError : Error {
+  using Error::Error;
+};
+// The numerics became unstable (NaN, time step too large, LBM Mach number...). The run
+// writes a last checkpoint before reporting it.
+struct NumericalError : Error {
+  using Error::Error;
+};
+}  // namespace ff

@@ -1,0 +1,39 @@
+// A driver is one loading protocol (UCS test, triaxial test, flow benchmark...): it declares
+// its scenario keys and runs. Drivers are listed once, in registry.cpp.
+#pragma once
+#include <filesystem>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "io/params.hpp"
+
+namespace ff {
+
+struct RunOptions {
+  std::filesystem::path out_dir;     // results folder (exists when run() is called)
+  int threads = 1;                   // OpenMP threads (already applied with omp_set_num_threads)
+  double max_wall_s = 0;             // > 0: write a checkpoint and stop after this wall time
+  bool resume = false;               // continue from out_dir/checkpoint/
+  std::filesystem::path abort_file;  // when this file appears: checkpoint and stop
+  double progress_interval_s = 5;    // status line period (0: silent)
+};
+
+// What run() reports back to the CLI.
+enum class RunStatus { Finished, Interrupted };
+
+struct Driver {
+  std::string_view name;
+  std::string_view summary;
+  void (*declare)(ParamTable&);
+  RunStatus (*run)(const Config&, const RunOptions&);
+};
+
+std::span<const Driver> all_drivers();
+const Driver& find_driver(const std::string& name);  // throws InputError listing the drivers
+// The full table of a driver: the common keys (driver, output.*) plus its own.
+ParamTable parameter_table(const Driver& d);
+// The built-in default scenario (`fracflow run` with no file).
+std::string_view default_scenario_text();
+
+}  // namespace ff

@@ -1,0 +1,49 @@
+// The one list of drivers. A new loading protocol = one folder + one line here.
+#include <fmt/format.h>
+
+#include <vector>
+
+#include "core/error.hpp"
+#include "drivers/common_params.hpp"
+#include "drivers/driver.hpp"
+// Each driver's header declares one function returning its Driver record.
+// (Add the include and the entry below; the first entry is the default driver.)
+
+namespace ff {
+
+namespace {
+const std::vector<Driver>& driver_list() {
+  static const std::vector<Driver> list = {
+  };
+  return list;
+}
+}  // namespace
+
+std::span<const Driver> all_drivers() { return driver_list(); }
+
+const Driver& find_driver(const std::string& name) {
+  for (auto& d : driver_list())
+    if (d.name == name) return d;
+  std::string known;
+  for (auto& d : driver_list()) known += fmt::format("\n  {:<20} {}", d.name, d.summary);
+  throw InputError(fmt::format("unknown driver '{}'; the known drivers are:{}", name, known));
+}
+
+void declare_common_params(ParamTable& t) {
+  std::vector<std::string> names;
+  for (auto& d : driver_list()) names.emplace_back(d.name);
+  t.string("driver", names.empty() ? std::string() : names.front(), "loading protocol / simulation type").one_of(names);
+  t.string("title", "", "free text copied into summary.json");
+  t.boolean("output.vtk", true, "write VTK (ParaView) files under vtk/");
+  t.boolean("output.plots", true, "draw the headline plots under plots/ (matplotlib via /usr/bin/python3)");
+  t.real("output.progress_interval", 5.0, "s", "wall-clock seconds between status lines (0: none)").non_negative();
+}
+
+ParamTable parameter_table(const Driver& d) {
+  ParamTable t;
+  declare_common_params(t);
+  d.declare(t);
+  return t;
+}
+
+}  // namespace ff

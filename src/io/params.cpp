@@ -1,0 +1,277 @@
+#include "io/params.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <sstream>
+
+#include "core/error.hpp"
+
+namespace ff {
+
+std::string to_string(ParamType t) {
+  switch (t) {
+    case ParamType::Real: return "real";
+    case ParamType::Int: return "integer";
+    case ParamType::Bool: return "boolean";
+    case ParamType::String: return "string";
+    case ParamType::RealList: return "list of reals";
+    case ParamType::StringList: return "list of strings";
+  }
+  return "?";
+}
+
+static std::string quote(const std::string& s) {
+  std::string o = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') o += '\\';
+    o += c;
+  }
+  return o + "\"";
+}
+
+std::string format_value(const ParamValue& v) {
+  struct V {
+    std::string operator()(double d) const {
+      std::string s = fmt::format("{}", d);  // shortest round-trip form
+      if (std::isfinite(d) && s.find_first_of(".eEn") == std::string::npos) s += ".0";
+      return s;
+    }
+    std::string operator()(long i) const { return std::to_string(i); }
+    std::string operator()(bool b) const { return b ? "true" : "false"; }
+    std::string operator()(const std::string& s) const { return quote(s); }
+    std::string operator()(const std::vector<double>& l) const {
+      std::string o = "[";
+      for (std::size_t i = 0; i < l.size(); ++i) o += (i ? ", " : "") + (*this)(l[i]);
+      return o + "]";
+    }
+    std::string operator()(const std::vector<std::string>& l) const {
+      std::string o = "[";
+      for (std::size_t i = 0; i < l.size(); ++i) o += (i ? ", " : "") + quote(l[i]);
+      return o + "]";
+    }
+  };
+  return std::visit(V{}, v);
+}
+
+static std::string fmt_num(double d) { return fmt::format("{}", d); }
+
+std::string ParamSpec::allowed() const {
+  std::string a = to_string(type);
+  if (!choices.empty()) {
+    a += " , one of:";
+    for (auto& c : choices) a += " " + quote(c);
+  }
+  const bool lo = std::isfinite(min), hi = std::isfinite(max);
+  if (type == ParamType::Real || type == ParamType::Int || type == ParamType::RealList) {
+    if (lo && hi) a += fmt::format(" in {}{}, {}{}", min_open ? "(" : "[", fmt_num(min), fmt_num(max), max_open ? ")" : "]");
+    else if (lo) a += fmt::format(" {} {}", min_open ? ">" : ">=", fmt_num(min));
+    else if (hi) a += fmt::format(" {} {}", max_open ? "<" : "<=", fmt_num(max));
+  }
+  if (type == ParamType::RealList || type == ParamType::StringList) {
+    if (list_min == list_max) a += fmt::format(" with {} entries", list_min);
+    else if (list_min > 0 || list_max != std::numeric_limits<std::size_t>::max())
+      a += fmt::format(" with {}..{} entries", list_min,
+                       list_max == std::numeric_limits<std::size_t>::max() ? std::string("any") : std::to_string(list_max));
+  }
+  return a;
+}
+
+static std::vector<std::string> split_dots(const std::string& k) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char c : k) {
+    if (c == '.') { out.push_back(cur); cur.clear(); } else cur += c;
+  }
+  out.push_back(cur);
+  return out;
+}
+
+bool ParamSpec::matches(const std::string& k) const {
+  if (key.find('*') == std::string::npos) return key == k;
+  const auto a = split_dots(key), b = split_dots(k);
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (a[i] != "*" && a[i] != b[i]) return false;
+  return true;
+}
+
+ParamSpec& ParamTable::add(ParamSpec s) {
+  for (auto& e : specs_)
+    if (e.key == s.key) throw Error("internal: parameter '" + s.key + "' declared twice");
+  specs_.push_back(std::move(s));
+  return specs_.back();
+}
+static ParamSpec make_spec(std::string key, ParamType type, std::string unit, std::string help,
+                           std::optional<ParamValue> def) {
+  ParamSpec s;
+  s.key = std::move(key);
+  s.type = type;
+  s.unit = std::move(unit);
+  s.help = std::move(help);
+  s.default_value = std::move(def);
+  return s;
+}
+ParamSpec& ParamTable::real(std::string key, double def, std::string unit, std::string help) {
+  return add(make_spec(std::move(key), ParamType::Real, std::move(unit), std::move(help), ParamValue{def}));
+}
+ParamSpec& ParamTable::real_required(std::string key, std::string unit, std::string help) {
+  return add(make_spec(std::move(key), ParamType::Real, std::move(unit), std::move(help), std::nullopt));
+}
+ParamSpec& ParamTable::integer(std::string key, long def, std::string unit, std::string help) {
+  return add(make_spec(std::move(key), ParamType::Int, std::move(unit), std::move(help), ParamValue{def}));
+}
+ParamSpec& ParamTable::boolean(std::string key, bool def, std::string help) {
+  return add(make_spec(std::move(key), ParamType::Bool, "-", std::move(help), ParamValue{def}));
+}
+ParamSpec& ParamTable::string(std::string key, std::string def, std::string help) {
+  return add(make_spec(std::move(key), ParamType::String, "-", std::move(help), ParamValue{std::move(def)}));
+}
+ParamSpec& ParamTable::real_list(std::string key, std::vector<double> def, std::string unit, std::string help) {
+  return add(make_spec(std::move(key), ParamType::RealList, std::move(unit), std::move(help), ParamValue{std::move(def)}));
+}
+ParamSpec& ParamTable::string_list(std::string key, std::vector<std::string> def, std::string help) {
+  return add(make_spec(std::move(key), ParamType::StringList, "-", std::move(help), ParamValue{std::move(def)}));
+}
+
+const ParamSpec* ParamTable::find(const std::string& key) const {
+  for (auto& s : specs_)  // exact names win over wildcards
+    if (s.key == key) return &s;
+  for (auto& s : specs_)
+    if (s.matches(key)) return &s;
+  return nullptr;
+}
+
+std::string ParamTable::markdown() const {
+  std::string o = "| key | type | unit | default | allowed | meaning |\n|---|---|---|---|---|---|\n";
+  for (auto& s : specs_) {
+    std::string allowed = s.allowed();
+    auto esc = [](std::string t) {
+      std::string r;
+      for (char c : t) r += (c == '|') ? std::string("\\|") : std::string(1, c);
+      return r;
+    };
+    o += fmt::format("| `{}` | {} | {} | {} | {} | {} |\n", s.key, to_string(s.type), s.unit,
+                     s.default_value ? "`" + format_value(*s.default_value) + "`" : std::string("required"),
+                     esc(allowed), esc(s.help));
+  }
+  return o;
+}
+
+// ---------------------------------------------------------------- Config
+
+const ParamSpec& Config::spec(const std::string& key) const {
+  const ParamSpec* s = table_ ? table_->find(key) : nullptr;
+  if (!s) throw Error("internal: parameter '" + key + "' is read but was never declared");
+  return *s;
+}
+
+const ParamValue& Config::value(const std::string& key, ParamType t) const {
+  const ParamSpec& s = spec(key);
+  if (s.type != t) throw Error("internal: parameter '" + key + "' is a " + to_string(s.type) + ", read as " + to_string(t));
+  auto it = values_.find(key);
+  if (it != values_.end()) return it->second.first;
+  if (!s.default_value)
+    throw InputError(fmt::format("{}: required key '{}' is missing ({} [{}]: {})", name_, key, s.allowed(), s.unit, s.help));
+  return *s.default_value;
+}
+
+double Config::real(const std::string& k) const { return std::get<double>(value(k, ParamType::Real)); }
+long Config::integer(const std::string& k) const { return std::get<long>(value(k, ParamType::Int)); }
+bool Config::boolean(const std::string& k) const { return std::get<bool>(value(k, ParamType::Bool)); }
+const std::string& Config::string(const std::string& k) const { return std::get<std::string>(value(k, ParamType::String)); }
+const std::vector<double>& Config::real_list(const std::string& k) const {
+  return std::get<std::vector<double>>(value(k, ParamType::RealList));
+}
+const std::vector<std::string>& Config::string_list(const std::string& k) const {
+  return std::get<std::vector<std::string>>(value(k, ParamType::StringList));
+}
+bool Config::has(const std::string& key) const { return values_.count(key) > 0; }
+
+std::vector<std::string> Config::names(const std::string& prefix) const {
+  std::vector<std::string> out;
+  const std::string p = prefix + ".";
+  for (auto& [k, v] : values_) {
+    if (k.rfind(p, 0) != 0) continue;
+    std::string rest = k.substr(p.size());
+    std::string name = rest.substr(0, rest.find('.'));
+    if (std::find(out.begin(), out.end(), name) == out.end()) out.push_back(name);
+  }
+  return out;
+}
+
+std::string Config::origin(const std::string& key) const {
+  auto it = values_.find(key);
+  if (it == values_.end()) return "default";
+  const ParamOrigin& o = it->second.second;
+  if (o.kind == ParamOrigin::CommandLine) return "--set";
+  return o.line > 0 ? fmt::format("{}:{}", o.file, o.line) : o.file;
+}
+
+void Config::fail(const std::string& key, const std::string& what) const {
+  std::string where = origin(key);
+  if (where == "default") where = name_ + " (default value)";
+  throw InputError(fmt::format("{}: key '{}': {}", where, key, what));
+}
+
+void Config::set(const std::string& key, ParamValue v, ParamOrigin o) { values_[key] = {std::move(v), std::move(o)}; }
+
+std::vector<std::pair<std::string, const ParamSpec*>> Config::expanded_keys() const {
+  std::vector<std::pair<std::string, const ParamSpec*>> out;
+  for (auto& s : table_->specs()) {
+    if (s.key.find('*') == std::string::npos) { out.emplace_back(s.key, &s); continue; }
+    // Expand the wildcard with the names that appear in the explicit values.
+    std::vector<std::string> done;
+    for (auto& [k, v] : values_)
+      if (s.matches(k) && std::find(done.begin(), done.end(), k) == done.end()) done.push_back(k);
+    // Also instantiate defaults for names present at the wildcard's level.
+    const auto pos = s.key.find('*');
+    const std::string prefix = s.key.substr(0, pos == 0 ? 0 : pos - 1);
+    const std::string suffix = s.key.substr(pos + 1);
+    if (suffix.find('*') == std::string::npos) {
+      for (auto& name : names(prefix)) {
+        std::string k = prefix + "." + name + suffix;
+        if (std::find(done.begin(), done.end(), k) == done.end() && table_->find(k) == &s) done.push_back(k);
+      }
+    }
+    std::sort(done.begin(), done.end());
+    for (auto& k : done) out.emplace_back(k, &s);
+  }
+  return out;
+}
+
+std::string Config::resolved_toml() const {
+  // Flat dotted keys are valid TOML and keep the file greppable.
+  std::string o = fmt::format("# Resolved parameters of {} (every key, defaults included).\n", name_);
+  for (auto& [k, s] : expanded_keys()) {
+    auto it = values_.find(k);
+    if (it != values_.end()) o += fmt::format("{} = {}\n", k, format_value(it->second.first));
+    else if (s->default_value) o += fmt::format("{} = {}\n", k, format_value(*s->default_value));
+  }
+  return o;
+}
+
+std::string Config::describe() const {
+  std::vector<std::array<std::string, 5>> rows;
+  rows.push_back({"key", "value", "unit", "default", "source"});
+  for (auto& [k, s] : expanded_keys()) {
+    auto it = values_.find(k);
+    std::string val = it != values_.end() ? format_value(it->second.first)
+                      : s->default_value ? format_value(*s->default_value) : "(missing!)";
+    rows.push_back({k, val, s->unit, s->default_value ? format_value(*s->default_value) : "required", origin(k)});
+  }
+  std::array<std::size_t, 5> w{};
+  for (auto& r : rows)
+    for (int i = 0; i < 5; ++i) w[i] = std::max(w[i], std::min<std::size_t>(r[i].size(), 48));
+  std::string o;
+  for (auto& r : rows) {
+    for (int i = 0; i < 5; ++i) o += fmt::format("{:<{}}  ", r[i], w[i]);
+    while (!o.empty() && o.back() == ' ') o.pop_back();
+    o += '\n';
+  }
+  return o;
+}
+
+}  // namespace ff

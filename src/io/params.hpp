@@ -1,0 +1,116 @@
+// Scenario parameters: one table declares every key once (type, unit, default, allowed
+// range, help). The same table validates scenario files and --set overrides, prints the
+// resolved values for `fracflow check`, and generates the README's parameter reference,
+// so the three cannot drift apart.
+#pragma once
+#include <limits>
+#include <map>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace ff {
+
+enum class ParamType { Real, Int, Bool, String, RealList, StringList };
+using ParamValue = std::variant<double, long, bool, std::string, std::vector<double>, std::vector<std::string>>;
+
+std::string to_string(ParamType t);
+std::string format_value(const ParamValue& v);
+
+struct ParamSpec {
+  std::string key;   // dotted path; a segment "*" matches any name, e.g. "dem.group.*.density"
+  ParamType type = ParamType::Real;
+  std::string unit;  // SI unit, "-" for dimensionless
+  std::string help;
+  std::optional<ParamValue> default_value;  // nullopt: the key is required
+  double min = -std::numeric_limits<double>::infinity();
+  double max = std::numeric_limits<double>::infinity();
+  bool min_open = false, max_open = false;  // open interval ends (min < v rather than min <= v)
+  std::vector<std::string> choices;         // allowed strings (String / StringList), empty = any
+  std::size_t list_min = 0, list_max = std::numeric_limits<std::size_t>::max();  // list sizes
+
+  // Fluent setters used where the table is declared.
+  ParamSpec& range(double lo, double hi) { min = lo; max = hi; return *this; }
+  ParamSpec& at_least(double lo) { min = lo; return *this; }
+  ParamSpec& positive() { min = 0; min_open = true; return *this; }
+  ParamSpec& non_negative() { min = 0; return *this; }
+  ParamSpec& open_range(double lo, double hi) { min = lo; max = hi; min_open = max_open = true; return *this; }
+  ParamSpec& below(double hi) { max = hi; max_open = true; return *this; }
+  ParamSpec& one_of(std::vector<std::string> c) { choices = std::move(c); return *this; }
+  ParamSpec& size(std::size_t n) { list_min = list_max = n; return *this; }
+  ParamSpec& size_between(std::size_t a, std::size_t b) { list_min = a; list_max = b; return *this; }
+
+  std::string allowed() const;  // human-readable "what is allowed"
+  bool matches(const std::string& k) const;
+};
+
+// The declaration table of one driver (and the modules it uses).
+class ParamTable {
+ public:
+  ParamSpec& real(std::string key, double def, std::string unit, std::string help);
+  ParamSpec& real_required(std::string key, std::string unit, std::string help);
+  ParamSpec& integer(std::string key, long def, std::string unit, std::string help);
+  ParamSpec& boolean(std::string key, bool def, std::string help);
+  ParamSpec& string(std::string key, std::string def, std::string help);
+  ParamSpec& real_list(std::string key, std::vector<double> def, std::string unit, std::string help);
+  ParamSpec& string_list(std::string key, std::vector<std::string> def, std::string help);
+
+  const ParamSpec* find(const std::string& key) const;  // exact or wildcard match
+  const std::vector<ParamSpec>& specs() const { return specs_; }
+  // Markdown table of every key (the README's parameter reference).
+  std::string markdown() const;
+
+ private:
+  ParamSpec& add(ParamSpec s);
+  std::vector<ParamSpec> specs_;
+};
+
+// Where a resolved value came from.
+struct ParamOrigin {
+  enum Kind { Default, File, CommandLine } kind = Default;
+  std::string file;
+  long line = 0;
+};
+
+// The resolved parameters of one run: scenario file + --set overrides + defaults, validated.
+class Config {
+ public:
+  Config() = default;
+  Config(const ParamTable* table, std::string scenario_name) : table_(table), name_(std::move(scenario_name)) {}
+
+  double real(const std::string& key) const;
+  long integer(const std::string& key) const;
+  bool boolean(const std::string& key) const;
+  const std::string& string(const std::string& key) const;
+  const std::vector<double>& real_list(const std::string& key) const;
+  const std::vector<std::string>& string_list(const std::string& key) const;
+  bool has(const std::string& key) const;  // set explicitly (file or --set)
+  // Names that appear at a wildcard level, e.g. names("dem.group") -> {"matrix","inclusion"}.
+  std::vector<std::string> names(const std::string& prefix) const;
+  // Where the key was set: "file.toml:12", "--set", or "default".
+  std::string origin(const std::string& key) const;
+  // Error for a value that passed the table check but fails a cross-parameter check
+  // (e.g. a time step above the critical one): names the file, line, key and the fix.
+  [[noreturn]] void fail(const std::string& key, const std::string& what) const;
+
+  void set(const std::string& key, ParamValue v, ParamOrigin o);
+  const ParamTable& table() const { return *table_; }
+  const std::string& scenario_name() const { return name_; }
+  const std::map<std::string, std::pair<ParamValue, ParamOrigin>>& values() const { return values_; }
+  // Every key with its resolved value (explicit and defaults; wildcard keys expanded for the
+  // names present) as TOML text; parsing it back gives the same Config.
+  std::string resolved_toml() const;
+  // Table for `fracflow check`: key, value, unit, default, source.
+  std::string describe() const;
+
+ private:
+  const ParamSpec& spec(const std::string& key) const;
+  const ParamValue& value(const std::string& key, ParamType t) const;
+  std::vector<std::pair<std::string, const ParamSpec*>> expanded_keys() const;
+  const ParamTable* table_ = nullptr;
+  std::string name_;
+  std::map<std::string, std::pair<ParamValue, ParamOrigin>> values_;
+};
+
+}  // namespace ff
