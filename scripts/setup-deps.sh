@@ -3,7 +3,7 @@
 # missing packages are installed. Needs root for apt-get (prints what to do otherwise).
 set -euo pipefail
 PKGS=(g++ cmake make libeigen3-dev libtomlplusplus-dev libcli11-dev libfmt-dev
-      libgtest-dev googletest libomp-dev clang libclang-rt-14-dev
+      libgtest-dev googletest nlohmann-json3-dev libomp-dev clang libclang-rt-14-dev
       python3 python3-matplotlib python3-numpy)
 missing=()
 for p in "${PKGS[@]}"; do
