@@ -6,6 +6,8 @@
 #include "core/error.hpp"
 #include "drivers/common_params.hpp"
 #include "drivers/driver.hpp"
+#include "drivers/ucs/ucs_driver.hpp"
+#include "drivers/flow/flow_drivers.hpp"
 // Each driver's header declares one function returning its Driver record.
 // (Add the include and the entry below; the first entry is the default driver.)
 
@@ -14,6 +16,10 @@ namespace ff {
 namespace {
 const std::vector<Driver>& driver_list() {
   static const std::vector<Driver> list = {
+      drivers::ucs_driver(),
+      drivers::flow_poiseuille_driver(),
+      drivers::flow_cavity_driver(),
+      drivers::flow_cylinder_driver(),
   };
   return list;
 }

@@ -13,23 +13,52 @@ namespace ff {
 
 std::string to_string(ParamType t) {
   switch (t) {
-    case ParamType::Real: return "real";
+    case ParamType::Float: return "real";
     case ParamType::Int: return "integer";
     case ParamType::Bool: return "boolean";
     case ParamType::String: return "string";
-    case ParamType::RealList: return "list of reals";
+    case ParamType::FloatList: return "list of reals";
     case ParamType::StringList: return "list of strings";
   }
   return "?";
 }
 
+// A TOML basic string: quotes, backslashes and control characters escaped, so that
+// resolved_toml() always parses back (found by tests/fuzz).
 static std::string quote(const std::string& s) {
   std::string o = "\"";
   for (char c : s) {
+    const auto u = static_cast<unsigned char>(c);
     if (c == '"' || c == '\\') o += '\\';
-    o += c;
+    if (c == '\n') o += "\\n";
+    else if (c == '\t') o += "\\t";
+    else if (u < 0x20 || u == 0x7F) o += fmt::format("\\u{:04X}", u);
+    else o += c;
   }
   return o + "\"";
+}
+
+// A dotted key as TOML: segments that are not bare keys ([A-Za-z0-9_-]+) are quoted,
+// e.g. dem.contact."rock/rock".law.
+static std::string toml_key(const std::string& key) {
+  std::string o, seg;
+  auto flush = [&] {
+    const bool bare = !seg.empty() && std::all_of(seg.begin(), seg.end(), [](char c) {
+      return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+    });
+    o += bare ? seg : quote(seg);
+    seg.clear();
+  };
+  for (char c : key) {
+    if (c == '.') {
+      flush();
+      o += '.';
+    } else {
+      seg += c;
+    }
+  }
+  flush();
+  return o;
 }
 
 std::string format_value(const ParamValue& v) {
@@ -65,12 +94,12 @@ std::string ParamSpec::allowed() const {
     for (auto& c : choices) a += " " + quote(c);
   }
   const bool lo = std::isfinite(min), hi = std::isfinite(max);
-  if (type == ParamType::Real || type == ParamType::Int || type == ParamType::RealList) {
+  if (type == ParamType::Float || type == ParamType::Int || type == ParamType::FloatList) {
     if (lo && hi) a += fmt::format(" in {}{}, {}{}", min_open ? "(" : "[", fmt_num(min), fmt_num(max), max_open ? ")" : "]");
     else if (lo) a += fmt::format(" {} {}", min_open ? ">" : ">=", fmt_num(min));
     else if (hi) a += fmt::format(" {} {}", max_open ? "<" : "<=", fmt_num(max));
   }
-  if (type == ParamType::RealList || type == ParamType::StringList) {
+  if (type == ParamType::FloatList || type == ParamType::StringList) {
     if (list_min == list_max) a += fmt::format(" with {} entries", list_min);
     else if (list_min > 0 || list_max != std::numeric_limits<std::size_t>::max())
       a += fmt::format(" with {}..{} entries", list_min,
@@ -115,10 +144,10 @@ static ParamSpec make_spec(std::string key, ParamType type, std::string unit, st
   return s;
 }
 ParamSpec& ParamTable::real(std::string key, double def, std::string unit, std::string help) {
-  return add(make_spec(std::move(key), ParamType::Real, std::move(unit), std::move(help), ParamValue{def}));
+  return add(make_spec(std::move(key), ParamType::Float, std::move(unit), std::move(help), ParamValue{def}));
 }
 ParamSpec& ParamTable::real_required(std::string key, std::string unit, std::string help) {
-  return add(make_spec(std::move(key), ParamType::Real, std::move(unit), std::move(help), std::nullopt));
+  return add(make_spec(std::move(key), ParamType::Float, std::move(unit), std::move(help), std::nullopt));
 }
 ParamSpec& ParamTable::integer(std::string key, long def, std::string unit, std::string help) {
   return add(make_spec(std::move(key), ParamType::Int, std::move(unit), std::move(help), ParamValue{def}));
@@ -130,7 +159,7 @@ ParamSpec& ParamTable::string(std::string key, std::string def, std::string help
   return add(make_spec(std::move(key), ParamType::String, "-", std::move(help), ParamValue{std::move(def)}));
 }
 ParamSpec& ParamTable::real_list(std::string key, std::vector<double> def, std::string unit, std::string help) {
-  return add(make_spec(std::move(key), ParamType::RealList, std::move(unit), std::move(help), ParamValue{std::move(def)}));
+  return add(make_spec(std::move(key), ParamType::FloatList, std::move(unit), std::move(help), ParamValue{std::move(def)}));
 }
 ParamSpec& ParamTable::string_list(std::string key, std::vector<std::string> def, std::string help) {
   return add(make_spec(std::move(key), ParamType::StringList, "-", std::move(help), ParamValue{std::move(def)}));
@@ -178,12 +207,12 @@ const ParamValue& Config::value(const std::string& key, ParamType t) const {
   return *s.default_value;
 }
 
-double Config::real(const std::string& k) const { return std::get<double>(value(k, ParamType::Real)); }
+double Config::real(const std::string& k) const { return std::get<double>(value(k, ParamType::Float)); }
 long Config::integer(const std::string& k) const { return std::get<long>(value(k, ParamType::Int)); }
 bool Config::boolean(const std::string& k) const { return std::get<bool>(value(k, ParamType::Bool)); }
 const std::string& Config::string(const std::string& k) const { return std::get<std::string>(value(k, ParamType::String)); }
 const std::vector<double>& Config::real_list(const std::string& k) const {
-  return std::get<std::vector<double>>(value(k, ParamType::RealList));
+  return std::get<std::vector<double>>(value(k, ParamType::FloatList));
 }
 const std::vector<std::string>& Config::string_list(const std::string& k) const {
   return std::get<std::vector<std::string>>(value(k, ParamType::StringList));
@@ -247,8 +276,8 @@ std::string Config::resolved_toml() const {
   std::string o = fmt::format("# Resolved parameters of {} (every key, defaults included).\n", name_);
   for (auto& [k, s] : expanded_keys()) {
     auto it = values_.find(k);
-    if (it != values_.end()) o += fmt::format("{} = {}\n", k, format_value(it->second.first));
-    else if (s->default_value) o += fmt::format("{} = {}\n", k, format_value(*s->default_value));
+    if (it != values_.end()) o += fmt::format("{} = {}\n", toml_key(k), format_value(it->second.first));
+    else if (s->default_value) o += fmt::format("{} = {}\n", toml_key(k), format_value(*s->default_value));
   }
   return o;
 }

@@ -12,7 +12,7 @@
 
 namespace ff {
 
-enum class ParamType { Real, Int, Bool, String, RealList, StringList };
+enum class ParamType { Float, Int, Bool, String, FloatList, StringList };
 using ParamValue = std::variant<double, long, bool, std::string, std::vector<double>, std::vector<std::string>>;
 
 std::string to_string(ParamType t);
@@ -20,7 +20,7 @@ std::string format_value(const ParamValue& v);
 
 struct ParamSpec {
   std::string key;   // dotted path; a segment "*" matches any name, e.g. "dem.group.*.density"
-  ParamType type = ParamType::Real;
+  ParamType type = ParamType::Float;
   std::string unit;  // SI unit, "-" for dimensionless
   std::string help;
   std::optional<ParamValue> default_value;  // nullopt: the key is required
@@ -37,6 +37,7 @@ struct ParamSpec {
   ParamSpec& non_negative() { min = 0; return *this; }
   ParamSpec& open_range(double lo, double hi) { min = lo; max = hi; min_open = max_open = true; return *this; }
   ParamSpec& below(double hi) { max = hi; max_open = true; return *this; }
+  ParamSpec& at_most(double hi) { max = hi; return *this; }
   ParamSpec& one_of(std::vector<std::string> c) { choices = std::move(c); return *this; }
   ParamSpec& size(std::size_t n) { list_min = list_max = n; return *this; }
   ParamSpec& size_between(std::size_t a, std::size_t b) { list_min = a; list_max = b; return *this; }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <sstream>
 #include <toml++/toml.h>
@@ -45,18 +46,112 @@ std::string sanitize(std::string_view text, const std::string& source) {
   return std::string(text);
 }
 
+// toml++ 3.3.0 decides whether a non-ASCII code point is whitespace through a table that hits
+// TOML_UNREACHABLE (undefined behaviour, in Debian's release build too) for e.g. U+00A1..U+0499
+// (upstream issues #190 and #295), and it asks that wherever it scans bare tokens: after a key,
+// in a number, after a line-ending backslash... (found by tests/fuzz). So toml++ is only ever
+// given ASCII: non-ASCII characters in basic strings become \uXXXX escapes, literal strings
+// become equivalent basic strings, comments lose theirs, and anywhere else (never valid TOML
+// 1.0) they are an error. Newlines are kept, so line numbers in messages stay right.
+std::string to_ascii_toml(std::string_view t, const std::string& source) {
+  enum State { Normal, Comment, Basic, Literal, MultiBasic, MultiLiteral } st = Normal;
+  std::string o;
+  o.reserve(t.size() + t.size() / 8);
+  long line = 1;
+  auto at = [&](std::size_t i) { return i < t.size() ? t[i] : '\0'; };
+  auto run = [&](std::size_t i, char q) { std::size_t n = 0; while (at(i + n) == q) ++n; return n; };
+  auto error = [&](const std::string& what) { return InputError(fmt::format("{}:{}: {}", source, line, what)); };
+  for (std::size_t i = 0; i < t.size();) {
+    const auto c = static_cast<unsigned char>(t[i]);
+    if (c >= 0x80) {  // one code point; sanitize() checked the byte structure
+      const std::size_t n = (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : 4;
+      char32_t cp = c & (n == 2 ? 0x1F : n == 3 ? 0x0F : 0x07);
+      for (std::size_t k = 1; k < n; ++k) cp = (cp << 6) | (static_cast<unsigned char>(t[i + k]) & 0x3F);
+      const char32_t min = n == 2 ? 0x80 : n == 3 ? 0x800 : 0x10000;
+      if (cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF))
+        throw error("invalid UTF-8 sequence; scenario files must be UTF-8 text");
+      if (st == Normal)
+        throw error("non-ASCII character outside a string or comment; quote names that use one, e.g. "
+                    "[dem.group.\"gr\\u00e8s\"]");
+      if (st == Comment) o += '?';
+      else o += cp <= 0xFFFF ? fmt::format("\\u{:04X}", static_cast<std::uint32_t>(cp))
+                             : fmt::format("\\U{:08X}", static_cast<std::uint32_t>(cp));
+      i += n;
+      continue;
+    }
+    const char ch = static_cast<char>(c);
+    if (ch == '\n') ++line;
+    std::size_t used = 1;  // bytes consumed from t
+    switch (st) {
+      case Normal:
+        if (ch == '#') st = Comment;
+        if (ch == '"' || ch == '\'') {
+          const bool multi = run(i, ch) >= 3;
+          st = ch == '"' ? (multi ? MultiBasic : Basic) : (multi ? MultiLiteral : Literal);
+          used = multi ? 3 : 1;
+          o += multi ? "\"\"\"" : "\"";
+        } else {
+          o += ch;
+        }
+        break;
+      case Comment:
+        if (ch == '\n') st = Normal;
+        o += ch;
+        break;
+      case Basic:
+      case MultiBasic:
+        if (ch == '\\' && static_cast<unsigned char>(at(i + 1)) >= 0x80)
+          throw error("a backslash followed by a non-ASCII character is not a valid escape sequence");
+        if (ch == '\\' && at(i + 1) != '\0' && at(i + 1) != '\n') {  // escape: copy both characters
+          o += t.substr(i, 2);
+          used = 2;
+        } else if (st == Basic && (ch == '"' || ch == '\n')) {
+          st = Normal;
+          o += ch;
+        } else if (st == MultiBasic && run(i, '"') >= 3) {
+          used = std::min<std::size_t>(run(i, '"'), 5);  // up to two quotes before the closing three are content
+          o.append(used, '"');
+          st = Normal;
+        } else {
+          o += ch;
+        }
+        break;
+      case Literal:
+      case MultiLiteral:
+        if (st == Literal && (ch == '\'' || ch == '\n')) {
+          st = Normal;
+          o += ch == '\'' ? '"' : '\n';
+        } else if (st == MultiLiteral && run(i, '\'') >= 3) {
+          used = run(i, '\'');
+          if (used > 5) throw error("more than five quotes in a row end a multi-line literal string");
+          o.append(used - 3, '\'');
+          o += "\"\"\"";
+          st = Normal;
+        } else if (ch == '"' || ch == '\\') {  // literal text, escaped for the basic string it becomes
+          o += '\\';
+          o += ch;
+        } else {
+          o += ch;
+        }
+        break;
+    }
+    i += used;
+  }
+  return o;
+}
+
 long line_of(const toml::node& n) { return static_cast<long>(n.source().begin.line); }
 
 void flatten(const toml::table& t, const std::string& prefix, const std::string& source, std::vector<RawEntry>& out);
 
 void add_leaf(const toml::node& n, const std::string& key, const std::string& source, std::vector<RawEntry>& out) {
   const long line = line_of(n);
-  if (auto v = n.as_floating_point()) { out.push_back({key, ParamValue{v->get()}, ParamType::Real, line}); return; }
+  if (auto v = n.as_floating_point()) { out.push_back({key, ParamValue{v->get()}, ParamType::Float, line}); return; }
   if (auto v = n.as_integer()) { out.push_back({key, ParamValue{static_cast<long>(v->get())}, ParamType::Int, line}); return; }
   if (auto v = n.as_boolean()) { out.push_back({key, ParamValue{v->get()}, ParamType::Bool, line}); return; }
   if (auto v = n.as_string()) { out.push_back({key, ParamValue{std::string(v->get())}, ParamType::String, line}); return; }
   if (auto a = n.as_array()) {
-    if (a->empty()) { out.push_back({key, ParamValue{std::vector<double>{}}, ParamType::RealList, line}); return; }
+    if (a->empty()) { out.push_back({key, ParamValue{std::vector<double>{}}, ParamType::FloatList, line}); return; }
     if (a->is_array_of_tables()) {  // [[x]] blocks: flattened with their index as name
       for (std::size_t i = 0; i < a->size(); ++i) flatten(*a->get(i)->as_table(), key + "." + std::to_string(i), source, out);
       return;
@@ -69,7 +164,7 @@ void add_leaf(const toml::node& n, const std::string& key, const std::string& so
     if (all_num) {
       std::vector<double> l;
       for (auto& e : *a) l.push_back(e.is_integer() ? static_cast<double>(e.as_integer()->get()) : e.as_floating_point()->get());
-      out.push_back({key, ParamValue{std::move(l)}, ParamType::RealList, line});
+      out.push_back({key, ParamValue{std::move(l)}, ParamType::FloatList, line});
       return;
     }
     if (all_str) {
@@ -86,6 +181,11 @@ void add_leaf(const toml::node& n, const std::string& key, const std::string& so
 void flatten(const toml::table& t, const std::string& prefix, const std::string& source, std::vector<RawEntry>& out) {
   for (auto& [k, node] : t) {
     const std::string key = prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
+    // Keys are handled as dotted paths: a quoted name that is empty or holds a dot would
+    // silently become another key (and not survive resolved_toml()).
+    if (k.str().empty() || k.str().find('.') != std::string_view::npos)
+      throw InputError(fmt::format("{}:{}: key '{}': a name may not be empty or contain a dot", source,
+                                   static_cast<long>(k.source().begin.line), key));
     if (auto sub = node.as_table()) flatten(*sub, key, source, out);
     else add_leaf(node, key, source, out);
   }
@@ -98,8 +198,8 @@ ParamValue coerce(const ParamSpec& s, const RawEntry& e, const std::string& wher
                                   format_value(e.value), s.allowed(), s.unit, s.help));
   };
   switch (s.type) {
-    case ParamType::Real:
-      if (e.type == ParamType::Real) return e.value;
+    case ParamType::Float:
+      if (e.type == ParamType::Float) return e.value;
       if (e.type == ParamType::Int) return ParamValue{static_cast<double>(std::get<long>(e.value))};
       throw wrong();
     case ParamType::Int:
@@ -111,12 +211,12 @@ ParamValue coerce(const ParamSpec& s, const RawEntry& e, const std::string& wher
     case ParamType::String:
       if (e.type == ParamType::String) return e.value;
       throw wrong();
-    case ParamType::RealList:
-      if (e.type == ParamType::RealList) return e.value;
+    case ParamType::FloatList:
+      if (e.type == ParamType::FloatList) return e.value;
       throw wrong();
     case ParamType::StringList:
       if (e.type == ParamType::StringList) return e.value;
-      if (e.type == ParamType::RealList && std::get<std::vector<double>>(e.value).empty())
+      if (e.type == ParamType::FloatList && std::get<std::vector<double>>(e.value).empty())
         return ParamValue{std::vector<std::string>{}};
       throw wrong();
   }
@@ -184,7 +284,7 @@ std::string suggestion(const ParamTable& t, const std::string& key) {
 }  // namespace
 
 std::vector<RawEntry> parse_toml_flat(std::string_view text, const std::string& source) {
-  const std::string clean = sanitize(text, source);
+  const std::string clean = to_ascii_toml(sanitize(text, source), source);
   toml::table doc;
   try {
     doc = toml::parse(clean, std::string_view(source));
@@ -223,6 +323,8 @@ Config build_config(const ParamTable& table, const std::string& source, const st
       throw InputError(fmt::format("--set '{}': expected key=value, e.g. --set dem.damping=0.5", o));
     std::string key = o.substr(0, eq), val = o.substr(eq + 1);
     while (!key.empty() && key.back() == ' ') key.pop_back();
+    if (key.empty() || key.front() == '.' || key.back() == '.' || key.find("..") != std::string::npos)
+      throw InputError(fmt::format("--set '{}': the key has an empty name between dots", o));
     // The value is read as TOML; a bare word that is not valid TOML is taken as a string.
     std::vector<RawEntry> parsed;
     try {
@@ -230,7 +332,11 @@ Config build_config(const ParamTable& table, const std::string& source, const st
     } catch (const InputError&) {
       parsed = parse_toml_flat("v = \"" + val + "\"", "--set " + key);
     }
-    RawEntry e = parsed.at(0);
+    // Exactly one plain value: `{}` gives no entry, `{a=1}` gives "v.a", "1\nw=2" two entries.
+    if (parsed.size() != 1 || parsed.front().key != "v")
+      throw InputError(fmt::format("--set '{}': the value must be one number, string, boolean or list, "
+                                   "e.g. --set dem.damping=0.5 or --set load.pressures=[1e6,2e6]", o));
+    RawEntry e = parsed.front();
     e.key = key;
     e.line = 0;
     apply(e, "--set " + key, ParamOrigin{ParamOrigin::CommandLine, "--set", 0});

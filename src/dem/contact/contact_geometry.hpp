@@ -1,0 +1,62 @@
+// Contact geometry and kinematics shared by particle-particle and particle-wall contacts, so
+// the force laws never learn whether the other body is a wall (STYLE.md B).
+// Conventions (METHODS.md 1.2): n points from A to B; gap = d - (RA + RB) (< 0: overlap);
+// increments are B relative to A; d_delta_n > 0 means opening.
+#pragma once
+#include "core/types.hpp"
+
+namespace ff::dem {
+
+struct ContactGeom {
+  Vec3 n;            // unit normal from A to B
+  Real gap;          // [m]
+  Vec3 xc;           // contact point [m]
+  Real rA, rB;       // radii; a wall has rB = 0
+  Real d_delta_n;    // normal displacement increment (opening > 0) [m]
+  Vec3 d_delta_s;    // shear displacement increment of B relative to A [m]
+  Vec3 d_theta;      // relative rotation increment (wB - wA) dt [rad]
+  Real mean_spin_n;  // 0.5 (wA + wB) . n, used to rotate stored shear vectors
+};
+
+// History carried by a frictional contact between steps (shared by the contact laws so the
+// engine stores one array whatever the law).
+struct ContactState {
+  Vec3 fs = Vec3::Zero();  // shear force on B [N]
+};
+
+// Relative motion at the contact point (METHODS.md 1.2).
+inline void contact_kinematics(ContactGeom& g, const Vec3& xA, const Vec3& vA, const Vec3& wA, const Vec3& xB,
+                               const Vec3& vB, const Vec3& wB, Real dt) {
+  const Vec3 vc = (vB + wB.cross(g.xc - xB)) - (vA + wA.cross(g.xc - xA));
+  const Real vn = vc.dot(g.n);
+  g.d_delta_n = vn * dt;
+  g.d_delta_s = (vc - vn * g.n) * dt;
+  g.d_theta = (wB - wA) * dt;
+  g.mean_spin_n = 0.5 * (wA + wB).dot(g.n);
+}
+
+// Brings a stored shear vector into the current contact plane: drop the out-of-plane part,
+// keep the magnitude, rotate by the mean spin about n (standard incremental DEM practice,
+// as YADE/LIGGGHTS; METHODS.md 1.2).
+inline void rotate_into_plane(Vec3& v, const ContactGeom& g, Real dt) {
+  const Real mag2 = v.squaredNorm();
+  if (mag2 == 0) return;
+  v -= v.dot(g.n) * g.n;
+  const Real new2 = v.squaredNorm();
+  if (new2 > 0) v *= std::sqrt(mag2 / new2);
+  v -= v.cross(g.mean_spin_n * dt * g.n);
+}
+
+// Sphere-sphere geometry; returns false when the centres coincide (then n is arbitrary, x).
+inline bool sphere_sphere(ContactGeom& g, const Vec3& xA, Real rA, const Vec3& xB, Real rB) {
+  const Vec3 d = xB - xA;
+  const Real dist = d.norm();
+  g.n = dist > 0 ? Vec3(d / dist) : Vec3::UnitX();
+  g.gap = dist - (rA + rB);
+  g.xc = xA + (rA + 0.5 * g.gap) * g.n;
+  g.rA = rA;
+  g.rB = rB;
+  return dist > 0;
+}
+
+}  // namespace ff::dem

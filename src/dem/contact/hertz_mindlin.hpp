@@ -1,0 +1,59 @@
+// Hertz-Mindlin contact with Coulomb friction (no-slip Mindlin tangential stiffness,
+// incremental form), as PFC "hertz" / YADE / LIGGGHTS granular/hertz/history:
+//   Fn = 4/3 E* sqrt(R*) delta^(3/2),  kt = 8 G* sqrt(R* delta)
+// with, for two bodies of one material (shear modulus G, Poisson ratio nu),
+//   E* = E / (2 (1 - nu^2)),  G* = G / (2 (2 - nu)),  R* = RA RB / (RA + RB)
+// (Johnson 1985, Contact Mechanics, ch. 4 and 7). Against a wall, R* = RA and the wall is rigid
+// (E* = E/(1-nu^2), G* = G/(2-nu)). In 2D the same formulas are used per unit thickness, which
+// is a common approximation (Hertz has no exact 2D law for cylinders).
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <string_view>
+
+#include "dem/contact/contact_geometry.hpp"
+
+namespace ff::dem {
+
+struct HertzMindlinContact {
+  static constexpr std::string_view name = "hertz_mindlin";
+  struct Params {
+    Real shear_modulus = 1e9;  // G [Pa]
+    Real poisson = 0.25;       // nu [-]
+    Real fric = 0.5;           // [-]
+  };
+  using State = ContactState;
+  static void moduli(const Params& p, bool wall, Real& e_star, Real& g_star) {
+    const Real E = 2 * p.shear_modulus * (1 + p.poisson);
+    e_star = E / ((wall ? 1.0 : 2.0) * (1 - p.poisson * p.poisson));
+    g_star = p.shear_modulus / ((wall ? 1.0 : 2.0) * (2 - p.poisson));
+  }
+  static Real reduced_radius(Real rA, Real rB) { return rB > 0 ? rA * rB / (rA + rB) : rA; }
+  // Tangent normal stiffness dFn/d(delta) = 2 E* sqrt(R* delta), for the time-step estimate.
+  static Real normal_stiffness(const Params& p, Real rA, Real rB, Real overlap) {
+    Real es, gs;
+    moduli(p, rB <= 0, es, gs);
+    return 2 * es * std::sqrt(reduced_radius(rA, rB) * std::max(overlap, 0.0));
+  }
+  static Vec3 force(const Params& p, const ContactGeom& g, State& s, Real dt, int /*dim*/, Real& fn) {
+    if (g.gap >= 0) {
+      fn = 0;
+      s.fs.setZero();
+      return Vec3::Zero();
+    }
+    Real es, gs;
+    moduli(p, g.rB <= 0, es, gs);
+    const Real delta = -g.gap;
+    const Real a = std::sqrt(reduced_radius(g.rA, g.rB) * delta);  // contact radius
+    fn = 4.0 / 3.0 * es * a * delta;
+    const Real kt = 8 * gs * a;
+    rotate_into_plane(s.fs, g, dt);
+    s.fs -= kt * g.d_delta_s;
+    const Real limit = p.fric * fn;
+    const Real fs2 = s.fs.squaredNorm();
+    if (fs2 > limit * limit) s.fs *= limit / std::sqrt(fs2);
+    return fn * g.n + s.fs;
+  }
+};
+
+}  // namespace ff::dem

@@ -1,0 +1,155 @@
+#include "dem/dem_checkpoint.hpp"
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+
+namespace ff {
+// Bond and history states are plain aggregates of doubles and Eigen fixed-size members.
+template <> struct is_checkpoint_pod<dem::ParallelBond::State> : std::true_type {};
+template <> struct is_checkpoint_pod<dem::RotationalBond::State> : std::true_type {};
+template <> struct is_checkpoint_pod<dem::ContactState> : std::true_type {};
+template <> struct is_checkpoint_pod<dem::CrackEvent> : std::true_type {};
+}  // namespace ff
+
+namespace ff::dem {
+
+namespace {
+// Walls without their name (stored separately) so they can be written as raw bytes.
+struct WallRecord {
+  std::uint8_t kind, active;
+  Vec3 point, normal, velocity, force, displacement;
+  Real radius, radial_velocity, friction, contact_stiffness;
+  int contacts;
+};
+}  // namespace
+}  // namespace ff::dem
+
+namespace ff {
+template <> struct is_checkpoint_pod<dem::WallRecord> : std::true_type {};
+}
+
+namespace ff::dem {
+
+void save_dem(CheckpointWriter& w, const DemSystem& s) {
+  const auto& P = s.particles;
+  w.put("dem.pos", P.pos);
+  w.put("dem.vel", P.vel);
+  w.put("dem.omega", P.omega);
+  w.put("dem.orient", P.orient);
+  w.put("dem.disp", P.disp);
+  w.put("dem.radius", P.radius);
+  w.put("dem.mass", P.mass);
+  w.put("dem.inertia", P.inertia);
+  w.put("dem.inv_mass", P.inv_mass);
+  w.put("dem.inv_inertia", P.inv_inertia);
+  w.put("dem.group", P.group);
+  w.put("dem.bond_i", s.bond_i);
+  w.put("dem.bond_j", s.bond_j);
+  w.put("dem.bond_pair", s.bond_pair);
+  w.put("dem.bond_broken", s.bond_broken);
+  w.put("dem.pbond", s.pbond);
+  w.put("dem.rbond", s.rbond);
+  w.put_value("dem.time", s.time);
+  w.put_value("dem.step", s.step_count);
+  w.put_value("dem.dt", s.settings.dt);
+  w.put_value("dem.skin", s.settings.skin);
+  const auto& nl = s.neighbors();
+  w.put("dem.nl_i", std::vector<Index>(nl.first().begin(), nl.first().end()));
+  w.put("dem.nl_j", std::vector<Index>(nl.second().begin(), nl.second().end()));
+  w.put("dem.nl_ref", const_cast<DemSystem&>(s).neighbors().reference_positions());
+  w.put_value("dem.nl_builds", nl.builds());
+  w.put("dem.contact_state", const_cast<DemSystem&>(s).contact_state());
+  std::vector<WallRecord> walls;
+  std::string names;
+  for (auto& x : s.walls) {
+    walls.push_back(WallRecord{static_cast<std::uint8_t>(x.kind), static_cast<std::uint8_t>(x.active), x.point, x.normal,
+                               x.velocity, x.force, x.displacement, x.radius, x.radial_velocity, x.friction,
+                               x.contact_stiffness, x.contacts});
+    names += x.name + "\n";
+  }
+  w.put("dem.walls", walls);
+  w.put_string("dem.wall_names", names);
+  auto& wc = const_cast<DemSystem&>(s).wall_contacts();
+  for (std::size_t k = 0; k < wc.size(); ++k) {
+    w.put(fmt::format("dem.wall{}.particle", k), wc[k].particle);
+    w.put(fmt::format("dem.wall{}.state", k), wc[k].state);
+  }
+  w.put("dem.cracks", s.cracks.events);
+  w.put_value("dem.wall_motion", s.wall_motion_since_build());
+}
+
+void load_dem(CheckpointReader& r, DemSystem& s) {
+  auto& P = s.particles;
+  r.get("dem.pos", P.pos);
+  const std::size_t n = P.pos.size();
+  P.resize(n);
+  r.get("dem.vel", P.vel);
+  r.get("dem.omega", P.omega);
+  r.get("dem.orient", P.orient);
+  r.get("dem.disp", P.disp);
+  r.get("dem.radius", P.radius);
+  r.get("dem.mass", P.mass);
+  r.get("dem.inertia", P.inertia);
+  r.get("dem.inv_mass", P.inv_mass);
+  r.get("dem.inv_inertia", P.inv_inertia);
+  r.get("dem.group", P.group);
+  r.get("dem.bond_i", s.bond_i);
+  r.get("dem.bond_j", s.bond_j);
+  r.get("dem.bond_pair", s.bond_pair);
+  r.get("dem.bond_broken", s.bond_broken);
+  r.get("dem.pbond", s.pbond);
+  r.get("dem.rbond", s.rbond);
+  s.time = r.get_value<Real>("dem.time");
+  s.step_count = r.get_value<long>("dem.step");
+  s.settings.dt = r.get_value<Real>("dem.dt");
+  s.settings.skin = r.get_value<Real>("dem.skin");
+  std::vector<WallRecord> walls;
+  r.get("dem.walls", walls);
+  const std::string names = r.get_string("dem.wall_names");
+  s.walls.clear();
+  std::size_t pos = 0;
+  for (auto& x : walls) {
+    Wall w;
+    const auto nl = names.find('\n', pos);
+    w.name = names.substr(pos, nl - pos);
+    pos = nl + 1;
+    w.kind = static_cast<Wall::Kind>(x.kind);
+    w.active = x.active;
+    w.point = x.point;
+    w.normal = x.normal;
+    w.velocity = x.velocity;
+    w.force = x.force;
+    w.displacement = x.displacement;
+    w.radius = x.radius;
+    w.radial_velocity = x.radial_velocity;
+    w.friction = x.friction;
+    w.contact_stiffness = x.contact_stiffness;
+    w.contacts = x.contacts;
+    s.walls.push_back(w);
+  }
+  r.get("dem.cracks", s.cracks.events);
+  s.cracks.tensile = s.cracks.shear = 0;
+  for (auto& e : s.cracks.events) (e.mode == 1 ? s.cracks.tensile : s.cracks.shear)++;
+  // Rebuild derived storage, then put back the exact neighbour list and histories.
+  s.particles.force.assign(n, Vec3::Zero());
+  s.particles.moment.assign(n, Vec3::Zero());
+  s.build_bond_adjacency();
+  auto& nl = s.neighbors();
+  r.get("dem.nl_i", nl.pair_i());
+  r.get("dem.nl_j", nl.pair_j());
+  r.get("dem.nl_ref", nl.reference_positions());
+  nl.restore(s.settings.skin, r.get_value<long>("dem.nl_builds"));
+  r.get("dem.contact_state", s.contact_state());
+  s.restore_loads_after_load();
+  auto& wc = s.wall_contacts();
+  wc.assign(s.walls.size(), WallContacts{});
+  for (std::size_t k = 0; k < wc.size(); ++k) {
+    r.get(fmt::format("dem.wall{}.particle", k), wc[k].particle);
+    r.get(fmt::format("dem.wall{}.state", k), wc[k].state);
+    wc[k].load.assign(wc[k].particle.size(), PairLoad{});
+  }
+  s.wall_motion_since_build() = r.get_value<Real>("dem.wall_motion");
+}
+
+}  // namespace ff::dem

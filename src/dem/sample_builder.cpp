@@ -1,0 +1,340 @@
+#include "dem/sample_builder.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <numeric>
+
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "geometry/packing.hpp"
+#include "geometry/point_in_mesh.hpp"
+#include "geometry/shapes.hpp"
+
+namespace ff::dem {
+
+void declare_sample_params(ParamTable& t) {
+  t.string("sample.shape", "cylinder", "sample shape: cylinder (3D, axis z) or box (2D: rectangle in x-y, loaded along y)")
+      .one_of({"cylinder", "box"});
+  t.real("sample.diameter", 25e-3, "m", "cylinder diameter").positive();
+  t.real("sample.height", 50e-3, "m", "sample height along the loading axis (z in 3D, y in 2D)").positive();
+  t.real("sample.width", 25e-3, "m", "box width along x").positive();
+  t.real("sample.depth", 25e-3, "m", "box depth along y (3D box only)").positive();
+  t.real("sample.radius_min", 0.4e-3, "m", "smallest particle radius (uniform distribution)").positive();
+  t.real("sample.radius_max", 0.6e-3, "m", "largest particle radius").positive();
+  t.real("sample.porosity", 0.38, "-", "target porosity of the packing (3D >= 0.35, 2D >= 0.16)").open_range(0, 1);
+  t.integer("sample.seed", 1, "-", "random seed of the packing (same seed, same sample)").non_negative();
+  t.real("sample.locked_in_stress", 0.1e6, "Pa", "isotropic stress left in the packing when bonds are installed is reduced below this").positive();
+  t.real("sample.bond_gap", 0.05e-3, "m", "bonds are installed between particles whose gap is at most this (seed 000: 0.05 mm)").non_negative();
+  t.string("sample.default_group", "", "group of particles outside every region (default: the first declared group)");
+  t.real("sample.genesis_tolerance", 1e-2, "-", "equilibrium criterion of the genesis: mean unbalanced-force ratio").positive();
+  t.integer("sample.genesis_max_steps", 2000, "-", "step cap of each genesis equilibration").positive();
+  // Regions assigning groups (later regions win).
+  t.string("sample.region.*.group", "", "group of the particles whose centres lie in this region");
+  t.string("sample.region.*.shape", "sphere", "region shape").one_of({"box", "sphere", "cylinder", "ellipsoid", "stl"});
+  t.real_list("sample.region.*.center", {0, 0, 0}, "m", "sphere/ellipsoid centre, cylinder base centre").size(3);
+  t.real("sample.region.*.radius", 1e-3, "m", "sphere or cylinder radius").positive();
+  t.real_list("sample.region.*.lo", {0, 0, 0}, "m", "box lower corner").size(3);
+  t.real_list("sample.region.*.hi", {0, 0, 0}, "m", "box upper corner").size(3);
+  t.real_list("sample.region.*.axis", {0, 0, 1}, "m", "cylinder axis direction (normalised)").size(3);
+  t.real("sample.region.*.length", 1e-3, "m", "cylinder length along its axis").positive();
+  t.real_list("sample.region.*.semi_axes", {1e-3, 1e-3, 1e-3}, "m", "ellipsoid semi-axes").size(3).positive();
+  t.real_list("sample.region.*.rotation", {0, 0, 0}, "deg", "ellipsoid rotation: angles about x, then y, then z").size(3);
+  t.string("sample.region.*.file", "", "closed STL surface (relative paths from the scenario file's folder)");
+}
+
+namespace {
+
+std::vector<Region> read_regions(const Config& cfg, const Materials& mat, std::vector<int>& region_group) {
+  std::vector<Region> regions;
+  auto names = cfg.names("sample.region");
+  std::sort(names.begin(), names.end(), [](const std::string& a, const std::string& b) {
+    return a.size() != b.size() ? a.size() < b.size() : a < b;  // [[sample.region]] order
+  });
+  const std::filesystem::path base = std::filesystem::path(cfg.scenario_name()).parent_path();
+  for (auto& n : names) {
+    const std::string k = "sample.region." + n + ".";
+    const std::string group = cfg.string(k + "group");
+    const int g = mat.group_index(group);
+    if (g < 0) cfg.fail(k + "group", fmt::format("'{}' is not a declared group ([dem.group.NAME])", group));
+    const std::string shape = cfg.string(k + "shape");
+    auto v3 = [&](const std::string& key) {
+      const auto& l = cfg.real_list(k + key);
+      return Vec3(l[0], l[1], l[2]);
+    };
+    if (shape == "sphere") {
+      regions.emplace_back(Sphere{v3("center"), cfg.real(k + "radius")});
+    } else if (shape == "box") {
+      const Vec3 lo = v3("lo"), hi = v3("hi");
+      if ((hi - lo).minCoeff() <= 0) cfg.fail(k + "hi", "every coordinate of hi must exceed lo");
+      regions.emplace_back(Box{lo, hi});
+    } else if (shape == "cylinder") {
+      const Vec3 ax = v3("axis");
+      if (ax.norm() == 0) cfg.fail(k + "axis", "the axis must not be the zero vector");
+      regions.emplace_back(Cylinder{v3("center"), ax.normalized(), cfg.real(k + "radius"), cfg.real(k + "length")});
+    } else if (shape == "ellipsoid") {
+      const Vec3 rot = v3("rotation") * (kPi / 180.0);
+      const Quat q = Eigen::AngleAxis<Real>(rot.z(), Vec3::UnitZ()) * Eigen::AngleAxis<Real>(rot.y(), Vec3::UnitY()) *
+                     Eigen::AngleAxis<Real>(rot.x(), Vec3::UnitX());
+      regions.emplace_back(Ellipsoid{v3("center"), v3("semi_axes"), q});
+    } else {
+      std::filesystem::path f = cfg.string(k + "file");
+      if (f.empty()) cfg.fail(k + "file", "an stl region needs file = \"path/to/surface.stl\"");
+      if (f.is_relative()) f = base / f;
+      try {
+        regions.emplace_back(geom::load_mesh_region(f));
+      } catch (const InputError& e) {
+        cfg.fail(k + "file", e.what());
+      }
+    }
+    region_group.push_back(g);
+  }
+  return regions;
+}
+
+// Spatial order (cells of two max radii, raster z-y-x) so neighbours sit close in memory.
+void sort_spatially(std::vector<Vec3>& pos, std::vector<Real>& rad) {
+  const Real h = 2 * *std::max_element(rad.begin(), rad.end());
+  Vec3 lo = pos[0];
+  for (auto& p : pos) lo = lo.cwiseMin(p);
+  std::vector<std::int64_t> key(pos.size());
+  for (std::size_t i = 0; i < pos.size(); ++i) {
+    const Vec3 c = (pos[i] - lo) / h;
+    key[i] = (static_cast<std::int64_t>(c.z()) << 40) + (static_cast<std::int64_t>(c.y()) << 20) + static_cast<std::int64_t>(c.x());
+  }
+  std::vector<std::size_t> order(pos.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key[a] < key[b]; });
+  std::vector<Vec3> p2(pos.size());
+  std::vector<Real> r2(pos.size());
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    p2[i] = pos[order[i]];
+    r2[i] = rad[order[i]];
+  }
+  pos.swap(p2);
+  rad.swap(r2);
+}
+
+// Cycles until the mean unbalanced-force ratio is below `tol` (or the step cap).
+long equilibrate(DemSystem& sys, Real tol, long max_steps) {
+  long s = 0;
+  for (; s < max_steps; s += 50) {
+    sys.run(50);
+    if (sys.max_unbalanced_force_ratio() < tol) break;
+  }
+  return s;
+}
+
+// Mean stress (compression > 0) of all particles, over the container volume.
+Real mean_stress(const DemSystem& sys, Real volume, int dim) {
+  const Mat3 s = sys.average_stress([](const Vec3&) { return true; }, volume);
+  return dim == 3 ? -s.trace() / 3.0 : -(s(0, 0) + s(1, 1)) / 2.0;
+}
+
+}  // namespace
+
+SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
+  const auto t0 = std::chrono::steady_clock::now();
+  SampleInfo info;
+  const int dim = sys.settings.dim;
+  info.dim = dim;
+  info.axis = dim == 3 ? 2 : 1;
+  const std::string shape = cfg.string("sample.shape");
+  info.cylinder = shape == "cylinder";
+  if (dim == 2 && info.cylinder) cfg.fail("sample.shape", "a 2D sample is a rectangle: use shape = \"box\"");
+  const Real rmin = cfg.real("sample.radius_min"), rmax = cfg.real("sample.radius_max");
+  if (rmax < rmin) cfg.fail("sample.radius_max", fmt::format("must be >= sample.radius_min ({} m)", rmin));
+
+  geom::PackingSpec spec;
+  spec.dim = dim;
+  spec.radius_min = rmin;
+  spec.radius_max = rmax;
+  spec.porosity = cfg.real("sample.porosity");
+  spec.seed = static_cast<std::uint64_t>(cfg.integer("sample.seed"));
+  const Real H = cfg.real("sample.height");
+  Real width = info.cylinder ? cfg.real("sample.diameter") : cfg.real("sample.width");
+  if (width < 4 * rmax || H < 4 * rmax)
+    cfg.fail(info.cylinder ? "sample.diameter" : "sample.width",
+             fmt::format("the sample must be at least 4 particle radii wide and high (radius_max = {} m)", rmax));
+  if (info.cylinder) {
+    spec.container = geom::PackingSpec::Container::Cylinder;
+    spec.cyl_radius = 0.5 * width;
+    spec.cyl_height = H;
+    info.volume = kPi * 0.25 * width * width * H;
+  } else {
+    spec.container = geom::PackingSpec::Container::Box;
+    spec.box_lo = Vec3::Zero();
+    spec.box_hi = dim == 3 ? Vec3(width, cfg.real("sample.depth"), H) : Vec3(width, H, 0);
+    info.volume = dim == 3 ? width * cfg.real("sample.depth") * H : width * H;
+  }
+  const Real min_por = dim == 3 ? geom::kMinPorosity3D : geom::kMinPorosity2D;
+  if (spec.porosity < min_por)
+    cfg.fail("sample.porosity", fmt::format("{} is denser than a random packing can be made here; use >= {}", spec.porosity, min_por));
+  geom::Packing pk;
+  try {
+    pk = geom::dense_random_packing(spec);
+  } catch (const InputError& e) {
+    cfg.fail("sample.porosity", e.what());
+  }
+  sort_spatially(pk.position, pk.radius);
+
+  // Groups.
+  std::vector<int> region_group;
+  const auto regions = read_regions(cfg, sys.materials, region_group);
+  int default_group = 0;
+  if (!cfg.string("sample.default_group").empty()) {
+    default_group = sys.materials.group_index(cfg.string("sample.default_group"));
+    if (default_group < 0) cfg.fail("sample.default_group", "not a declared group ([dem.group.NAME])");
+  }
+  const auto groups = geom::assign_groups(pk.position, regions, region_group, default_group);
+
+  auto& P = sys.particles;
+  P.resize(pk.position.size());
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    P.pos[i] = pk.position[i];
+    P.radius[i] = pk.radius[i];
+    P.group[i] = groups[i];
+    P.set_mass_from_density(i, sys.materials.density[groups[i]], dim);
+  }
+
+  // Rigid vessel.
+  sys.walls.clear();
+  auto plane = [&](const char* name, Vec3 point, Vec3 normal) {
+    Wall w;
+    w.name = name;
+    w.point = point;
+    w.normal = normal;
+    w.friction = 0;
+    sys.walls.push_back(w);
+  };
+  if (info.cylinder) {
+    Wall c;
+    c.kind = Wall::Kind::CylinderInside;
+    c.name = "vessel";
+    c.point = Vec3::Zero();
+    c.normal = Vec3::UnitZ();
+    c.radius = 0.5 * width;
+    c.friction = 0;
+    sys.walls.push_back(c);
+    plane("bottom", Vec3::Zero(), Vec3::UnitZ());
+    plane("top", Vec3(0, 0, H), -Vec3::UnitZ());
+  } else {
+    const Vec3 hi = spec.box_hi;
+    plane("x-", Vec3::Zero(), Vec3::UnitX());
+    plane("x+", hi, -Vec3::UnitX());
+    plane("y-", Vec3::Zero(), Vec3::UnitY());
+    plane("y+", hi, -Vec3::UnitY());
+    if (dim == 3) {
+      plane("z-", Vec3::Zero(), Vec3::UnitZ());
+      plane("z+", hi, -Vec3::UnitZ());
+    }
+  }
+
+  // Frictionless genesis: the contact friction is restored before bonding.
+  const Materials saved = sys.materials;
+  for (auto& p : sys.materials.linear) p.fric = 0;
+  for (auto& p : sys.materials.hertz) p.fric = 0;
+  const BondLaw bond_law = sys.materials.bond_law;
+  sys.materials.bond_law = BondLaw::None;
+  Real rmean = 0;
+  for (Real r : P.radius) rmean += r;
+  rmean /= static_cast<Real>(P.size());
+  sys.settings.skin = cfg.real("sample.genesis_tolerance") > 0 ? cfg.real("dem.skin_ratio") * rmean : 0;
+  sys.initialise();
+  sys.settings.dt = 0.8 * sys.critical_time_step();
+  const Real tol = cfg.real("sample.genesis_tolerance");
+  const long max_steps = cfg.integer("sample.genesis_max_steps");
+  long steps = equilibrate(sys, tol, max_steps);
+  const Real target = cfg.real("sample.locked_in_stress");
+  Real p = mean_stress(sys, info.volume, dim);
+  // Shrink radii until the isotropic stress is below the target (PFC genesis step 3).
+  for (int it = 0; it < 12 && p > target; ++it) {
+    Real overlap = 0;
+    long n = 0;
+    const auto pi = sys.neighbors().first(), pj = sys.neighbors().second();
+    for (std::size_t k = 0; k < pi.size(); ++k) {
+      const Real gap = (P.pos[pj[k]] - P.pos[pi[k]]).norm() - P.radius[pi[k]] - P.radius[pj[k]];
+      if (gap < 0) { overlap -= gap; ++n; }
+    }
+    if (n == 0) break;
+    const Real mean_overlap_ratio = overlap / n / rmean;
+    const Real shrink = 0.5 * mean_overlap_ratio * (1.0 - 0.5 * target / p);
+    for (std::size_t i = 0; i < P.size(); ++i) {
+      P.radius[i] *= 1.0 - shrink;
+      P.set_mass_from_density(i, sys.materials.density[P.group[i]], dim);
+    }
+    sys.rebuild_neighbors();
+    sys.settings.dt = 0.8 * sys.critical_time_step();
+    steps += equilibrate(sys, tol, max_steps);
+    p = mean_stress(sys, info.volume, dim);
+  }
+  info.locked_in_stress = p;
+  if (p > target)
+    log::warn("genesis: locked-in stress {:.3g} Pa is still above sample.locked_in_stress = {:.3g} Pa after 12 reductions", p, target);
+
+  // Floaters (PFC eliminates them; we report them).
+  std::vector<int> ncontacts(P.size(), 0);
+  {
+    const auto pi = sys.neighbors().first(), pj = sys.neighbors().second();
+    for (std::size_t k = 0; k < pi.size(); ++k)
+      if ((P.pos[pj[k]] - P.pos[pi[k]]).norm() < P.radius[pi[k]] + P.radius[pj[k]]) {
+        ++ncontacts[pi[k]];
+        ++ncontacts[pj[k]];
+      }
+    for (int c : ncontacts) info.floaters += c < (dim == 3 ? 3 : 2);
+  }
+
+  // Bonds, with the real contact properties back.
+  sys.materials = saved;
+  sys.materials.bond_law = bond_law;
+  if (bond_law != BondLaw::None) info.bonds = sys.install_bonds(cfg.real("sample.bond_gap"));
+  Real solid = 0;
+  for (Real r : P.radius) solid += dim == 3 ? 4.0 / 3.0 * kPi * r * r * r : kPi * r * r;
+  info.porosity = 1.0 - solid / info.volume;
+
+  // Remove the vessel; the sample starts at rest with zero displacement.
+  sys.walls.clear();
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    P.vel[i].setZero();
+    P.omega[i].setZero();
+    P.disp[i].setZero();
+  }
+  sys.time = 0;
+  sys.step_count = 0;
+  sys.cracks = CrackLog{};
+  sys.initialise();
+  info.height = H;
+  info.width = width;
+  info.area = info.cylinder ? kPi * 0.25 * width * width : (dim == 3 ? width * cfg.real("sample.depth") : width);
+  info.genesis_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  log::info("sample: {} particles, {} bonds, porosity {:.3f}, locked-in stress {:.3g} Pa, {} floaters, genesis {} steps in {:.1f} s",
+            P.size(), info.bonds, info.porosity, info.locked_in_stress, info.floaters, steps, info.genesis_seconds);
+  return info;
+}
+
+void add_platens(DemSystem& sys, const SampleInfo& info, Real friction) {
+  const auto& P = sys.particles;
+  Real lo = std::numeric_limits<Real>::infinity(), hi = -lo;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    lo = std::min(lo, P.pos[i][info.axis] - P.radius[i]);
+    hi = std::max(hi, P.pos[i][info.axis] + P.radius[i]);
+  }
+  Vec3 n = Vec3::Zero();
+  n[info.axis] = 1;
+  Wall bottom, top;
+  bottom.name = "platen_bottom";
+  bottom.point = lo * n;
+  bottom.normal = n;
+  bottom.friction = friction;
+  top.name = "platen_top";
+  top.point = hi * n;
+  top.normal = -n;
+  top.friction = friction;
+  sys.walls.push_back(bottom);
+  sys.walls.push_back(top);
+  sys.initialise();
+}
+
+}  // namespace ff::dem

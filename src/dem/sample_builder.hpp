@@ -1,0 +1,34 @@
+// Bonded-particle sample genesis, after PFC's bonded-particle-model procedure (Potyondy &
+// Cundall 2004, section 3.1): dense random packing in a rigid vessel -> frictionless
+// equilibration -> isotropic stress reduced below a set value (locked-in stress) -> bonds
+// installed between particles closer than a gap -> vessel removed. Groups are assigned from
+// primitives and closed STL surfaces (point-in-mesh of the particle centres).
+#pragma once
+#include "dem/dem_system.hpp"
+#include "io/params.hpp"
+
+namespace ff::dem {
+
+struct SampleInfo {
+  int dim = 3;
+  int axis = 2;               // loading axis: z in 3D, y in 2D
+  Real height = 0;            // along the loading axis, platen to platen [m]
+  Real width = 0;             // cylinder diameter or box width [m]
+  Real area = 0;              // loaded cross-section [m^2] (2D: width x 1 m)
+  Real volume = 0;            // container volume [m^3] (2D: area x 1 m)
+  bool cylinder = true;
+  Real porosity = 0;          // after genesis
+  Real locked_in_stress = 0;  // mean stress when bonds were installed [Pa], compression > 0
+  std::size_t bonds = 0;
+  std::size_t floaters = 0;   // particles with fewer than 3 (3D) or 2 (2D) contacts before bonding
+  double genesis_seconds = 0;
+};
+
+void declare_sample_params(ParamTable& t);
+// Builds particles, groups, masses and bonds in `sys` (whose settings/materials are set),
+// removes the vessel and leaves no walls. Throws InputError for bad sample keys.
+SampleInfo build_sample(const Config& cfg, DemSystem& sys);
+// Adds two platens touching the sample's ends along info.axis (bottom first), with friction.
+void add_platens(DemSystem& sys, const SampleInfo& info, Real friction);
+
+}  // namespace ff::dem

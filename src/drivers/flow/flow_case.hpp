@@ -1,0 +1,82 @@
+// A flow benchmark (Poiseuille channel, lid-driven cavity, cylinder in a channel) as seen
+// by the shared LBM runner (flow_runner.hpp): the case describes its lattice domain, turns
+// sampled fields into rows of series.csv, and writes its results at the end. The runner owns
+// the solver, the time loop, units, output files, checkpoints and stability checks.
+#pragma once
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/types.hpp"
+#include "io/params.hpp"
+#include "lbm/boundary.hpp"
+#include "lbm/shapes.hpp"
+#include "lbm/solver.hpp"
+#include "lbm/units.hpp"
+
+namespace ff::drivers {
+
+// The lattice problem in lattice units (a 2D description; D3Q19 runs extrude it along a
+// periodic z axis of lbm.depth_cells cells).
+struct DomainSpec {
+  int nx = 1, ny = 1;
+  std::array<bool, 2> periodic{};                  // x, y
+  std::array<lbm::FaceCondition, 4> faces;         // x-, x+, y-, y+ (ignored on periodic axes)
+  struct Object {
+    std::string name;
+    lbm::WallScheme scheme = lbm::WallScheme::HalfwayBounceBack;
+    Vec3 center = Vec3::Zero();
+    std::optional<lbm::Shape> shape;               // solid cells and link fractions
+    std::vector<std::array<int, 2>> cells;         // extra solid cells (mask, image)
+  };
+  std::vector<Object> objects;
+  Vec3 body_force = Vec3::Zero();                  // lattice force density
+  std::function<void(int x, int y, double& rho, Vec3& u)> init;  // initial state (default rest)
+};
+
+// Macroscopic state at one sampling step, SI units, on the z = 0 plane of the lattice.
+struct FlowSample {
+  long step = 0;
+  double time = 0;                   // s
+  int nx = 0, ny = 0;
+  std::span<const double> pressure;  // Pa relative to the reference state, nx*ny, x fastest
+  std::span<const Vec3> velocity;    // m/s
+  std::span<const std::uint8_t> solid;
+  // Per solid object (same order as DomainSpec::objects): force and torque per unit depth
+  // (N/m and N), at time t - dt/2.
+  std::vector<Vec3> force, torque;
+  std::array<Vec3, 4> face_force{};  // walls x-, x+, y-, y+ (N/m)
+  double max_mach = 0;
+  std::size_t at(int x, int y) const { return std::size_t(x) + std::size_t(nx) * std::size_t(y); }
+};
+
+class FlowCase {
+ public:
+  virtual ~FlowCase() = default;
+  // Cell size [m] from the case geometry and its resolution key.
+  virtual double cell_size() const = 0;
+  // Number of cells across the characteristic length, and its key (for fix suggestions).
+  virtual int resolution() const = 0;
+  virtual std::string resolution_key() const { return "lbm.resolution"; }
+  // Largest speed expected [m/s] (Mach check before the run).
+  virtual double characteristic_speed() const = 0;
+  virtual DomainSpec domain(const lbm::Units& u) = 0;
+  virtual std::vector<std::string> columns() const = 0;  // after the runner's "step", "time"
+  virtual void measure(const FlowSample& s, std::vector<double>& row) const = 0;
+  // Column (index into columns()) whose relative change decides steady state; none: run to end.
+  virtual std::optional<int> steady_column() const { return std::nullopt; }
+  // Results into `summary`, extra files and plots into `out` (history = all series rows,
+  // each starting with step and time).
+  virtual void finish(const FlowSample& last, const std::vector<std::vector<double>>& history,
+                      const std::filesystem::path& out, bool plots, nlohmann::json& summary) const = 0;
+  // One short line for the progress display.
+  virtual std::string progress_text(const std::vector<double>& row) const { return {}; }
+};
+
+}  // namespace ff::drivers

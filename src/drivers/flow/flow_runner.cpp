@@ -1,0 +1,398 @@
+#include "drivers/flow/flow_runner.hpp"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "core/progress.hpp"
+#include "fracflow/version.hpp"
+#include "io/checkpoint.hpp"
+#include "io/csv.hpp"
+#include "io/json_out.hpp"
+#include "io/plot.hpp"
+#include "io/pvd.hpp"
+#include "io/vtk.hpp"
+
+namespace fs = std::filesystem;
+
+namespace ff::drivers {
+
+void declare_lbm_params(ParamTable& t, const LbmDefaults& d) {
+  t.string("lbm.lattice", "D2Q9", "velocity set; D3Q19 extrudes the 2D case along a periodic z axis").one_of({"D2Q9", "D3Q19"});
+  t.integer("lbm.depth_cells", 1, "cells", "D3Q19 only: cells along the periodic z axis").at_least(1);
+  t.string("lbm.precision", "double", "storage and arithmetic precision of the populations").one_of({"double", "float"});
+  t.string("lbm.collision", "trt", "collision: two-relaxation-time (Ginzburg et al. 2008) or BGK").one_of({"trt", "bgk"});
+  t.real("lbm.trt_magic", 3.0 / 16.0, "-", "TRT magic parameter Lambda (3/16 puts bounce-back walls exactly mid-link)")
+      .positive();
+  t.real("lbm.tau", d.tau, "-", "relaxation time; gives dt = (tau - 1/2) dx^2 / (3 nu) unless lbm.time_step is set")
+      .open_range(0.5, 1e6);
+  t.real("lbm.time_step", 0.0, "s", "time step; 0: derived from lbm.tau").non_negative();
+  t.integer("lbm.resolution", d.resolution, "cells", "cells across the characteristic length of the case").at_least(2);
+  t.real("fluid.density", d.density, "kg/m^3", "fluid density").positive();
+  t.real("fluid.viscosity", d.viscosity, "m^2/s", "kinematic viscosity").positive();
+  t.real("run.end_time", d.end_time, "s", "simulated time at which the run stops").positive();
+  t.real("run.steady_tolerance", d.steady_tolerance, "-",
+         "stop once the monitored result changes by less than this (relative) over 3 samples; 0: run to run.end_time")
+      .non_negative();
+  t.integer("output.samples", 200, "-", "rows of series.csv over run.end_time").at_least(1);
+  t.integer("output.snapshots", 10, "-", "VTK snapshots over run.end_time (plus the first and last)").non_negative();
+  t.integer("output.checkpoints", 10, "-", "checkpoints over run.end_time (there is always one at the end)").non_negative();
+}
+
+lbm::Units make_units(const Config& cfg, double dx) {
+  const double nu = cfg.real("fluid.viscosity"), rho = cfg.real("fluid.density");
+  if (cfg.has("lbm.time_step") && cfg.real("lbm.time_step") > 0) {
+    if (cfg.has("lbm.tau"))
+      cfg.fail("lbm.tau", "set either lbm.tau or lbm.time_step, not both (one follows from the other and the viscosity)");
+    return lbm::Units::from_time_step(dx, cfg.real("lbm.time_step"), nu, rho);
+  }
+  return lbm::Units::from_tau(dx, cfg.real("lbm.tau"), nu, rho);
+}
+
+namespace {
+
+// Runner state that must survive a restart (next to the populations and the history).
+struct RunnerState {
+  std::int64_t step = 0;
+  std::int64_t vtk_index = 0;
+  std::int64_t finished = 0;
+  std::int64_t columns = 0;
+};
+
+}  // namespace
+}  // namespace ff::drivers
+
+namespace ff {
+template <> struct is_checkpoint_pod<drivers::RunnerState> : std::true_type {};
+}
+
+namespace ff::drivers {
+namespace {
+
+template <class L, class T>
+class Runner {
+ public:
+  Runner(const Config& cfg, const RunOptions& opt, FlowCase& fc, std::string_view driver)
+      : cfg_(cfg), opt_(opt), fc_(fc), driver_(driver), units_(make_units(cfg, fc.cell_size())) {}
+
+  RunStatus run();
+
+ private:
+  void build();
+  void sample(FlowSample& s);
+  void write_vtk(const FlowSample& s);
+  void write_checkpoint(const fs::path& dir);
+  void read_checkpoint();
+  [[noreturn]] void unstable(const std::string& what);
+  void summary(const FlowSample& last, const std::string& stop_reason, double loop_seconds, long loop_steps);
+
+  const Config& cfg_;
+  const RunOptions& opt_;
+  FlowCase& fc_;
+  std::string driver_;
+  lbm::Units units_;
+  DomainSpec dom_;
+  std::unique_ptr<lbm::Solver<L, T>> sol_;
+  int nz_ = 1;
+  RunnerState st_;
+  std::vector<double> history_;  // all series rows, flattened (reserved once)
+  std::size_t ncols_ = 0;
+  PvdSeries pvd_;
+  // Output buffers, allocated once (no allocation in the time loop).
+  std::vector<double> pressure_;
+  std::vector<Vec3> velocity_;
+  std::vector<std::uint8_t> solid_;
+  std::vector<double> row_;
+};
+
+template <class L, class T>
+void Runner<L, T>::build() {
+  dom_ = fc_.domain(units_);
+  nz_ = L::D == 3 ? int(cfg_.integer("lbm.depth_cells")) : 1;
+  lbm::Grid g(L::D, dom_.nx, dom_.ny, nz_, {dom_.periodic[0], dom_.periodic[1], true});
+  lbm::SolverSettings s;
+  s.collision = cfg_.string("lbm.collision") == "bgk" ? lbm::CollisionModel::Bgk : lbm::CollisionModel::Trt;
+  s.tau = units_.tau();
+  s.magic = cfg_.real("lbm.trt_magic");
+  s.body_force = dom_.body_force;
+  sol_ = std::make_unique<lbm::Solver<L, T>>(g, s);
+  for (int f = 0; f < 4; ++f)
+    if (!dom_.periodic[f / 2]) sol_->set_face(f, dom_.faces[f]);
+  for (auto& o : dom_.objects) {
+    const int id = sol_->add_object(o.name, o.scheme, o.center);
+    if (o.shape) sol_->add_shape(id, *o.shape);
+    for (auto& c : o.cells)
+      for (int z = 0; z < nz_; ++z) sol_->set_solid(c[0], c[1], z, id);
+  }
+  sol_->finalize();
+  auto init = dom_.init;
+  sol_->initialize([&](int x, int y, int, double& rho, Vec3& u) {
+    if (init) init(x, y, rho, u);
+  });
+  const std::size_t n = std::size_t(dom_.nx) * dom_.ny * nz_;
+  pressure_.assign(n, 0.0);
+  velocity_.assign(n, Vec3::Zero());
+  solid_.assign(n, 0);
+}
+
+template <class L, class T>
+void Runner<L, T>::sample(FlowSample& s) {
+  const auto& g = sol_->grid();
+  double umax = 0;
+  for (int z = 0; z < nz_; ++z)
+    for (int y = 0; y < g.ny; ++y)
+      for (int x = 0; x < g.nx; ++x) {
+        const std::size_t i = std::size_t(x) + std::size_t(g.nx) * (std::size_t(y) + std::size_t(g.ny) * z);
+        const bool solid = sol_->is_solid(x, y, z);
+        solid_[i] = solid ? 1 : 0;
+        pressure_[i] = solid ? 0.0 : units_.to_si_pressure(sol_->density(x, y, z));
+        const Vec3 u = solid ? Vec3::Zero() : sol_->velocity(x, y, z);
+        velocity_[i] = units_.to_si_velocity(1.0) * u;
+        if (!solid) umax = std::max(umax, u.norm());
+      }
+  s.step = sol_->time_step();
+  s.time = double(s.step) * units_.dt();
+  s.nx = g.nx;
+  s.ny = g.ny;
+  const std::size_t plane = std::size_t(g.nx) * g.ny;
+  s.pressure = std::span<const double>(pressure_.data(), plane);
+  s.velocity = std::span<const Vec3>(velocity_.data(), plane);
+  s.solid = std::span<const std::uint8_t>(solid_.data(), plane);
+  const auto& objs = sol_->objects();
+  s.force.resize(dom_.objects.size());
+  s.torque.resize(dom_.objects.size());
+  auto per_depth = [&](const Vec3& f) { return units_.to_si_force(1.0, 2) / nz_ * f; };
+  for (std::size_t k = 0; k < dom_.objects.size(); ++k) {
+    const auto& o = objs[lbm::Solver<L, T>::kFirstUserObject + k];
+    s.force[k] = per_depth(o.force);
+    s.torque[k] = units_.to_si_force(1.0, 2) * units_.dx() / nz_ * o.torque;
+  }
+  for (int f = 0; f < 4; ++f) s.face_force[f] = per_depth(objs[f].force);
+  s.max_mach = std::sqrt(3.0) * sol_->max_speed();
+}
+
+template <class L, class T>
+void Runner<L, T>::write_vtk(const FlowSample& s) {
+  const auto& g = sol_->grid();
+  const std::string file = fmt::format("flow_{:06d}.vti", st_.vtk_index++);
+  const VtkArray arrays[] = {vtk_array("pressure", std::span<const double>(pressure_)),
+                             vtk_array("velocity", std::span<const Vec3>(velocity_)),
+                             vtk_array("solid", std::span<const std::uint8_t>(solid_))};
+  const double dx = units_.dx();
+  write_vti(opt_.out_dir / "vtk" / file, {g.nx, g.ny, nz_}, Vec3::Zero(), Vec3(dx, dx, dx), arrays);
+  pvd_.add(s.time, file);
+}
+
+template <class L, class T>
+void Runner<L, T>::write_checkpoint(const fs::path& dir) {
+  fs::create_directories(dir);
+  CheckpointWriter w(dir / "state.ffcp");
+  const auto& f = sol_->populations();
+  w.put("lbm.populations", std::vector<T>(f.begin(), f.end()));
+  st_.step = sol_->time_step();
+  st_.columns = std::int64_t(ncols_);
+  w.put_value("flow.state", st_);
+  w.put("flow.history", history_);
+  w.put_string("flow.lattice", fmt::format("{} {} {}x{}x{}", L::name, sizeof(T) == 8 ? "double" : "float", dom_.nx,
+                                           dom_.ny, nz_));
+  w.commit();
+}
+
+template <class L, class T>
+void Runner<L, T>::read_checkpoint() {
+  CheckpointReader r(opt_.out_dir / "checkpoint" / "state.ffcp");
+  const std::string expect = fmt::format("{} {} {}x{}x{}", L::name, sizeof(T) == 8 ? "double" : "float", dom_.nx,
+                                         dom_.ny, nz_);
+  const std::string have = r.get_string("flow.lattice");
+  if (have != expect)
+    throw InputError(fmt::format("{}: the checkpoint holds a {} lattice but the scenario builds {}", r.path().string(),
+                                 have, expect));
+  std::vector<T> f;
+  r.get("lbm.populations", f);
+  st_ = r.get_value<RunnerState>("flow.state");
+  sol_->restore(f, long(st_.step));
+  r.get("flow.history", history_);
+  if (std::size_t(st_.columns) != ncols_)
+    throw InputError(fmt::format("{}: the checkpoint's series has {} columns, this scenario writes {}", r.path().string(),
+                                 st_.columns, ncols_));
+}
+
+template <class L, class T>
+void Runner<L, T>::unstable(const std::string& what) {
+  write_checkpoint(opt_.out_dir / "checkpoint_failed");
+  throw NumericalError(fmt::format(
+      "the LBM became unstable at step {} (t = {:.6g} s): {}. The state is saved in {}. To fix it, raise {} (finer "
+      "cells, lower Mach number) or lower the time step, or use lbm.collision = \"trt\" with a relaxation time further "
+      "from 1/2 (now tau = {:.4g})",
+      sol_->time_step(), double(sol_->time_step()) * units_.dt(), what, (opt_.out_dir / "checkpoint_failed").string(),
+      fc_.resolution_key(), units_.tau()));
+}
+
+template <class L, class T>
+RunStatus Runner<L, T>::run() {
+  const auto wall_start = std::chrono::steady_clock::now();
+  const bool tau_mode = !(cfg_.real("lbm.time_step") > 0);
+  {
+    const auto chk = units_.check(fc_.characteristic_speed(), fc_.resolution(), fc_.resolution_key(), tau_mode);
+    if (!chk.error.empty()) cfg_.fail(tau_mode ? "lbm.tau" : "lbm.time_step", chk.error);
+    build();
+    log::info("{}", units_.describe(L::D));
+    log::info("lattice {} {} x {} x {} ({} precision, {}): {} fluid cells, {} on boundaries, {} solid links",
+              L::name, dom_.nx, dom_.ny, nz_, sizeof(T) == 8 ? "double" : "single", cfg_.string("lbm.collision"),
+              sol_->num_fluid_cells(), sol_->num_boundary_cells(), [&] {
+                long n = 0;
+                for (auto& o : sol_->objects()) n += o.links;
+                return n;
+              }());
+    log::info("Mach number {:.3g} (characteristic speed {:.4g} m/s = {:.4g} lattice units)",
+              std::sqrt(3.0) * units_.to_lattice_velocity(fc_.characteristic_speed()), fc_.characteristic_speed(),
+              units_.to_lattice_velocity(fc_.characteristic_speed()));
+    for (auto& w : chk.warnings) log::warn("{}", w);
+  }
+  const long steps_total = std::max(1L, std::lround(cfg_.real("run.end_time") / units_.dt()));
+  const long samples = cfg_.integer("output.samples");
+  const long sample_every = std::max(1L, steps_total / samples);
+  const long n_samples = (steps_total + sample_every - 1) / sample_every;
+  auto every = [&](long n) { return n > 0 ? std::max(1L, n_samples / n) : 0L; };
+  const long vtk_every = cfg_.boolean("output.vtk") ? every(cfg_.integer("output.snapshots")) : 0;
+  const long cp_every = every(cfg_.integer("output.checkpoints"));
+  const double steady_tol = cfg_.real("run.steady_tolerance");
+  const auto steady_col = fc_.steady_column();
+
+  std::vector<std::string> columns = {"step", "time"};
+  for (auto& c : fc_.columns()) columns.push_back(c);
+  ncols_ = columns.size();
+  history_.reserve(std::size_t(n_samples) * ncols_);
+  CsvWriter series;
+  const fs::path cp_dir = opt_.out_dir / "checkpoint";
+  if (opt_.resume) {
+    read_checkpoint();
+    if (st_.finished) {
+      log::info("this run had already finished; nothing to resume");
+      return RunStatus::Finished;
+    }
+    series.reopen(opt_.out_dir / "series.csv", columns, history_.size() / ncols_);
+    log::info("resuming at step {} (t = {:.6g} s)", sol_->time_step(), double(sol_->time_step()) * units_.dt());
+  } else {
+    series.open(opt_.out_dir / "series.csv", columns);
+  }
+  if (vtk_every > 0) pvd_.open(opt_.out_dir / "vtk" / "flow.pvd", opt_.resume, double(sol_->time_step()) * units_.dt());
+  FlowSample s;
+  row_.reserve(columns.size());
+  if (!opt_.resume && vtk_every > 0) {
+    sample(s);
+    write_vtk(s);
+  }
+
+  Progress progress(driver_, opt_.progress_interval_s);
+  RunStatus status = RunStatus::Finished;
+  std::string stop_reason = fmt::format("reached run.end_time = {} s", cfg_.real("run.end_time"));
+  const auto loop_start = std::chrono::steady_clock::now();
+  const long loop_first_step = sol_->time_step();
+  while (sol_->time_step() < steps_total) {
+    const long n = std::min(sample_every, steps_total - sol_->time_step());
+    for (long i = 0; i < n; ++i) sol_->step(i == n - 1);
+    sample(s);
+    if (!(s.max_mach == s.max_mach)) unstable("the velocity field holds NaN");
+    if (s.max_mach > 0.3) unstable(fmt::format("the Mach number reached {:.3g} (limit 0.3)", s.max_mach));
+    row_.clear();
+    row_.push_back(double(s.step));
+    row_.push_back(s.time);
+    fc_.measure(s, row_);
+    series.row(row_);
+    history_.insert(history_.end(), row_.begin(), row_.end());
+    const long k = long(history_.size() / ncols_);
+    const bool last = sol_->time_step() >= steps_total;
+    bool steady = false;
+    if (steady_col && steady_tol > 0 && k >= 4) {
+      const std::size_t c = std::size_t(*steady_col) + 2;
+      steady = true;
+      for (long j = k - 3; j < k; ++j) {
+        const double a = history_[std::size_t(j) * ncols_ + c], b = history_[std::size_t(j - 1) * ncols_ + c];
+        if (!(std::abs(a - b) <= steady_tol * std::max(std::abs(a), 1e-300))) steady = false;
+      }
+      if (steady) stop_reason = fmt::format("steady state ({} changed by less than {} over 3 samples)", columns[c], steady_tol);
+    }
+    const bool done = last || steady;
+    if (vtk_every > 0 && (k % vtk_every == 0 || done)) write_vtk(s);
+    if (done) break;
+    if (cp_every > 0 && k % cp_every == 0) write_checkpoint(cp_dir);
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+    if ((opt_.max_wall_s > 0 && elapsed >= opt_.max_wall_s) || (!opt_.abort_file.empty() && fs::exists(opt_.abort_file))) {
+      write_checkpoint(cp_dir);
+      status = RunStatus::Interrupted;
+      break;
+    }
+    progress.update(sol_->time_step(), s.time, double(sol_->time_step()) / double(steps_total), fc_.progress_text(row_));
+  }
+  const double loop_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - loop_start).count();
+  series.close();
+  if (status == RunStatus::Interrupted) return status;
+  st_.finished = 1;
+  write_checkpoint(cp_dir);
+  summary(s, stop_reason, loop_s, sol_->time_step() - loop_first_step);
+  return status;
+}
+
+template <class L, class T>
+void Runner<L, T>::summary(const FlowSample& last, const std::string& stop_reason, double loop_s, long loop_steps) {
+  nlohmann::json j;
+  j["fracflow_version"] = kVersion;
+  j["driver"] = driver_;
+  j["title"] = cfg_.string("title");
+  j["stop_reason"] = stop_reason;
+  j["lattice"] = {{"velocity_set", L::name},
+                  {"precision", sizeof(T) == 8 ? "double" : "float"},
+                  {"collision", cfg_.string("lbm.collision")},
+                  {"cells", {dom_.nx, dom_.ny, nz_}},
+                  {"fluid_cells", sol_->num_fluid_cells()},
+                  {"boundary_cells", sol_->num_boundary_cells()}};
+  j["units"] = {{"dx_m", units_.dx()},
+                {"dt_s", units_.dt()},
+                {"tau", units_.tau()},
+                {"nu_lattice", units_.nu_lb()},
+                {"velocity_factor_m_per_s", units_.velocity_factor()},
+                {"pressure_factor_Pa", units_.pressure_factor()},
+                {"force_factor_N_per_m", units_.force_factor()},
+                {"mach_characteristic", std::sqrt(3.0) * units_.to_lattice_velocity(fc_.characteristic_speed())},
+                {"mach_max_final", last.max_mach}};
+  j["steps"] = sol_->time_step();
+  j["simulated_time_s"] = double(sol_->time_step()) * units_.dt();
+  j["wall_time_s"] = loop_s;
+  j["mlups"] = loop_s > 0 ? double(sol_->num_fluid_cells()) * double(loop_steps) / loop_s * 1e-6 : 0.0;
+  j["threads"] = opt_.threads;
+  nlohmann::json results = nlohmann::json::object();
+  const bool plots = cfg_.boolean("output.plots");
+  if (plots) fs::create_directories(opt_.out_dir / "plots");
+  std::vector<std::vector<double>> rows;
+  for (std::size_t i = 0; i + ncols_ <= history_.size(); i += ncols_)
+    rows.emplace_back(history_.begin() + std::ptrdiff_t(i), history_.begin() + std::ptrdiff_t(i + ncols_));
+  fc_.finish(last, rows, opt_.out_dir, plots, results);
+  j["results"] = results;
+  nlohmann::json params = nlohmann::json::object();
+  for (auto& [k, v] : cfg_.values()) params[k] = format_value(v.first);
+  j["parameters"] = params;
+  write_json_atomic(opt_.out_dir / "summary.json", j);
+}
+
+template <class L, class T>
+RunStatus run_typed(const Config& cfg, const RunOptions& opt, FlowCase& fc, std::string_view driver) {
+  Runner<L, T> r(cfg, opt, fc, driver);
+  return r.run();
+}
+
+}  // namespace
+
+RunStatus run_flow(const Config& cfg, const RunOptions& opt, FlowCase& fc, std::string_view driver) {
+  const bool d3 = cfg.string("lbm.lattice") == "D3Q19";
+  const bool dbl = cfg.string("lbm.precision") == "double";
+  if (!d3 && cfg.has("lbm.depth_cells") && cfg.integer("lbm.depth_cells") != 1)
+    cfg.fail("lbm.depth_cells", "only D3Q19 has a depth; set lbm.lattice = \"D3Q19\" or remove lbm.depth_cells");
+  if (d3) return dbl ? run_typed<lbm::D3Q19, double>(cfg, opt, fc, driver) : run_typed<lbm::D3Q19, float>(cfg, opt, fc, driver);
+  return dbl ? run_typed<lbm::D2Q9, double>(cfg, opt, fc, driver) : run_typed<lbm::D2Q9, float>(cfg, opt, fc, driver);
+}
+
+}  // namespace ff::drivers

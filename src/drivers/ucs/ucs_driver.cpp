@@ -1,0 +1,303 @@
+#include "drivers/ucs/ucs_driver.hpp"
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <filesystem>
+
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "core/progress.hpp"
+#include "dem/dem_checkpoint.hpp"
+#include "dem/dem_output.hpp"
+#include "dem/dem_params.hpp"
+#include "dem/sample_builder.hpp"
+#include "drivers/ucs/ucs_measure.hpp"
+#include "fracflow/version.hpp"
+#include "io/csv.hpp"
+#include "io/json_out.hpp"
+#include "io/plot.hpp"
+
+namespace fs = std::filesystem;
+
+namespace ff::drivers {
+
+namespace {
+
+void declare(ParamTable& t) {
+  dem::declare_dem_params(t);
+  dem::declare_sample_params(t);
+  t.real("ucs.platen_velocity", 0.05, "m/s", "speed of each platen towards the sample").positive();
+  t.real("ucs.platen_friction", 0.1, "-", "friction between platens and particles (seed 000: 0.1)").non_negative();
+  t.real("ucs.stop_fraction", 0.6, "-", "stop when the axial stress has fallen below this fraction of its peak").open_range(0, 1);
+  t.real("ucs.max_strain", 0.05, "-", "stop at this axial strain in any case").positive();
+  t.integer("ucs.series_interval", 100, "steps", "steps between rows of series.csv").positive();
+  t.real("ucs.vtk_strain_interval", 1e-3, "-", "axial strain between VTK snapshots").positive();
+  t.integer("ucs.checkpoint_interval", 20000, "steps", "steps between checkpoints (0: only at the end and on interruption)").non_negative();
+}
+
+const std::vector<std::string> kColumns = {"step", "time", "axial_strain", "axial_stress", "lateral_strain",
+                                           "volumetric_strain", "cracks_tensile", "cracks_shear", "cracks_total",
+                                           "intact_bonds", "kinetic_energy", "unbalanced_force_ratio"};
+
+// Driver state that must survive a restart.
+struct UcsState {
+  Real peak_stress = 0, strain_at_peak = 0;
+  long peak_row = 0, rows = 0, cracks_written = 0, vtk_index = 0;
+  Real next_vtk_strain = 0, h0 = 0;
+  int finished = 0;
+};
+
+}  // namespace
+}  // namespace ff::drivers
+
+namespace ff {
+template <> struct is_checkpoint_pod<drivers::UcsState> : std::true_type {};
+template <> struct is_checkpoint_pod<dem::SampleInfo> : std::false_type {};
+}  // namespace ff
+
+namespace ff::drivers {
+namespace {
+
+struct SampleRecord {  // SampleInfo without its non-trivial members
+  int dim, axis, cylinder;
+  Real height, width, area, volume, porosity, locked_in_stress, genesis_seconds;
+  std::uint64_t bonds, floaters;
+};
+
+}  // namespace
+}  // namespace ff::drivers
+namespace ff {
+template <> struct is_checkpoint_pod<drivers::SampleRecord> : std::true_type {};
+}
+
+namespace ff::drivers {
+namespace {
+
+void write_checkpoint(const fs::path& dir, const dem::DemSystem& sys, const UcsState& st, const dem::SampleInfo& info) {
+  fs::create_directories(dir);
+  CheckpointWriter w(dir / "state.ffcp");
+  dem::save_dem(w, sys);
+  w.put_value("ucs.state", st);
+  w.put_value("ucs.sample", SampleRecord{info.dim, info.axis, info.cylinder, info.height, info.width, info.area, info.volume,
+                                         info.porosity, info.locked_in_stress, info.genesis_seconds, info.bonds, info.floaters});
+  w.commit();
+}
+
+void read_checkpoint(const fs::path& dir, dem::DemSystem& sys, UcsState& st, dem::SampleInfo& info) {
+  CheckpointReader r(dir / "state.ffcp");
+  dem::load_dem(r, sys);
+  st = r.get_value<UcsState>("ucs.state");
+  const auto s = r.get_value<SampleRecord>("ucs.sample");
+  info.dim = s.dim;
+  info.axis = s.axis;
+  info.cylinder = s.cylinder;
+  info.height = s.height;
+  info.width = s.width;
+  info.area = s.area;
+  info.volume = s.volume;
+  info.porosity = s.porosity;
+  info.locked_in_stress = s.locked_in_stress;
+  info.genesis_seconds = s.genesis_seconds;
+  info.bonds = s.bonds;
+  info.floaters = s.floaters;
+}
+
+nlohmann::json params_json(const Config& cfg) {
+  nlohmann::json j = nlohmann::json::object();
+  for (auto& [k, v] : cfg.values()) j[k] = format_value(v.first);
+  return j;
+}
+
+void make_plots(const fs::path& out, const Config& cfg) {
+  if (!cfg.boolean("output.plots")) return;
+  fs::create_directories(out / "plots");
+  PlotSpec a;
+  a.title = "Uniaxial compression: stress and cracks";
+  a.x = "axial_strain";
+  a.x_scale = 100;
+  a.xlabel = "axial strain [%]";
+  a.y = {"axial_stress"};
+  a.y_scale = 1e-6;
+  a.ylabel = "axial stress [MPa]";
+  a.y2 = {"cracks_total", "cracks_tensile", "cracks_shear"};
+  a.y2label = "number of cracks";
+  plot_series(out / "series.csv", out / "plots" / "stress_strain_cracks.png", a);
+  PlotSpec b;
+  b.title = "Uniaxial compression: strains";
+  b.x = "axial_strain";
+  b.x_scale = 100;
+  b.xlabel = "axial strain [%]";
+  b.y = {"lateral_strain", "volumetric_strain"};
+  b.y_scale = 100;
+  b.ylabel = "strain [%] (compression > 0)";
+  plot_series(out / "series.csv", out / "plots" / "strains.png", b);
+}
+
+RunStatus run(const Config& cfg, const RunOptions& opt) {
+  const auto wall_start = std::chrono::steady_clock::now();
+  dem::DemSystem sys;
+  sys.settings = dem::build_settings(cfg);
+  sys.materials = dem::build_materials(cfg);
+  dem::SampleInfo info;
+  UcsState st;
+  const fs::path cp_dir = opt.out_dir / "checkpoint";
+  if (opt.resume) {
+    read_checkpoint(cp_dir, sys, st, info);
+    if (st.finished) {
+      log::info("this run had already finished; nothing to resume");
+      return RunStatus::Finished;
+    }
+    log::info("resuming at step {} (t = {:.6g} s)", sys.step_count, sys.time);
+  } else {
+    info = dem::build_sample(cfg, sys);
+    dem::add_platens(sys, info, cfg.real("ucs.platen_friction"));
+    dem::choose_time_step(cfg, sys);
+    const Real v = cfg.real("ucs.platen_velocity");
+    sys.walls[0].velocity[info.axis] = v;
+    sys.walls[1].velocity[info.axis] = -v;
+  }
+  CompressionGauge gauge;
+  gauge.init(sys, info);
+  if (opt.resume) gauge.set_initial_height(st.h0);
+  else st.h0 = gauge.initial_height();
+
+  // Outputs (on resume: rows and snapshots after the checkpoint are dropped; they are
+  // recomputed identically).
+  CsvWriter series;
+  if (opt.resume) series.reopen(opt.out_dir / "series.csv", kColumns, static_cast<std::size_t>(st.rows));
+  else series.open(opt.out_dir / "series.csv", kColumns);
+  const fs::path cracks_csv = opt.out_dir / "cracks.csv";
+  if (!opt.resume) dem::append_cracks_csv(cracks_csv, sys.cracks, sys.materials, 0);
+  else {
+    // Rewrite the crack file up to the checkpoint (later lines would be duplicated).
+    dem::CrackLog head;
+    head.events.assign(sys.cracks.events.begin(), sys.cracks.events.begin() + st.cracks_written);
+    dem::append_cracks_csv(cracks_csv, head, sys.materials, 0);
+  }
+  const bool vtk = cfg.boolean("output.vtk");
+  dem::DemVtkWriter writer;
+  const Real extent = 1.6 * std::max(info.width, info.height);
+  if (vtk) writer.open(opt.out_dir / "vtk", opt.resume, sys.time);
+  if (vtk && !opt.resume) {
+    writer.write(sys, st.vtk_index++, extent);
+    st.next_vtk_strain = cfg.real("ucs.vtk_strain_interval");
+  }
+
+  const long series_every = cfg.integer("ucs.series_interval");
+  const long cp_every = cfg.integer("ucs.checkpoint_interval");
+  const Real stop_fraction = cfg.real("ucs.stop_fraction"), max_strain = cfg.real("ucs.max_strain");
+  const Real vtk_every = cfg.real("ucs.vtk_strain_interval");
+  Progress progress("ucs", opt.progress_interval_s);
+  std::vector<Real> e_hist, s_hist, l_hist;
+  {  // The elastic fit needs the whole curve: re-read the rows kept so far.
+    if (opt.resume && st.rows > 0) {
+      const CsvTable t = read_csv(opt.out_dir / "series.csv");
+      e_hist = t.column("axial_strain");
+      s_hist = t.column("axial_stress");
+      l_hist = t.column("lateral_strain");
+    }
+  }
+  RunStatus status = RunStatus::Finished;
+  std::string stop_reason;
+  try {
+    for (;;) {
+      sys.run(series_every);
+      const CompressionState m = gauge.measure(sys, info);
+      const double row[] = {static_cast<double>(sys.step_count), sys.time, m.axial_strain, m.axial_stress,
+                            m.lateral_strain, m.volumetric_strain, static_cast<double>(sys.cracks.tensile),
+                            static_cast<double>(sys.cracks.shear), static_cast<double>(sys.cracks.total()),
+                            static_cast<double>(sys.intact_bonds()), sys.kinetic_energy(), sys.max_unbalanced_force_ratio()};
+      series.row(row);
+      e_hist.push_back(m.axial_strain);
+      s_hist.push_back(m.axial_stress);
+      l_hist.push_back(m.lateral_strain);
+      if (m.axial_stress > st.peak_stress) {
+        st.peak_stress = m.axial_stress;
+        st.strain_at_peak = m.axial_strain;
+        st.peak_row = st.rows;
+      }
+      ++st.rows;
+      dem::append_cracks_csv(cracks_csv, sys.cracks, sys.materials, static_cast<std::size_t>(st.cracks_written));
+      st.cracks_written = static_cast<long>(sys.cracks.events.size());
+      if (vtk && m.axial_strain >= st.next_vtk_strain) {
+        writer.write(sys, st.vtk_index++, extent);
+        while (st.next_vtk_strain <= m.axial_strain) st.next_vtk_strain += vtk_every;
+      }
+      const bool past_peak = st.peak_stress > 0 && st.rows > 10 && m.axial_strain > st.strain_at_peak &&
+                             m.axial_stress < stop_fraction * st.peak_stress;
+      if (past_peak) stop_reason = fmt::format("stress fell below {} of the peak", stop_fraction);
+      if (m.axial_strain >= max_strain) stop_reason = fmt::format("axial strain reached ucs.max_strain = {}", max_strain);
+      Real fraction = m.axial_strain / max_strain;
+      if (st.peak_stress > 0 && m.axial_strain > st.strain_at_peak)
+        fraction = std::max(fraction, (st.peak_stress - m.axial_stress) / (st.peak_stress * (1 - stop_fraction)));
+      progress.update(sys.step_count, sys.time, std::min(fraction, 1.0),
+                      fmt::format("strain {:.3f}%  stress {:.3f} MPa  cracks {}", 100 * m.axial_strain, 1e-6 * m.axial_stress,
+                                  sys.cracks.total()));
+      if (!stop_reason.empty()) break;
+      if (cp_every > 0 && (sys.step_count / series_every) % std::max(1L, cp_every / series_every) == 0)
+        write_checkpoint(cp_dir, sys, st, info);
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+      if ((opt.max_wall_s > 0 && elapsed >= opt.max_wall_s) || (!opt.abort_file.empty() && fs::exists(opt.abort_file))) {
+        write_checkpoint(cp_dir, sys, st, info);
+        status = RunStatus::Interrupted;
+        break;
+      }
+    }
+  } catch (const NumericalError&) {
+    // Keep the last good checkpoint; save the failing state beside it for inspection.
+    write_checkpoint(opt.out_dir / "checkpoint_failed", sys, st, info);
+    series.close();
+    throw;
+  }
+  series.close();
+  if (status == RunStatus::Interrupted) return status;
+
+  st.finished = 1;
+  write_checkpoint(cp_dir, sys, st, info);
+  if (vtk) writer.write(sys, st.vtk_index++, extent);
+  const ElasticFit fit = fit_elastic(e_hist, s_hist, l_hist, static_cast<std::size_t>(st.peak_row));
+  nlohmann::json j;
+  j["fracflow_version"] = kVersion;
+  j["driver"] = "ucs";
+  j["title"] = cfg.string("title");
+  j["stop_reason"] = stop_reason;
+  j["ucs_Pa"] = st.peak_stress;
+  j["strain_at_peak"] = st.strain_at_peak;
+  j["youngs_modulus_Pa"] = fit.youngs_modulus;
+  j["poisson_ratio"] = fit.poisson_ratio;
+  j["elastic_fit"] = {{"method", "least squares on the pre-peak curve between 20% and 50% of the peak stress"},
+                      {"points", fit.points}};
+  j["cracks"] = {{"tensile", sys.cracks.tensile}, {"shear", sys.cracks.shear}, {"total", sys.cracks.total()}};
+  {
+    nlohmann::json by_pair = nlohmann::json::object();
+    const auto& g = sys.materials.group_names;
+    for (int a = 0; a < sys.materials.groups(); ++a)
+      for (int b = a; b < sys.materials.groups(); ++b)
+        by_pair[g[a] + "-" + g[b]] = {{"tensile", sys.cracks.count(a, b, 1)}, {"shear", sys.cracks.count(a, b, 2)}};
+    j["cracks"]["by_group_pair"] = by_pair;
+  }
+  j["sample"] = {{"particles", sys.particles.size()}, {"bonds", info.bonds}, {"porosity", info.porosity},
+                 {"height_m", info.height}, {"width_m", info.width}, {"locked_in_stress_Pa", info.locked_in_stress},
+                 {"floaters", info.floaters}, {"dimension", info.dim}};
+  j["time_step_s"] = sys.settings.dt;
+  j["steps"] = sys.step_count;
+  j["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  j["threads"] = opt.threads;
+  j["parameters"] = params_json(cfg);
+  write_json_atomic(opt.out_dir / "summary.json", j);
+  make_plots(opt.out_dir, cfg);
+  log::info("UCS {:.3f} MPa at axial strain {:.3f}%, E = {:.3f} GPa, nu = {:.3f}, cracks {} ({} tensile, {} shear); {}",
+            1e-6 * st.peak_stress, 100 * st.strain_at_peak, 1e-9 * fit.youngs_modulus, fit.poisson_ratio, sys.cracks.total(),
+            sys.cracks.tensile, sys.cracks.shear, stop_reason);
+  return RunStatus::Finished;
+}
+
+}  // namespace
+
+Driver ucs_driver() {
+  return Driver{"ucs", "uniaxial compression of a bonded-particle sample (UCS, E, nu, cracks)", declare, run};
+}
+
+}  // namespace ff::drivers

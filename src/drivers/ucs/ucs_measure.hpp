@@ -1,0 +1,40 @@
+// Measurements of a compression test: platen stress and strain, lateral strain from a
+// mid-height gauge on the sample's outer shell, and the elastic constants fitted on the
+// pre-peak curve. Rock-mechanics signs: compression positive (bulging gives negative lateral
+// strain), volumetric strain = axial + 2 lateral (3D) or axial + lateral (2D).
+#pragma once
+#include <vector>
+
+#include "dem/dem_system.hpp"
+#include "dem/sample_builder.hpp"
+
+namespace ff::drivers {
+
+struct CompressionState {
+  Real axial_strain = 0, axial_stress = 0, lateral_strain = 0, volumetric_strain = 0;
+};
+
+class CompressionGauge {
+ public:
+  // Selects the gauge particles: outer shell (within two max radii of the surface) between
+  // 25% and 75% of the height. Platens are walls 0 (bottom) and 1 (top) of the system.
+  void init(const dem::DemSystem& sys, const dem::SampleInfo& info);
+  CompressionState measure(const dem::DemSystem& sys, const dem::SampleInfo& info) const;
+  Real initial_height() const { return h0_; }
+  void set_initial_height(Real h) { h0_ = h; }
+
+ private:
+  std::vector<Index> gauge_;
+  Real h0_ = 0;
+};
+
+// Young's modulus and Poisson's ratio from a least-squares line through the pre-peak points
+// whose stress lies in [lo, hi] x peak (ISRM-style average modulus; default 20%-50%).
+struct ElasticFit {
+  Real youngs_modulus = 0, poisson_ratio = 0;
+  int points = 0;
+};
+ElasticFit fit_elastic(const std::vector<Real>& axial_strain, const std::vector<Real>& stress,
+                       const std::vector<Real>& lateral_strain, std::size_t peak_index, Real lo = 0.2, Real hi = 0.5);
+
+}  // namespace ff::drivers

@@ -1,0 +1,78 @@
+#include "io/atomic_file.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <system_error>
+
+#include "core/error.hpp"
+
+namespace ff {
+
+AtomicFileWriter::AtomicFileWriter(std::filesystem::path path, bool durable) : path_(std::move(path)), durable_(durable) {
+  if (path_.empty()) throw Error("cannot write a file with an empty path");
+  const auto parent = path_.parent_path();
+  if (!parent.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(parent, ec);
+    if (ec) throw Error(fmt::format("cannot write '{}': cannot create folder '{}': {}", path_.string(), parent.string(), ec.message()));
+  }
+  tmp_ = path_;
+  tmp_ += fmt::format(".tmp.{}", static_cast<long>(::getpid()));
+  f_ = std::fopen(tmp_.c_str(), "wb");
+  if (!f_) fail("cannot create the temporary file");
+}
+
+AtomicFileWriter::~AtomicFileWriter() {
+  if (f_) {  // not committed: leave the previous file (if any) untouched
+    std::fclose(f_);
+    std::error_code ec;
+    std::filesystem::remove(tmp_, ec);
+  }
+}
+
+void AtomicFileWriter::fail(const char* what) {
+  const int err = errno;
+  if (f_) {
+    std::fclose(f_);
+    f_ = nullptr;
+  }
+  std::error_code ec;
+  std::filesystem::remove(tmp_, ec);
+  throw Error(fmt::format("cannot write '{}': {} ({})", path_.string(), what, std::strerror(err)));
+}
+
+void AtomicFileWriter::write(const void* data, std::size_t n) {
+  if (!f_) throw Error(fmt::format("internal: write to '{}' after commit", path_.string()));
+  if (n > 0 && std::fwrite(data, 1, n, f_) != n) fail("write failed (disk full?)");
+  written_ += n;
+}
+
+void AtomicFileWriter::commit() {
+  if (!f_) throw Error(fmt::format("internal: '{}' committed twice", path_.string()));
+  if (std::fflush(f_) != 0) fail("write failed (disk full?)");
+  if (durable_ && ::fsync(::fileno(f_)) != 0) fail("fsync failed");
+  if (std::fclose(f_) != 0) {
+    f_ = nullptr;
+    fail("close failed (disk full?)");
+  }
+  f_ = nullptr;
+  if (std::rename(tmp_.c_str(), path_.c_str()) != 0) {
+    const int err = errno;
+    std::error_code ec;
+    std::filesystem::remove(tmp_, ec);
+    throw Error(fmt::format("cannot write '{}': renaming the temporary file failed ({})", path_.string(), std::strerror(err)));
+  }
+}
+
+void write_file_atomic(const std::filesystem::path& path, std::string_view bytes, bool durable) {
+  AtomicFileWriter w(path, durable);
+  w.write(bytes);
+  w.commit();
+}
+
+void write_file_atomic(const std::filesystem::path& path, std::string_view bytes) { write_file_atomic(path, bytes, false); }
+
+}  // namespace ff

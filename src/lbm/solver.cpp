@@ -1,0 +1,296 @@
+// Solver: construction, state, the boundary-cell path and force reduction. The geometry
+// classification is in solver_setup.cpp, the bulk sweep in bulk_sweep.cpp.
+#include "lbm/solver.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.hpp"
+
+namespace ff::lbm {
+
+template <class L, class T>
+Solver<L, T>::Solver(const Grid& grid, const SolverSettings& settings) : grid_(grid), settings_(settings) {
+  if (grid.dim != L::D)
+    throw Error(fmt::format("internal: a {} solver needs a {}-dimensional grid", L::name, L::D));
+  if (!(settings.tau > 0.5))
+    throw InputError(fmt::format("LBM relaxation time tau = {} must be above 1/2", settings.tau));
+  set_body_force(settings.body_force);
+  const CellIndex N = n_();
+  f_.assign(std::size_t(Q) * N, T(0));
+  type_.assign(N, CellType::Fluid);
+  object_.assign(N, -1);
+  drho_.assign(N, T(0));
+  for (auto& u : u_) u.assign(N, T(0));
+  for (int f = 0; f < kNumFaces; ++f) {
+    const int axis = f / 2;
+    faces_[f].kind = grid_.periodic[axis] ? FaceCondition::Kind::Periodic : FaceCondition::Kind::Wall;
+    SolidObject o;
+    o.name = fmt::format("wall {}", face_name(f));
+    objects_.push_back(o);
+  }
+}
+
+template <class L, class T>
+void Solver<L, T>::set_face(int f, const FaceCondition& c) {
+  const int axis = f / 2;
+  const bool periodic = c.kind == FaceCondition::Kind::Periodic;
+  if (periodic != grid_.periodic[axis])
+    throw InputError(fmt::format("face {}: {} axis {} is {}periodic in the grid; periodic faces come in pairs and are "
+                                 "set with the grid",
+                                 face_name(f), periodic ? "cannot be periodic:" : "cannot take a wall or open condition:",
+                                 "xyz"[axis], grid_.periodic[axis] ? "" : "not "));
+  faces_[f] = c;
+  if (c.kind == FaceCondition::Kind::Wall) objects_[f].velocity = c.velocity;
+}
+
+template <class L, class T>
+int Solver<L, T>::add_object(std::string name, WallScheme scheme, const Vec3& center) {
+  SolidObject o;
+  o.name = std::move(name);
+  o.scheme = scheme;
+  o.center = center;
+  objects_.push_back(o);
+  return int(objects_.size()) - 1;
+}
+
+template <class L, class T>
+void Solver<L, T>::add_shape(int object, const Shape& shape) {
+  objects_.at(object).shape = shape;
+  for (int z = 0; z < grid_.nz; ++z)
+    for (int y = 0; y < grid_.ny; ++y)
+      for (int x = 0; x < grid_.nx; ++x)
+        if (inside(shape, Vec3(x, y, z))) set_solid(x, y, z, object);
+}
+
+template <class L, class T>
+void Solver<L, T>::set_solid(int x, int y, int z, int object) {
+  const CellIndex i = grid_.index(x, y, z);
+  type_[i] = CellType::Solid;
+  object_[i] = std::int16_t(object);
+}
+
+template <class L, class T>
+void Solver<L, T>::set_object_motion(int object, const Vec3& velocity, const Vec3& omega) {
+  objects_.at(object).velocity = velocity;
+  objects_.at(object).omega = omega;
+  compute_link_velocities();
+}
+
+template <class L, class T>
+void Solver<L, T>::set_body_force(const Vec3& f) {
+  settings_.body_force = f;
+  const double fa[3] = {f[0], f[1], L::D == 3 ? f[2] : 0.0};
+  relax_ = make_relax<T>(settings_.collision, settings_.tau, settings_.magic, fa);
+}
+
+template <class L, class T>
+Vec3 Solver<L, T>::wall_velocity(int object, const Vec3& x) const {
+  const SolidObject& o = objects_[object];
+  return o.velocity + o.omega.cross(x - o.center);
+}
+
+template <class L, class T>
+void Solver<L, T>::compute_link_velocities() {
+  link_uw_.assign(3 * links_.size(), T(0));
+  for (std::size_t l = 0; l < links_.size(); ++l) {
+    const Link& k = links_[l];
+    const BoundaryCell& b = bcells_[k.cell];
+    const int o = L::opp[k.q];
+    const Vec3 xw = Vec3(b.x, b.y, b.z) + double(k.delta) * Vec3(L::c[o][0], L::c[o][1], L::c[o][2]);
+    const Vec3 uw = wall_velocity(k.object, xw);
+    for (int a = 0; a < 3; ++a) link_uw_[3 * l + a] = T(a < L::D ? uw[a] : 0.0);
+  }
+}
+
+template <class L, class T>
+void Solver<L, T>::initialize(const std::function<void(int, int, int, double&, Vec3&)>& init) {
+  const CellIndex N = n_();
+  std::fill(f_.begin(), f_.end(), T(0));
+  for (int z = 0; z < grid_.nz; ++z)
+    for (int y = 0; y < grid_.ny; ++y)
+      for (int x = 0; x < grid_.nx; ++x) {
+        const CellIndex i = grid_.index(x, y, z);
+        double rho = 1;
+        Vec3 u = Vec3::Zero();
+        if (type_[i] == CellType::Fluid) init(x, y, z, rho, u);
+        const T uu[3] = {T(u[0]), T(u[1]), T(L::D == 3 ? u[2] : 0.0)};
+        T geq[Q];
+        equilibrium<L, T>(T(rho), uu, geq);
+        for (int q = 0; q < Q; ++q) f_[q * N + i] = geq[q];
+        drho_[i] = T(rho - 1);
+        for (int a = 0; a < 3; ++a) u_[a][i] = uu[a];
+      }
+  time_ = 0;
+}
+
+template <class L, class T>
+void Solver<L, T>::restore(const std::vector<T>& f, long time_step) {
+  if (f.size() != f_.size())
+    throw InputError(fmt::format("checkpoint holds {} populations, this lattice needs {}: the checkpoint belongs to "
+                                 "another scenario",
+                                 f.size(), f_.size()));
+  std::copy(f.begin(), f.end(), f_.begin());
+  time_ = time_step;
+}
+
+template <class L, class T>
+Vec3 Solver<L, T>::velocity(int x, int y, int z) const {
+  const CellIndex i = grid_.index(x, y, z);
+  return Vec3(u_[0][i], u_[1][i], u_[2][i]);
+}
+
+template <class L, class T>
+std::size_t Solver<L, T>::num_bulk_cells() const {
+  std::size_t n = 0;
+  for (auto& s : spans_) n += std::size_t(s.n);
+  return n;
+}
+
+template <class L, class T>
+double Solver<L, T>::max_speed() const {
+  double m = 0;
+  bool nan = false;
+  auto visit = [&](CellIndex i) {
+    const double u2 = double(u_[0][i]) * u_[0][i] + double(u_[1][i]) * u_[1][i] + double(u_[2][i]) * u_[2][i];
+    if (std::isnan(u2) || std::isnan(double(drho_[i]))) nan = true;
+    else m = std::max(m, u2);
+  };
+  for (auto& s : spans_)
+    for (int k = 0; k < s.n; ++k) visit(grid_.index(s.x0 + k, s.y, s.z));
+  for (auto& b : bcells_) visit(b.cell);
+  return nan ? std::nan("") : std::sqrt(m);
+}
+
+template <class L, class T>
+double Solver<L, T>::total_mass() const {
+  double m = 0;
+  for (int z = 0; z < grid_.nz; ++z)
+    for (int y = 0; y < grid_.ny; ++y)
+      for (int x = 0; x < grid_.nx; ++x) {
+        const CellIndex i = grid_.index(x, y, z);
+        if (type_[i] == CellType::Fluid) m += 1.0 + double(drho_[i]);
+      }
+  return m;
+}
+
+// ---------------------------------------------------------------- time step
+
+template <class L, class T>
+void Solver<L, T>::step(bool sample) {
+  const bool odd = (time_ & 1) != 0;
+  save_interpolation_inputs(odd);
+  bulk_sweep(odd, sample);
+  boundary_sweep(odd, sample);
+  reduce_forces();
+  ++time_;
+}
+
+// The interpolated schemes need g*_q(x, t) of the population leaving the wall, which the
+// neighbour x + c_q consumes during the same in-place step: copy it first.
+template <class L, class T>
+void Solver<L, T>::save_interpolation_inputs(bool odd) {
+  const CellIndex N = n_();
+  for (std::size_t l = 0; l < links_.size(); ++l) {
+    const Link& k = links_[l];
+    if (k.scheme == WallScheme::HalfwayBounceBack || !k.has_second) continue;
+    const BoundaryCell& b = bcells_[k.cell];
+    const int q = k.q, o = L::opp[q];
+    // Post-collision slot of the previous step: even step -> own cell, swapped slot;
+    // odd step -> the neighbour along c_q, regular slot.
+    const CellIndex at = odd ? o * N + b.cell
+                             : q * N + grid_.neighbour(b.x, b.y, b.z, L::c[q][0], L::c[q][1], L::c[q][2]);
+    link_saved_[l] = f_[at];
+  }
+}
+
+template <class L, class T>
+void Solver<L, T>::boundary_sweep(bool odd, bool sample) {
+  const std::int64_t nb = std::int64_t(bcells_.size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < nb; ++i) update_boundary_cell(std::size_t(i), odd, sample);
+}
+
+template <class L, class T>
+void Solver<L, T>::update_boundary_cell(std::size_t i, bool odd, bool sample) {
+  const BoundaryCell& b = bcells_[i];
+  const CellIndex N = n_();
+  T g[Q];
+  CellIndex src[Q];  // x - c_q (so src[opp q] = x + c_q)
+  for (int q = 0; q < Q; ++q) src[q] = grid_.neighbour(b.x, b.y, b.z, -L::c[q][0], -L::c[q][1], -L::c[q][2]);
+
+  // 1. Streamed populations (AA pattern: even reads the own slot, odd the neighbour's swapped slot).
+  g[0] = f_[b.cell];
+  for (int q = 1; q < Q; ++q) {
+    if ((b.link_mask | b.open_mask) & (1u << q)) continue;
+    g[q] = odd ? f_[L::opp[q] * N + src[q]] : f_[q * N + b.cell];
+  }
+  // 2. Wall links: bounce-back (plain or interpolated) and the momentum exchange.
+  for (int l = b.first_link; l < b.first_link + b.num_links; ++l) {
+    const Link& k = links_[l];
+    const int q = k.q, o = L::opp[q];
+    const T A = odd ? f_[q * N + b.cell] : f_[o * N + src[q]];  // g*_o(x, t), where the wall left it
+    const T* uw = &link_uw_[3 * l];
+    const T cu = L::c[q][0] * uw[0] + L::c[q][1] * uw[1] + L::c[q][2] * uw[2];
+    const T mw = T(6 * L::w[q]) * cu;  // rho_w = rho_0 = 1 (nearly incompressible, [S003] Sec. 2.3.2)
+    const T B = link_saved_[l];
+    const T C = k.has_second ? g[o] : T(0);
+    const T gq = reflect<T>(k.scheme, T(k.delta), k.has_second, A, B, C, mw);
+    g[q] = gq;
+    // Momentum exchange on the link ([S003] Eq. 11) in the Galilean-invariant form of
+    // Wen et al. (2014): F = (c_o - u_w) f*_o - (c_q - u_w) f_q, with c_q = -c_o.
+    for (int a = 0; a < 3; ++a)
+      link_force_[3 * l + a] = double(L::c[o][a]) * (double(A) + double(gq)) - double(uw[a]) * (double(A) - double(gq));
+  }
+  // 3. Open faces (Zou-He / Hecht-Harting): needs every other population first.
+  if (b.open >= 0) zou_he<L, T>(g, open_[b.open]);
+  // 4. Collide.
+  T drho, u[3];
+  const bool force = settings_.body_force.squaredNorm() > 0;
+  if (settings_.collision == CollisionModel::Trt) {
+    if (force) collide<L, T, CollisionModel::Trt, true>(g, relax_, drho, u);
+    else collide<L, T, CollisionModel::Trt, false>(g, relax_, drho, u);
+  } else {
+    if (force) collide<L, T, CollisionModel::Bgk, true>(g, relax_, drho, u);
+    else collide<L, T, CollisionModel::Bgk, false>(g, relax_, drho, u);
+  }
+  // 5. Store: even -> own cell, swapped slot; odd -> neighbour x + c_q, regular slot.
+  f_[b.cell] = g[0];
+  for (int q = 1; q < Q; ++q) {
+    const int o = L::opp[q];
+    if (odd) f_[q * N + src[o]] = g[q];
+    else f_[o * N + b.cell] = g[q];
+  }
+  if (sample) {
+    drho_[b.cell] = drho;
+    for (int a = 0; a < 3; ++a) u_[a][b.cell] = u[a];
+  }
+}
+
+// Sums the link forces per object in link order: the same result on any thread count.
+template <class L, class T>
+void Solver<L, T>::reduce_forces() {
+  for (auto& o : objects_) {
+    o.force.setZero();
+    o.torque.setZero();
+  }
+  for (std::size_t l = 0; l < links_.size(); ++l) {
+    const Link& k = links_[l];
+    const BoundaryCell& b = bcells_[k.cell];
+    SolidObject& obj = objects_[k.object];
+    const Vec3 F(link_force_[3 * l], link_force_[3 * l + 1], link_force_[3 * l + 2]);
+    const int o = L::opp[k.q];
+    const Vec3 xw = Vec3(b.x, b.y, b.z) + double(k.delta) * Vec3(L::c[o][0], L::c[o][1], L::c[o][2]);
+    obj.force += F;
+    obj.torque += (xw - obj.center).cross(F);
+  }
+}
+
+template class Solver<D2Q9, double>;
+template class Solver<D2Q9, float>;
+template class Solver<D3Q19, double>;
+template class Solver<D3Q19, float>;
+
+}  // namespace ff::lbm

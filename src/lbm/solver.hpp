@@ -1,0 +1,160 @@
+// The lattice Boltzmann solver: populations, geometry (faces, solid objects), one time step,
+// macroscopic fields and forces on solids. Lattice units only (lbm/units.hpp converts).
+//
+// Templated on the lattice (D2Q9, D3Q19) and on the storage precision (float, double); the
+// four combinations are compiled once in solver.cpp, and drivers pick one at run time.
+//
+// Memory layout: populations f[q * N + cell] (one array per direction), N = padded cells.
+// Streaming uses the in-place AA pattern (Bailey et al. 2009): even steps read and write a
+// cell's own populations (stored in swapped slots), odd steps read from and write to the
+// neighbours. One array, no write-allocate traffic. docs/lbm.md explains the choice.
+//
+// Cells are split once, in finalize(): plain fluid cells whose neighbours are all fluid
+// form row spans updated by the branch-free kernel (stream_collide.hpp); every other fluid
+// cell is a BoundaryCell updated by a general path that applies the wall and open-face
+// conditions link by link. Solid cells are never updated; their memory holds the bounced
+// populations.
+//
+// Ownership: the Solver owns all its arrays; references returned stay valid until the
+// next finalize(). Not copyable (large), movable.
+#pragma once
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/types.hpp"
+#include "lbm/aligned_vector.hpp"
+#include "lbm/boundary.hpp"
+#include "lbm/collision.hpp"
+#include "lbm/descriptor.hpp"
+#include "lbm/grid.hpp"
+#include "lbm/shapes.hpp"
+
+namespace ff::lbm {
+
+enum class CellType : std::uint8_t { Fluid = 0, Solid = 1, Open = 2 };
+
+// Condition on one face of the box (faces numbered as in grid.hpp). Periodic is set by
+// the Grid; the other kinds need a non-periodic axis.
+struct FaceCondition {
+  enum class Kind { Periodic, Wall, Velocity, Pressure };
+  Kind kind = Kind::Wall;
+  Vec3 velocity = Vec3::Zero();  // Wall: wall velocity (moving wall); Velocity: inflow velocity
+  double density = 1;            // Pressure: prescribed density (p = c_s^2 rho)
+  std::function<Vec3(int x, int y, int z)> profile;  // Velocity: per-cell velocity, overrides `velocity`
+};
+
+struct SolverSettings {
+  CollisionModel collision = CollisionModel::Trt;
+  double tau = 0.8;                  // relaxation time of the shear modes (viscosity)
+  double magic = 3.0 / 16.0;         // TRT magic parameter Lambda
+  Vec3 body_force = Vec3::Zero();    // force density, lattice units (Guo forcing)
+};
+
+// A solid body (or a wall of the box) and the hydrodynamic load on it.
+struct SolidObject {
+  std::string name;
+  WallScheme scheme = WallScheme::HalfwayBounceBack;
+  std::optional<Shape> shape;          // gives the link fractions; none: half-way (delta = 1/2)
+  Vec3 center = Vec3::Zero();          // torque reference point, lattice units
+  Vec3 velocity = Vec3::Zero();        // rigid motion: u_w = velocity + omega x (x_w - center)
+  Vec3 omega = Vec3::Zero();
+  Vec3 force = Vec3::Zero();           // of the last step (time t + 1/2), lattice units,
+  Vec3 torque = Vec3::Zero();          //   relative to the reference pressure c_s^2 rho_0
+  long links = 0;                      // fluid->solid links (0: the object touches no fluid)
+};
+
+template <class L, class T>
+class Solver {
+ public:
+  static constexpr int Q = L::Q;
+  // Objects 0..5 are the six faces of the box ("wall x-" ... "wall z+").
+  static constexpr int kFirstUserObject = kNumFaces;
+
+  Solver(const Grid& grid, const SolverSettings& settings);
+  Solver(const Solver&) = delete;
+  Solver& operator=(const Solver&) = delete;
+  Solver(Solver&&) = default;
+
+  const Grid& grid() const { return grid_; }
+  const SolverSettings& settings() const { return settings_; }
+
+  // ---- geometry; call finalize() after any change
+  void set_face(int face, const FaceCondition& c);
+  const FaceCondition& face(int f) const { return faces_[f]; }
+  int add_object(std::string name, WallScheme scheme, const Vec3& center);
+  // Marks every cell whose centre lies inside `shape` as solid and belonging to `object`;
+  // the shape then also gives the link fractions of the object's interpolated scheme.
+  void add_shape(int object, const Shape& shape);
+  void set_solid(int x, int y, int z, int object);  // from a mask or an image
+  bool is_solid(int x, int y, int z) const { return type_[grid_.index(x, y, z)] != CellType::Fluid; }
+  void finalize();
+
+  // ---- motion of solids (enters the moving-wall term of bounce-back)
+  void set_object_motion(int object, const Vec3& velocity, const Vec3& omega);
+  void set_body_force(const Vec3& f);
+
+  // ---- state
+  // f = f^eq(rho, u) from init(x, y, z, rho, u) on every fluid cell; time step 0.
+  void initialize(const std::function<void(int, int, int, double&, Vec3&)>& init);
+  // One fused stream-collide step. With `sample`, the macroscopic fields of time t (the
+  // moments the collision used) are stored for density()/velocity()/max_speed().
+  void step(bool sample = false);
+  long time_step() const { return time_; }
+
+  // ---- results of the last sampling step (or of initialize())
+  double density(int x, int y, int z) const { return 1.0 + double(drho_[grid_.index(x, y, z)]); }
+  Vec3 velocity(int x, int y, int z) const;
+  double max_speed() const;   // over fluid cells; NaN if any cell is NaN
+  double total_mass() const;  // sum of rho over fluid cells (deterministic order)
+  const std::vector<SolidObject>& objects() const { return objects_; }
+  std::size_t num_boundary_cells() const { return bcells_.size(); }
+  std::size_t num_bulk_cells() const;
+  std::size_t num_fluid_cells() const { return num_bulk_cells() + bcells_.size(); }
+
+  // ---- checkpoint: the populations and the step counter are the whole state
+  const AlignedVector<T>& populations() const { return f_; }
+  void restore(const std::vector<T>& f, long time_step);
+
+ private:
+  struct Span {
+    int x0, y, z, n;
+  };
+  void bulk_sweep(bool odd, bool sample);
+  void boundary_sweep(bool odd, bool sample);
+  void update_boundary_cell(std::size_t i, bool odd, bool sample);
+  void save_interpolation_inputs(bool odd);
+  void reduce_forces();
+  void compute_link_velocities();
+  Vec3 wall_velocity(int object, const Vec3& x) const;
+  CellIndex n_() const { return grid_.padded_size(); }
+
+  Grid grid_;
+  SolverSettings settings_;
+  Relax<T> relax_;
+  std::array<FaceCondition, kNumFaces> faces_;
+  std::vector<SolidObject> objects_;
+  long time_ = 0;
+
+  AlignedVector<T> f_;                 // Q * N populations
+  std::vector<CellType> type_;         // N
+  std::vector<std::int16_t> object_;   // N: owning object of solid cells, -1 for fluid
+  AlignedVector<T> drho_;              // N: sampled rho - 1
+  std::array<AlignedVector<T>, 3> u_;  // N: sampled velocity
+
+  std::vector<Span> spans_;
+  std::vector<BoundaryCell> bcells_;
+  std::vector<Link> links_;
+  std::vector<OpenNode<T>> open_;
+  std::vector<T> link_uw_;             // 3 per link: wall velocity at the link
+  std::vector<T> link_saved_;          // 1 per link: g*_q(x, t) saved before the step
+  std::vector<double> link_force_;     // 3 per link: momentum exchange of the last step
+};
+
+extern template class Solver<D2Q9, double>;
+extern template class Solver<D2Q9, float>;
+extern template class Solver<D3Q19, double>;
+extern template class Solver<D3Q19, float>;
+
+}  // namespace ff::lbm

@@ -1,0 +1,99 @@
+#include "lbm/units.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "core/error.hpp"
+
+namespace ff::lbm {
+
+namespace {
+constexpr double kMachWarn = 0.1, kMachError = 0.3, kTauWarn = 0.01;
+const double kCs = 1.0 / std::sqrt(3.0);
+}  // namespace
+
+Units Units::from_tau(double dx, double tau, double nu, double rho) {
+  if (!(dx > 0) || !(nu > 0) || !(rho > 0)) throw InputError("LBM units need a positive cell size, viscosity and density");
+  Units u;
+  u.dx_ = dx;
+  u.tau_ = tau;
+  u.nu_ = nu;
+  u.rho_ = rho;
+  u.dt_ = (tau - 0.5) * dx * dx / (3.0 * nu);
+  return u;
+}
+
+Units Units::from_time_step(double dx, double dt, double nu, double rho) {
+  if (!(dx > 0) || !(dt > 0) || !(nu > 0) || !(rho > 0))
+    throw InputError("LBM units need a positive cell size, time step, viscosity and density");
+  Units u;
+  u.dx_ = dx;
+  u.dt_ = dt;
+  u.nu_ = nu;
+  u.rho_ = rho;
+  u.tau_ = 0.5 + 3.0 * nu * dt / (dx * dx);
+  return u;
+}
+
+StabilityCheck Units::check(double u, int resolution, const std::string& resolution_key, bool tau_mode) const {
+  StabilityCheck r;
+  const double ulb = to_lattice_velocity(std::abs(u));
+  const double ma = ulb / kCs;
+  // Fixes for the Mach number: with tau fixed u_lb scales as 1/N; with dt fixed as dt.
+  auto mach_fix = [&](double target) {
+    const double f = ma / target;
+    const int n_needed = int(std::ceil(resolution * f));
+    if (tau_mode) {
+      const double tau_needed = 0.5 + (tau_ - 0.5) / f;
+      return fmt::format("raise {} to at least {} (same tau), or lower lbm.tau to {:.4g}", resolution_key, n_needed,
+                         tau_needed);
+    }
+    return fmt::format("lower lbm.time_step to at most {:.4g} s (tau becomes {:.4g}), or raise {} to at least {} with "
+                       "lbm.time_step scaled by (old/new resolution)^2",
+                       dt_ / f, 0.5 + (tau_ - 0.5) / f, resolution_key, n_needed);
+  };
+  if (!(tau_ > 0.5)) {
+    const double dt_needed = (0.55 - 0.5) * dx_ * dx_ / (3 * nu_);
+    r.error = fmt::format("relaxation time tau = {:.6g} must be above 1/2 (nu_lb = {:.3g} <= 0): raise lbm.time_step to "
+                          "at least {:.4g} s (tau = 0.55) or lower {} (coarser cells)",
+                          tau_, nu_lb(), dt_needed, resolution_key);
+    return r;
+  }
+  if (ma > kMachError) {
+    r.error = fmt::format("Mach number {:.3g} (lattice speed {:.3g}) is above {}: the flow is far from incompressible; {}",
+                          ma, ulb, kMachError, mach_fix(kMachWarn));
+    return r;
+  }
+  if (ma > kMachWarn)
+    r.warnings.push_back(fmt::format("Mach number {:.3g} (lattice speed {:.3g}) is above {}: compressibility errors of "
+                                     "order Ma^2 = {:.2g}; {}",
+                                     ma, ulb, kMachWarn, ma * ma, mach_fix(kMachWarn)));
+  if (tau_ - 0.5 < kTauWarn) {
+    // Larger tau at fixed Mach needs more cells: u_lb = Re_cell (tau - 1/2)/3 with Re_cell ~ 1/N.
+    const double tau_target = 0.5 + kTauWarn * 5;
+    const double f = (tau_target - 0.5) / (tau_ - 0.5);
+    std::string fix = tau_mode ? fmt::format("raise lbm.tau to {:.3g}", tau_target)
+                               : fmt::format("raise lbm.time_step to {:.4g} s (tau = {:.3g})", dt_ * f, tau_target);
+    r.warnings.push_back(fmt::format("relaxation time tau = {:.5g} is within {} of 1/2: BGK becomes unstable and walls "
+                                     "inaccurate; {} and raise {} to at least {} to keep the Mach number",
+                                     tau_, kTauWarn, fix, resolution_key, int(std::ceil(resolution * f))));
+  }
+  return r;
+}
+
+std::string Units::describe(int dim) const {
+  std::string s;
+  s += "LBM units ([S003] Table 1):\n";
+  s += fmt::format("  cell size      dx  = L_r = {:.6g} m\n", dx_);
+  s += fmt::format("  time step      dt  = t_r = {:.6g} s\n", dt_);
+  s += fmt::format("  density        rho_r     = {:.6g} kg/m^3 (rho_lb = 1)\n", rho_);
+  s += fmt::format("  viscosity      nu  = {:.6g} m^2/s  ->  nu_lb = {:.6g}, tau = {:.6g}\n", nu_, nu_lb(), tau_);
+  s += fmt::format("  velocity       u_r = {:.6g} m/s\n", velocity_factor());
+  s += fmt::format("  pressure       P_r = {:.6g} Pa   (p - p0 = (rho_lb - 1) P_r / 3)\n", pressure_factor());
+  s += fmt::format("  force          F_r = {:.6g} N/m per unit depth{}", force_factor(),
+                   dim == 3 ? fmt::format(" (3D: F_r L_r = {:.6g} N)", force_factor() * dx_) : std::string());
+  return s;
+}
+
+}  // namespace ff::lbm
