@@ -67,6 +67,7 @@ porosity = 0.38
   for (int threads = 1; threads <= maxthreads; threads *= 2) {
     omp_set_num_threads(threads);
     dem::DemSystem sys = base;
+    sys.stage_times = {};
     sys.run(20);  // warm-up
     const auto a = std::chrono::steady_clock::now();
     sys.run(steps);
@@ -76,6 +77,11 @@ porosity = 0.38
     if (reference.empty()) reference = sys.particles.pos;
     else same = std::memcmp(reference.data(), sys.particles.pos.data(), reference.size() * sizeof(Vec3)) == 0;
     fmt::print("threads {}: {:.3g} particle-steps/s{}\n", threads, rate, same ? "" : "  (RESULTS DIFFER FROM 1 THREAD!)");
+    const auto& t = sys.stage_times;
+    const double tot = t.neighbors + t.contacts + t.bonds + t.walls + t.integrate;
+    fmt::print("  stages: neighbours {:.0f}%, contacts {:.0f}%, bonds {:.0f}%, walls {:.0f}%, gather+integrate {:.0f}%\n",
+               100 * t.neighbors / tot, 100 * t.contacts / tot, 100 * t.bonds / tot, 100 * t.walls / tot,
+               100 * t.integrate / tot);
   }
   return 0;
 }

@@ -81,6 +81,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> sets;
   int threads = 0;
   double max_wall = 0;
+  long max_steps = 0;
   bool overwrite = false, quiet = false;
 
   auto* run = app.add_subcommand("run", "run a scenario (the built-in default when no file is given)");
@@ -89,6 +90,8 @@ int main(int argc, char** argv) {
   run->add_option("--threads,-j", threads, "OpenMP threads (default: all cores)")->check(CLI::NonNegativeNumber);
   run->add_option("--set,-s", sets, "override a parameter: --set key=value (repeatable)");
   run->add_option("--max-wall", max_wall, "stop with a checkpoint after this many wall-clock seconds")
+      ->check(CLI::NonNegativeNumber);
+  run->add_option("--max-steps", max_steps, "stop with a checkpoint once this time step is reached")
       ->check(CLI::NonNegativeNumber);
   run->add_flag("--overwrite", overwrite, "replace an existing results folder");
   run->add_flag("--quiet,-q", quiet, "no status lines");
@@ -101,6 +104,8 @@ int main(int argc, char** argv) {
   resume->add_option("dir", resume_dir, "results folder of the run")->required();
   resume->add_option("--threads,-j", threads, "OpenMP threads")->check(CLI::NonNegativeNumber);
   resume->add_option("--max-wall", max_wall, "stop with a checkpoint after this many wall-clock seconds")
+      ->check(CLI::NonNegativeNumber);
+  resume->add_option("--max-steps", max_steps, "stop with a checkpoint once this time step is reached")
       ->check(CLI::NonNegativeNumber);
   resume->add_flag("--quiet,-q", quiet, "no status lines");
 
@@ -131,6 +136,7 @@ int main(int argc, char** argv) {
     RunOptions opt;
     opt.threads = threads > 0 ? threads : omp_get_max_threads();
     opt.max_wall_s = max_wall;
+    opt.max_steps = max_steps;
     if (*run) {
       auto l = load(scenario, sets);  // every key validated before anything is written
       if (out_dir.empty())

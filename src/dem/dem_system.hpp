@@ -33,8 +33,14 @@ struct WallContacts {           // candidate particles of one wall, sorted by in
   std::vector<PairLoad> load;   // f = force on the wall; mA = moment on the particle
 };
 
+// Wall-clock seconds spent in each stage of step() (the timing report of benchmarks).
+struct StageTimes {
+  double neighbors = 0, contacts = 0, bonds = 0, walls = 0, integrate = 0;
+};
+
 class DemSystem {
  public:
+  StageTimes stage_times;
   DemSettings settings;
   ParticleStore particles;
   Materials materials;

@@ -30,7 +30,7 @@ void declare_sample_params(ParamTable& t) {
   t.real("sample.bond_gap", 0.05e-3, "m", "bonds are installed between particles whose gap is at most this (seed 000: 0.05 mm)").non_negative();
   t.string("sample.default_group", "", "group of particles outside every region (default: the first declared group)");
   t.real("sample.genesis_tolerance", 1e-2, "-", "equilibrium criterion of the genesis: mean unbalanced-force ratio").positive();
-  t.integer("sample.genesis_max_steps", 2000, "-", "step cap of each genesis equilibration").positive();
+  t.integer("sample.genesis_max_steps", 1000, "-", "step cap of each genesis equilibration").positive();
   // Regions assigning groups (later regions win).
   t.string("sample.region.*.group", "", "group of the particles whose centres lie in this region");
   t.string("sample.region.*.shape", "sphere", "region shape").one_of({"box", "sphere", "cylinder", "ellipsoid", "stl"});
@@ -131,6 +131,38 @@ long equilibrate(DemSystem& sys, Real tol, long max_steps) {
 Real mean_stress(const DemSystem& sys, Real volume, int dim) {
   const Mat3 s = sys.average_stress([](const Vec3&) { return true; }, volume);
   return dim == 3 ? -s.trace() / 3.0 : -(s(0, 0) + s(1, 1)) / 2.0;
+}
+
+// Scale factor of all radii that brings the mean stress of the particle contacts, estimated
+// from their normal forces, p = sum F d / (dim V) (Love-Weber trace), down to `goal`.
+Real shrink_factor_for_stress(const DemSystem& sys, Real goal, Real volume) {
+  const auto& P = sys.particles;
+  const auto pi = sys.neighbors().first(), pj = sys.neighbors().second();
+  const int dim = sys.settings.dim;
+  auto stress_at = [&](Real s) {
+    Real sum = 0;
+    for (std::size_t k = 0; k < pi.size(); ++k) {
+      const Index a = pi[k], b = pj[k];
+      const Real d = (P.pos[b] - P.pos[a]).norm();
+      const Real overlap = s * (P.radius[a] + P.radius[b]) - d;
+      if (overlap <= 0) continue;
+      const int pt = sys.materials.pair(P.group[a], P.group[b]);
+      Real f;
+      if (sys.materials.contact_law == ContactLaw::Linear)
+        f = LinearContact::normal_stiffness(sys.materials.linear[pt], s * P.radius[a], s * P.radius[b], dim) * overlap;
+      else
+        f = 2.0 / 3.0 * HertzMindlinContact::normal_stiffness(sys.materials.hertz[pt], s * P.radius[a], s * P.radius[b], overlap) * overlap;
+      sum += f * d;
+    }
+    return sum / (dim * volume);
+  };
+  if (stress_at(1.0) <= goal) return 1.0;
+  Real lo = 0.9, hi = 1.0;  // a 10% shrink opens every contact of a converged packing
+  for (int k = 0; k < 50; ++k) {
+    const Real mid = 0.5 * (lo + hi);
+    (stress_at(mid) > goal ? hi : lo) = mid;
+  }
+  return lo;
 }
 
 }  // namespace
@@ -249,20 +281,13 @@ SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
   long steps = equilibrate(sys, tol, max_steps);
   const Real target = cfg.real("sample.locked_in_stress");
   Real p = mean_stress(sys, info.volume, dim);
-  // Shrink radii until the isotropic stress is below the target (PFC genesis step 3).
-  for (int it = 0; it < 12 && p > target; ++it) {
-    Real overlap = 0;
-    long n = 0;
-    const auto pi = sys.neighbors().first(), pj = sys.neighbors().second();
-    for (std::size_t k = 0; k < pi.size(); ++k) {
-      const Real gap = (P.pos[pj[k]] - P.pos[pi[k]]).norm() - P.radius[pi[k]] - P.radius[pj[k]];
-      if (gap < 0) { overlap -= gap; ++n; }
-    }
-    if (n == 0) break;
-    const Real mean_overlap_ratio = overlap / n / rmean;
-    const Real shrink = 0.5 * mean_overlap_ratio * (1.0 - 0.5 * target / p);
+  // Reduce the isotropic stress below the target (PFC genesis step 3): shrink all radii by
+  // the factor that brings the contact-force estimate of the mean stress to half the target
+  // (bisection, no cycling), then cycle to equilibrium and measure again.
+  for (int it = 0; it < 4 && p > target; ++it) {
+    const Real s = shrink_factor_for_stress(sys, 0.5 * target, info.volume);
     for (std::size_t i = 0; i < P.size(); ++i) {
-      P.radius[i] *= 1.0 - shrink;
+      P.radius[i] *= s;
       P.set_mass_from_density(i, sys.materials.density[P.group[i]], dim);
     }
     sys.rebuild_neighbors();
@@ -272,24 +297,20 @@ SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
   }
   info.locked_in_stress = p;
   if (p > target)
-    log::warn("genesis: locked-in stress {:.3g} Pa is still above sample.locked_in_stress = {:.3g} Pa after 12 reductions", p, target);
-
-  // Floaters (PFC eliminates them; we report them).
-  std::vector<int> ncontacts(P.size(), 0);
-  {
-    const auto pi = sys.neighbors().first(), pj = sys.neighbors().second();
-    for (std::size_t k = 0; k < pi.size(); ++k)
-      if ((P.pos[pj[k]] - P.pos[pi[k]]).norm() < P.radius[pi[k]] + P.radius[pj[k]]) {
-        ++ncontacts[pi[k]];
-        ++ncontacts[pj[k]];
-      }
-    for (int c : ncontacts) info.floaters += c < (dim == 3 ? 3 : 2);
-  }
+    log::warn("genesis: locked-in stress {:.3g} Pa is still above sample.locked_in_stress = {:.3g} Pa after 4 reductions", p, target);
 
   // Bonds, with the real contact properties back.
   sys.materials = saved;
   sys.materials.bond_law = bond_law;
   if (bond_law != BondLaw::None) info.bonds = sys.install_bonds(cfg.real("sample.bond_gap"));
+  {  // Floaters: particles held by fewer than 3 (2D: 2) bonds (PFC counts contacts; we report them).
+    std::vector<int> degree(P.size(), 0);
+    for (std::size_t b = 0; b < sys.bond_i.size(); ++b) {
+      ++degree[sys.bond_i[b]];
+      ++degree[sys.bond_j[b]];
+    }
+    for (int d : degree) info.floaters += d < (dim == 3 ? 3 : 2);
+  }
   Real solid = 0;
   for (Real r : P.radius) solid += dim == 3 ? 4.0 / 3.0 * kPi * r * r * r : kPi * r * r;
   info.porosity = 1.0 - solid / info.volume;

@@ -20,7 +20,7 @@ struct SampleInfo {
   Real porosity = 0;          // after genesis
   Real locked_in_stress = 0;  // mean stress when bonds were installed [Pa], compression > 0
   std::size_t bonds = 0;
-  std::size_t floaters = 0;   // particles with fewer than 3 (3D) or 2 (2D) contacts before bonding
+  std::size_t floaters = 0;   // particles with fewer than 3 (3D) or 2 (2D) bonds
   double genesis_seconds = 0;
 };
 

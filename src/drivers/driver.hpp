@@ -14,6 +14,7 @@ struct RunOptions {
   std::filesystem::path out_dir;     // results folder (exists when run() is called)
   int threads = 1;                   // OpenMP threads (already applied with omp_set_num_threads)
   double max_wall_s = 0;             // > 0: write a checkpoint and stop after this wall time
+  long max_steps = 0;                // > 0: write a checkpoint and stop once this step is reached
   bool resume = false;               // continue from out_dir/checkpoint/
   std::filesystem::path abort_file;  // when this file appears: checkpoint and stop
   double progress_interval_s = 5;    // status line period (0: silent)

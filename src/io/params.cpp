@@ -282,6 +282,16 @@ std::string Config::resolved_toml() const {
   return o;
 }
 
+std::vector<std::pair<std::string, ParamValue>> Config::resolved_values() const {
+  std::vector<std::pair<std::string, ParamValue>> out;
+  for (auto& [k, s] : expanded_keys()) {
+    auto it = values_.find(k);
+    if (it != values_.end()) out.emplace_back(k, it->second.first);
+    else if (s->default_value) out.emplace_back(k, *s->default_value);
+  }
+  return out;
+}
+
 std::string Config::describe() const {
   std::vector<std::array<std::string, 5>> rows;
   rows.push_back({"key", "value", "unit", "default", "source"});

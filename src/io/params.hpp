@@ -102,6 +102,8 @@ class Config {
   // Every key with its resolved value (explicit and defaults; wildcard keys expanded for the
   // names present) as TOML text; parsing it back gives the same Config.
   std::string resolved_toml() const;
+  // Every key with its resolved value (defaults included, wildcards expanded), sorted as the table.
+  std::vector<std::pair<std::string, ParamValue>> resolved_values() const;
   // Table for `fracflow check`: key, value, unit, default, source.
   std::string describe() const;
 

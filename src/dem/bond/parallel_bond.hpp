@@ -31,6 +31,7 @@ struct ParallelBond {
     Real Fn = 0, Mt = 0;              // normal force (tension > 0) [N], twisting moment [N m]
     Vec3 Fs = Vec3::Zero(), Mb = Vec3::Zero();
     Real sigma = 0, tau = 0;          // peripheral stresses at the last evaluation [Pa]
+    Real tan_fa = 0;                  // tan(friction angle), cached at installation
   };
 
   // Section: R = lambda min(RA, RB); 3D A = pi R^2, I = pi R^4/4, J = pi R^4/2;
@@ -49,6 +50,7 @@ struct ParallelBond {
     }
     s.kn = m.emod / (rA + rB);
     s.ks = s.kn / m.kratio;
+    s.tan_fa = std::tan(m.fa_deg * kPi / 180.0);
     return s;
   }
   // Translational and rotational stiffness the bond adds to each end (time-step estimate).
@@ -73,7 +75,7 @@ struct ParallelBond {
     if (s.sigma >= m.ten) {
       fail = BondFailure::Tensile;
     } else {
-      const Real tau_c = m.coh - (s.Fn / s.A) * std::tan(m.fa_deg * kPi / 180.0);
+      const Real tau_c = m.coh - (s.Fn / s.A) * s.tan_fa;
       if (s.tau >= tau_c) fail = BondFailure::Shear;
     }
     // Force on B: tension pulls B back along -n; shear force acts on B as stored.

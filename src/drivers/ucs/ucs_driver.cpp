@@ -106,7 +106,7 @@ void read_checkpoint(const fs::path& dir, dem::DemSystem& sys, UcsState& st, dem
 
 nlohmann::json params_json(const Config& cfg) {
   nlohmann::json j = nlohmann::json::object();
-  for (auto& [k, v] : cfg.values()) j[k] = format_value(v.first);
+  for (auto& [k, v] : cfg.resolved_values()) std::visit([&](const auto& x) { j[k] = x; }, v);
   return j;
 }
 
@@ -239,7 +239,8 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
       if (cp_every > 0 && (sys.step_count / series_every) % std::max(1L, cp_every / series_every) == 0)
         write_checkpoint(cp_dir, sys, st, info);
       const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-      if ((opt.max_wall_s > 0 && elapsed >= opt.max_wall_s) || (!opt.abort_file.empty() && fs::exists(opt.abort_file))) {
+      if ((opt.max_wall_s > 0 && elapsed >= opt.max_wall_s) || (opt.max_steps > 0 && sys.step_count >= opt.max_steps) ||
+          (!opt.abort_file.empty() && fs::exists(opt.abort_file))) {
         write_checkpoint(cp_dir, sys, st, info);
         status = RunStatus::Interrupted;
         break;
