@@ -18,6 +18,7 @@ void declare_dem_params(ParamTable& t) {
   t.real("dem.time_step_safety", 0.8, "-", "fraction of the critical time step used (and allowed)").positive().at_most(1);
   t.boolean("dem.mass_scaling", false, "scale inertial masses so that dem.time_step is stable (quasi-static runs only)");
   t.real("dem.skin_ratio", 0.3, "-", "Verlet skin as a fraction of the mean particle radius").positive();
+  t.integer("dem.parallel_min", 2048, "-", "loops over fewer particles/contacts/bonds run on one thread (OpenMP fork/join costs more)").non_negative();
   t.real_list("dem.gravity", {0, 0, 0}, "m/s^2", "gravitational acceleration").size(3);
   t.real("dem.group.*.density", 2600, "kg/m^3", "particle density of the group").positive();
   // Linear contact (PFC deformability method).
@@ -136,6 +137,7 @@ DemSettings build_settings(const Config& cfg) {
   DemSettings s;
   s.dim = static_cast<int>(cfg.integer("dem.dim"));
   s.local_damping = cfg.real("dem.local_damping");
+  s.parallel_min = static_cast<std::size_t>(cfg.integer("dem.parallel_min"));
   const auto& g = cfg.real_list("dem.gravity");
   s.gravity = Vec3(g[0], g[1], g[2]);
   if (s.dim == 2 && g[2] != 0) cfg.fail("dem.gravity", "a 2D run lies in the x-y plane: the z component must be 0");

@@ -14,11 +14,11 @@ namespace ff::dem {
 namespace {
 // Sums f(i) for i in [0, n) in fixed blocks, so the result does not depend on the thread count.
 template <class F>
-Real deterministic_sum(std::size_t n, F f) {
+Real deterministic_sum(std::size_t n, std::size_t parallel_min, F f) {
   constexpr std::size_t kBlock = 4096;
   const std::size_t nb = (n + kBlock - 1) / kBlock;
   std::vector<Real> part(nb, 0.0);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n > parallel_min)
   for (std::size_t b = 0; b < nb; ++b) {
     Real s = 0;
     const std::size_t end = std::min(n, (b + 1) * kBlock);
@@ -32,9 +32,12 @@ Real deterministic_sum(std::size_t n, F f) {
 }  // namespace
 
 std::size_t DemSystem::install_bonds(Real max_gap) {
-  // Candidates come from a fresh neighbour list with the bonding gap as skin.
+  // Candidates come from a fresh neighbour list whose skin exceeds the bonding gap slightly: the
+  // list keeps pairs closer than (not at) its cut-off, and a pair with gap == max_gap (touching
+  // spheres with max_gap = 0) must be bonded. The exact test is the `gap > max_gap` below.
+  const Real r_max = particles.size() ? *std::max_element(particles.radius.begin(), particles.radius.end()) : 0;
   NeighborList tmp;
-  tmp.build(particles.pos, particles.radius, std::max(max_gap, Real(0)));
+  tmp.build(particles.pos, particles.radius, std::max(max_gap, Real(0)) + 1e-9 * r_max);
   const auto pi = tmp.first(), pj = tmp.second();
   const int dim = settings.dim;
   std::size_t added = 0;
@@ -115,6 +118,7 @@ void DemSystem::rebuild_neighbors() {
   old_i_.assign(nl_.first().begin(), nl_.first().end());
   old_j_.assign(nl_.second().begin(), nl_.second().end());
   old_state_.swap(cstate_);
+  nl_.set_parallel_min(settings.parallel_min);
   nl_.build(particles.pos, particles.radius, settings.skin);
   NeighborList::carry_over<ContactState>(old_i_, old_j_, old_state_, nl_.first(), nl_.second(), cstate_, ContactState{});
   pload_.assign(nl_.size(), PairLoad{});
@@ -158,7 +162,7 @@ void DemSystem::contact_forces(const std::vector<typename Law::Params>& params) 
   const auto& r = particles.radius;
   const auto& grp = particles.group;
   const int ng = materials.groups();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (np > settings.parallel_min)
   for (std::size_t p = 0; p < np; ++p) {
     const Index a = pi[p], b = pj[p];
     const Vec3 d = x[b] - x[a];
@@ -204,7 +208,7 @@ void DemSystem::bond_forces(const std::vector<typename Law::Material>& mats, std
   const int dim = settings.dim;
   const auto& x = particles.pos;
   const auto& r = particles.radius;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nb > settings.parallel_min)
   for (std::size_t b = 0; b < nb; ++b) {
     PairLoad& out = bload_[b];
     if (bond_broken[b]) {
@@ -263,7 +267,7 @@ void DemSystem::wall_forces(const std::vector<typename Law::Params>& params) {
     Wall& wall = walls[w];
     WallContacts& wc = wall_contacts_[w];
     const std::size_t nc = wc.particle.size();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nc > settings.parallel_min)
     for (std::size_t k = 0; k < nc; ++k) {
       const Index i = wc.particle[k];
       PairLoad& out = wc.load[k];
@@ -303,7 +307,7 @@ void DemSystem::gather_and_integrate() {
   const auto adj = nl_.adjacency();
   auto& F = particles.force;
   auto& M = particles.moment;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n > settings.parallel_min)
   for (std::size_t i = 0; i < n; ++i) {
     Vec3 f = Vec3::Zero(), m = Vec3::Zero();
     for (std::int64_t k = adj_off[i]; k < adj_off[i + 1]; ++k) {
@@ -334,7 +338,7 @@ void DemSystem::gather_and_integrate() {
   auto& x = particles.pos;
   auto& v = particles.vel;
   auto& w = particles.omega;
-#pragma omp parallel for schedule(static) reduction(| : bad)
+#pragma omp parallel for schedule(static) reduction(| : bad) if (n > settings.parallel_min)
   for (std::size_t i = 0; i < n; ++i) {
     Vec3 f = F[i] + particles.mass[i] * g;
     Vec3 m = M[i];
@@ -481,7 +485,7 @@ long DemSystem::contacts_touching() const {
 
 Real DemSystem::kinetic_energy() const {
   const auto& p = particles;
-  return deterministic_sum(p.size(), [&](std::size_t i) {
+  return deterministic_sum(p.size(), settings.parallel_min, [&](std::size_t i) {
     return 0.5 * p.mass[i] * p.vel[i].squaredNorm() + 0.5 * p.inertia[i] * p.omega[i].squaredNorm();
   });
 }
@@ -520,7 +524,7 @@ Real DemSystem::strain_energy() const {
 
 Real DemSystem::max_unbalanced_force_ratio() const {
   const std::size_t n = particles.size();
-  const Real unbalanced = deterministic_sum(n, [&](std::size_t i) { return particles.force[i].norm(); });
+  const Real unbalanced = deterministic_sum(n, settings.parallel_min, [&](std::size_t i) { return particles.force[i].norm(); });
   // Mean over the interactions that carry load (PFC's "average ratio").
   Real contact = 0;
   std::size_t loaded = 0;

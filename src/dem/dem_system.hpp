@@ -20,6 +20,7 @@ struct DemSettings {
   Real local_damping = 0.7;     // Cundall's local damping coefficient (PFC default 0.7)
   Vec3 gravity = Vec3::Zero();  // [m/s^2]
   Real skin = 0;                // Verlet skin [m]
+  std::size_t parallel_min = 2048;  // loops over fewer items run on one thread (fork/join costs more)
 };
 
 // Per-pair result slot: force on the second particle and total moments on both.

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/error.hpp"
+
 namespace ff::dem {
 
 std::size_t NeighborList::build(std::span<const Vec3> pos, std::span<const Real> radius, Real skin) {
@@ -27,6 +29,9 @@ std::size_t NeighborList::build(std::span<const Vec3> pos, std::span<const Real>
   }
   // Cells at least as large as the largest interaction distance, and not more than ~2 per
   // particle (particles flung far away must not create a huge grid).
+  if (!(hi - lo).allFinite())
+    throw NumericalError("neighbour search: a particle position is NaN or infinite; the run has become unstable "
+                         "(lower dem.time_step_safety or dem.time_step)");
   Real h = 2 * rmax + skin;
   const Vec3 ext = (hi - lo).cwiseMax(Vec3::Constant(h));
   for (;;) {
@@ -84,7 +89,7 @@ std::size_t NeighborList::build(std::span<const Vec3> pos, std::span<const Real>
     }
   };
   count_.assign(n + 1, 0);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n > parallel_min_)
   for (std::size_t i = 0; i < n; ++i) {
     std::int64_t k = 0;
     visit(i, [&](Index) { ++k; });
@@ -94,7 +99,7 @@ std::size_t NeighborList::build(std::span<const Vec3> pos, std::span<const Real>
   const std::size_t npairs = static_cast<std::size_t>(count_[n]);
   pair_i_.resize(npairs);
   pair_j_.resize(npairs);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (n > parallel_min_)
   for (std::size_t i = 0; i < n; ++i) {
     std::int64_t k = count_[i];
     visit(i, [&](Index j) {
@@ -133,7 +138,7 @@ bool NeighborList::needs_rebuild(std::span<const Vec3> pos, Real extra_wall_moti
   const Real lim2 = 0.25 * skin_ * skin_;
   Real max2 = 0;
   const std::size_t n = pos.size();
-#pragma omp parallel for reduction(max : max2) schedule(static)
+#pragma omp parallel for reduction(max : max2) schedule(static) if (n > parallel_min_)
   for (std::size_t i = 0; i < n; ++i) max2 = std::max(max2, (pos[i] - ref_pos_[i]).squaredNorm());
   // Two particles approaching each other can each move skin/2.
   return std::sqrt(max2) + extra_wall_motion > 0.5 * skin_ || max2 > lim2;

@@ -23,6 +23,7 @@ class NeighborList {
   std::span<const Index> second() const { return pair_j_; }
   std::size_t size() const { return pair_i_.size(); }
   Real skin() const { return skin_; }
+  void set_parallel_min(std::size_t n) { parallel_min_ = n; }  // shorter loops run on one thread
   long builds() const { return builds_; }
   // For each particle, the pairs it belongs to, as (pair index << 1 | is_second) entries:
   // the gather adds +F for the second particle and -F for the first.
@@ -51,6 +52,7 @@ class NeighborList {
   std::vector<Index> cell_particles_, cell_of_;
   Real skin_ = 0;
   long builds_ = 0;
+  std::size_t parallel_min_ = 2048;
 };
 
 template <class T>

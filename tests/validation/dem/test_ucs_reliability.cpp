@@ -34,8 +34,9 @@ TEST(UcsReliability, OneAndTwoThreadsGiveIdenticalResults) {
   const std::string text = test::small_ucs_scenario(3);
   const auto a = test::scratch("t1"), b = test::scratch("t2");
   // 3000 steps cover the elastic stage; enough to expose any order-dependent sum.
-  test::run_scenario(text, {}, a, 1, 3000);
-  test::run_scenario(text, {}, b, 2, 3000);
+  // Every loop goes parallel (dem.parallel_min = 0), however small the sample.
+  test::run_scenario(text, {"dem.parallel_min=0"}, a, 1, 3000);
+  test::run_scenario(text, {"dem.parallel_min=0"}, b, 2, 3000);
   EXPECT_TRUE(test::slurp(a / "series.csv") == test::slurp(b / "series.csv"));
   // The full particle state at the end, compared bit for bit.
   CheckpointReader ra(a / "checkpoint" / "state.ffcp"), rb(b / "checkpoint" / "state.ffcp");
