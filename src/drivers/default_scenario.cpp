@@ -41,7 +41,7 @@ seed = 1
 bond_gap = 0.05e-3
 
 [ucs]
-platen_velocity = 0.1     # m/s each (inertial number ~1e-4: quasi-static)
+platen_velocity = 0.2     # m/s each (inertial number ~2e-4 < 1e-3: quasi-static)
 platen_friction = 0.1
 stop_fraction = 0.6
 )toml";
