@@ -19,10 +19,12 @@ using namespace ff;
 
 int main(int argc, char** argv) {
   long steps = 300;
+  int max_threads = 0;  // 0: every core
   double diameter = 25e-3, height = 50e-3;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--steps") && i + 1 < argc) steps = std::atol(argv[++i]);
     if (!std::strcmp(argv[i], "--small")) { diameter = 12.5e-3; height = 25e-3; }
+    if (!std::strcmp(argv[i], "--max-threads") && i + 1 < argc) max_threads = std::atoi(argv[++i]);
   }
   const Driver& ucs = find_driver("ucs");
   ParamTable table = parameter_table(ucs);
@@ -63,7 +65,7 @@ porosity = 0.38
   fmt::print("ucs-cylinder benchmark: {} particles, {} bonds, {} contacts touching; genesis {:.1f} s\n",
              base.particles.size(), base.intact_bonds(), base.contacts_touching(), genesis);
   std::vector<Vec3> reference;
-  const int maxthreads = omp_get_num_procs();
+  const int maxthreads = max_threads > 0 ? max_threads : omp_get_num_procs();
   for (int threads = 1; threads <= maxthreads; threads *= 2) {
     omp_set_num_threads(threads);
     dem::DemSystem sys = base;

@@ -178,7 +178,7 @@ void DemSystem::contact_forces(const std::vector<typename Law::Params>& params) 
     }
     ContactGeom g;
     const Real dist = std::sqrt(d2);
-    g.n = d / dist;
+    g.n = d * (1.0 / dist);
     g.gap = dist - rsum;
     g.xc = x[a] + (r[a] + 0.5 * g.gap) * g.n;
     g.rA = r[a];

@@ -32,6 +32,7 @@ struct ParallelBond {
     Vec3 Fs = Vec3::Zero(), Mb = Vec3::Zero();
     Real sigma = 0, tau = 0;          // peripheral stresses at the last evaluation [Pa]
     Real tan_fa = 0;                  // tan(friction angle), cached at installation
+    Real inv_A = 0, R_over_I = 0, R_over_J = 0;  // cached so the hot loop multiplies instead of dividing
   };
 
   // Section: R = lambda min(RA, RB); 3D A = pi R^2, I = pi R^4/4, J = pi R^4/2;
@@ -51,6 +52,9 @@ struct ParallelBond {
     s.kn = m.emod / (rA + rB);
     s.ks = s.kn / m.kratio;
     s.tan_fa = std::tan(m.fa_deg * kPi / 180.0);
+    s.inv_A = 1.0 / s.A;
+    s.R_over_I = s.R / s.I;
+    s.R_over_J = s.J > 0 ? s.R / s.J : 0.0;
     return s;
   }
   // Translational and rotational stiffness the bond adds to each end (time-step estimate).
@@ -69,13 +73,14 @@ struct ParallelBond {
     if (dim == 3) s.Mt -= s.ks * s.J * dtheta_t;
     // Peripheral stresses (P&C 2004 Eq. 6-7 with the moment-contribution factor).
     const Real mb = s.Mb.norm();
-    s.sigma = s.Fn / s.A + m.beta * mb * s.R / s.I;
-    s.tau = s.Fs.norm() / s.A + (dim == 3 ? m.beta * std::abs(s.Mt) * s.R / s.J : 0.0);
+    const Real normal_stress = s.Fn * s.inv_A;
+    s.sigma = normal_stress + m.beta * mb * s.R_over_I;
+    s.tau = s.Fs.norm() * s.inv_A + m.beta * std::abs(s.Mt) * s.R_over_J;  // Mt = 0 in 2D
     BondFailure fail = BondFailure::None;
     if (s.sigma >= m.ten) {
       fail = BondFailure::Tensile;
     } else {
-      const Real tau_c = m.coh - (s.Fn / s.A) * s.tan_fa;
+      const Real tau_c = m.coh - normal_stress * s.tan_fa;
       if (s.tau >= tau_c) fail = BondFailure::Shear;
     }
     // Force on B: tension pulls B back along -n; shear force acts on B as stored.

@@ -51,7 +51,7 @@ inline void rotate_into_plane(Vec3& v, const ContactGeom& g, Real dt) {
 inline bool sphere_sphere(ContactGeom& g, const Vec3& xA, Real rA, const Vec3& xB, Real rB) {
   const Vec3 d = xB - xA;
   const Real dist = d.norm();
-  g.n = dist > 0 ? Vec3(d / dist) : Vec3::UnitX();
+  g.n = dist > 0 ? Vec3(d * (1.0 / dist)) : Vec3::UnitX();
   g.gap = dist - (rA + rB);
   g.xc = xA + (rA + 0.5 * g.gap) * g.n;
   g.rA = rA;
