@@ -333,7 +333,6 @@ void DemSystem::gather_and_integrate() {
   const Real dt = settings.dt, alpha = settings.local_damping;
   const Vec3 g = settings.gravity;
   const bool planar = settings.dim == 2;
-  const bool track_orientation = materials.bond_law == BondLaw::Rotational;
   int bad = 0;
   auto& x = particles.pos;
   auto& v = particles.vel;
@@ -359,13 +358,12 @@ void DemSystem::gather_and_integrate() {
     const Vec3 dx = v[i] * dt;
     x[i] += dx;
     particles.disp[i] += dx;
-    // q' = 1/2 (0, w) q, integrated with the exact rotation of this step. Only bonds of the
-    // total (rotational) kind read orientations, so other runs skip the trigonometry.
-    const Real wn = track_orientation ? w[i].norm() : 0.0;
-    if (wn > 0) {
-      const Quat dq(Eigen::AngleAxis<Real>(wn * dt, w[i] / wn));
-      particles.orient[i] = (dq * particles.orient[i]).normalized();
-    }
+    // Orientation: q' = 1/2 (0, w) q (METHODS.md 1.1), first order and renormalised.
+    const Vec3 hw = (0.5 * dt) * w[i];
+    Quat& q = particles.orient[i];
+    q = Quat(q.w() - hw.dot(q.vec()), q.x() + hw.x() * q.w() + hw.y() * q.z() - hw.z() * q.y(),
+             q.y() + hw.y() * q.w() + hw.z() * q.x() - hw.x() * q.z(), q.z() + hw.z() * q.w() + hw.x() * q.y() - hw.y() * q.x());
+    q.normalize();
     if (!std::isfinite(x[i].x() + x[i].y() + x[i].z() + w[i].x() + w[i].y() + w[i].z())) bad = 1;
   }
   if (bad)

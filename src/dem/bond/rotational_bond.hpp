@@ -19,8 +19,8 @@
 //    Moments are about each particle's own centre and already contain the moment of the force.
 //  * Cross-section: beam radius R = L0/2 (ESyS "mean radius" scaling; equals (rA+rB)/2 for
 //    touching particles), A = pi R^2, I = pi R^4/4, J = pi R^4/2, length L0 = initial centre
-//    distance. dim == 2 uses the same circular section (a 2-D bond is a slice of the 3-D model);
-//    with in-plane positions and z-only rotations the twist and out-of-plane terms vanish exactly.
+//    distance. dim == 2 (disks 1 m thick) uses a 2R x 1 m rectangle, A = 2R, I = 2R^3/3, as the
+//    parallel bond; with in-plane positions and z-only rotations twist and out-of-plane terms vanish.
 //  * Bending moment = kb * theta with kb = E I / L0, i.e. an Euler-Bernoulli segment, so that
 //    Mb/Mb0 is the peak bending stress over the tensile strength c/tan(phi). ESyS applies
 //    kb*theta/2 (LAMMPS bpm/rotational applies kb*theta); for the same E our bonds are twice as
@@ -128,9 +128,15 @@ inline RotationalBond::State RotationalBond::install(const Material& m, const Bo
   if (!(s.r0 > 0))
     throw InputError("rotational bond: the two particles have the same centre; remove duplicate particles");
 
-  // ESyS brittle-beam scaling (METHODS 1.8): beam of radius R = L0/2 and length L0.
+  // ESyS brittle-beam scaling (METHODS 1.8): beam of radius R = L0/2 and length L0. In 2D the
+  // disks are 1 m thick (as everywhere in fracflow's 2D), so the beam is a 2R x 1 m rectangle
+  // (A = 2R, I = 2R^3/3, the same section as the parallel bond's 2D form); J only enters
+  // through twist, which vanishes in the plane.
   const Real R = 0.5 * s.r0;
-  const Real area = kPi * R * R, I = 0.25 * kPi * R * R * R * R, J = 2 * I;
+  const bool planar = m.dim == 2;
+  const Real area = planar ? 2 * R : kPi * R * R;
+  const Real I = planar ? 2.0 / 3.0 * R * R * R : 0.25 * kPi * R * R * R * R;
+  const Real J = 2 * I;
   const Real E = m.youngs_modulus, G = E / (2 * (1 + m.poisson_ratio));
   s.kr = E * area / s.r0;
   s.ks = G * area / s.r0;
