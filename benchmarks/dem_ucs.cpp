@@ -11,6 +11,7 @@
 #include <cstring>
 
 #include "dem/dem_params.hpp"
+#include "dem/presets.hpp"
 #include "dem/sample_builder.hpp"
 #include "drivers/driver.hpp"
 #include "io/scenario.hpp"
@@ -28,27 +29,10 @@ int main(int argc, char** argv) {
   }
   const Driver& ucs = find_driver("ucs");
   ParamTable table = parameter_table(ucs);
-  const std::string text = fmt::format(R"(
-driver = "ucs"
-[dem.group.matrix]
-density = 1390
-[dem.contact.matrix-matrix]
-emod = 2.09e9
-kratio = 14.65
-friction = 0.4
-[dem.bond.matrix-matrix]
-emod = 2.09e9
-kratio = 14.65
-tensile_strength = 17.4e6
-cohesion = 4.35e6
-friction_angle = 4.0
-[sample]
-diameter = {}
-height = {}
-radius_min = 0.4e-3
-radius_max = 0.6e-3
-porosity = 0.38
-)", diameter, height);
+  const std::string text = "driver = \"ucs\"\n" + std::string(dem::kCoalMatrixTable7Toml) +
+                           fmt::format("[sample]\ndiameter = {}\nheight = {}\nradius_min = 0.4e-3\nradius_max = 0.6e-3\n"
+                                       "porosity = 0.38\n",
+                                       diameter, height);
   Config cfg = load_scenario(table, "<benchmark>", text, {});
   omp_set_num_threads(omp_get_num_procs());
   dem::DemSystem base;

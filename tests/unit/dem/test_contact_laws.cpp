@@ -12,21 +12,13 @@
 #include "dem/contact/hertz_mindlin.hpp"
 #include "dem/contact/linear_contact.hpp"
 #include "dem/dem_system.hpp"
+#include "single_threaded.hpp"
 
 using namespace ff;
 using namespace ff::dem;
 
 namespace {
 
-// Small systems are stepped on one thread: a step has several OpenMP regions, and for a few
-// dozen bodies their barriers cost more than the work (badly so on a loaded machine). Results do
-// not depend on the thread count (DemThreads.BitIdenticalOnOneAndThreeThreads checks that).
-class SingleThreaded : public ::testing::Environment {
- public:
-  void SetUp() override { omp_set_num_threads(1); }
-};
-[[maybe_unused]] ::testing::Environment* const kSingleThreaded =
-    ::testing::AddGlobalTestEnvironment(new SingleThreaded);
 
 // Geometry of two bodies along the unit normal n with the given gap and no relative motion.
 ContactGeom geom(const Vec3& n, Real gap, Real rA, Real rB) {

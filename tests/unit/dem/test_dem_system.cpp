@@ -15,21 +15,13 @@
 #include "core/error.hpp"
 #include "core/rng.hpp"
 #include "dem/dem_system.hpp"
+#include "single_threaded.hpp"
 
 using namespace ff;
 using namespace ff::dem;
 
 namespace {
 
-// Small systems are stepped on one thread: a step has several OpenMP regions, and for a few
-// dozen bodies their barriers cost more than the work (badly so on a loaded machine). Results do
-// not depend on the thread count (DemThreads.BitIdenticalOnOneAndThreeThreads checks that).
-class SingleThreaded : public ::testing::Environment {
- public:
-  void SetUp() override { omp_set_num_threads(1); }
-};
-[[maybe_unused]] ::testing::Environment* const kSingleThreaded =
-    ::testing::AddGlobalTestEnvironment(new SingleThreaded);
 
 constexpr Real kDensity = 2600, kRadius = 1e-3;
 

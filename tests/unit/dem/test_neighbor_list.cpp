@@ -12,21 +12,13 @@
 
 #include "core/rng.hpp"
 #include "dem/dem_system.hpp"
+#include "single_threaded.hpp"
 #include "dem/neighbor_list.hpp"
 
 using namespace ff;
 using namespace ff::dem;
 
 namespace {
-
-// Runs on one thread except where a test asks for more: on a loaded 2-core machine each OpenMP
-// barrier can cost a scheduler time slice, and the rebuild loop below has hundreds of them.
-class SingleThreaded : public ::testing::Environment {
- public:
-  void SetUp() override { omp_set_num_threads(1); }
-};
-[[maybe_unused]] ::testing::Environment* const kSingleThreaded =
-    ::testing::AddGlobalTestEnvironment(new SingleThreaded);
 
 using Pairs = std::vector<std::pair<Index, Index>>;
 

@@ -10,6 +10,7 @@
 
 #include "dem/bond/parallel_bond.hpp"
 #include "dem/dem_system.hpp"
+#include "single_threaded.hpp"
 
 using namespace ff;
 using namespace ff::dem;
@@ -17,15 +18,6 @@ using PB = ParallelBond;
 
 namespace {
 
-// Small systems are stepped on one thread: a step has several OpenMP regions, and for a few
-// dozen bodies their barriers cost more than the work (badly so on a loaded machine). Results do
-// not depend on the thread count (DemThreads.BitIdenticalOnOneAndThreeThreads checks that).
-class SingleThreaded : public ::testing::Environment {
- public:
-  void SetUp() override { omp_set_num_threads(1); }
-};
-[[maybe_unused]] ::testing::Environment* const kSingleThreaded =
-    ::testing::AddGlobalTestEnvironment(new SingleThreaded);
 
 PB::Material bond_material() {
   PB::Material m;

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "core/log.hpp"
+#include "dem/presets.hpp"
 #include "drivers/driver.hpp"
 #include "io/csv.hpp"
 #include "io/scenario.hpp"
@@ -18,22 +19,7 @@ namespace ff::test {
 // A small sample so a whole test takes seconds: 2D 10 x 20 mm rectangle (~200 disks) or a
 // 3D 7 x 14 mm cylinder (~600 spheres), seed 000 Table 7 coal-matrix micro-parameters.
 inline std::string small_ucs_scenario(int dim) {
-  std::string s = R"(
-driver = "ucs"
-[dem]
-bond_law = "parallel"
-[dem.group.matrix]
-density = 1390
-[dem.contact.matrix-matrix]
-emod = 2.09e9
-kratio = 14.65
-friction = 0.4
-[dem.bond.matrix-matrix]
-emod = 2.09e9
-kratio = 14.65
-tensile_strength = 17.4e6
-cohesion = 4.35e6
-friction_angle = 4.0
+  std::string s = "driver = \"ucs\"\n[dem]\nbond_law = \"parallel\"\ndim = " + std::to_string(dim) + R"(
 [ucs]
 platen_velocity = 0.1
 series_interval = 50
@@ -41,20 +27,9 @@ series_interval = 50
 vtk = false
 plots = false
 progress_interval = 0
-)";
-  if (dim == 2)
-    s += "[sample]\nshape = \"box\"\nwidth = 10e-3\nheight = 20e-3\nporosity = 0.2\n[dem]\ndim = 2\n";
-  else
-    s += "[sample]\nshape = \"cylinder\"\ndiameter = 7e-3\nheight = 14e-3\nporosity = 0.42\n";
-  // TOML forbids a table twice: merge the second [dem] into the first.
-  const auto first = s.find("[dem]\n");
-  const auto second = s.rfind("[dem]\n");
-  if (second != first) {
-    s.erase(second, 6);
-    const auto dimline = s.find("dim = 2\n", second);
-    s.erase(dimline, 8);
-    s.insert(first + 6, "dim = 2\n");
-  }
+)" + std::string(dem::kCoalMatrixTable7Toml);
+  if (dim == 2) s += "[sample]\nshape = \"box\"\nwidth = 10e-3\nheight = 20e-3\nporosity = 0.2\n";
+  else s += "[sample]\nshape = \"cylinder\"\ndiameter = 7e-3\nheight = 14e-3\nporosity = 0.42\n";
   return s;
 }
 
