@@ -72,10 +72,10 @@ void DemSystem::build_bond_adjacency() {
   }
   for (std::size_t i = 0; i < n; ++i) bond_adj_offset_[i + 1] += bond_adj_offset_[i];
   bond_adj_.resize(bond_adj_offset_[n]);
-  std::vector<std::int64_t> fill(bond_adj_offset_.begin(), bond_adj_offset_.end() - 1);
+  bond_fill_.assign(bond_adj_offset_.begin(), bond_adj_offset_.end() - 1);
   for (std::size_t b = 0; b < nb; ++b) {
-    bond_adj_[fill[bond_i[b]]++] = static_cast<std::int64_t>(b) << 1;
-    bond_adj_[fill[bond_j[b]]++] = (static_cast<std::int64_t>(b) << 1) | 1;
+    bond_adj_[bond_fill_[bond_i[b]]++] = static_cast<std::int64_t>(b) << 1;
+    bond_adj_[bond_fill_[bond_j[b]]++] = (static_cast<std::int64_t>(b) << 1) | 1;
   }
   bload_.assign(nb, PairLoad{});
   bond_fail_flag_.assign(nb, 0);
@@ -110,24 +110,39 @@ void DemSystem::initialise() {
   particles.moment.assign(particles.size(), Vec3::Zero());
   wall_contacts_.resize(walls.size());
   build_bond_adjacency();
+  // Every crack is a broken bond: with this reserve, logging never allocates in the time loop.
+  cracks.events.reserve(cracks.events.size() + bond_i.size());
   rebuild_neighbors();
+  // Contacts multiply as a sample is compressed and fails: room for 50% more pairs up front.
+  const std::size_t room = nl_.size() + nl_.size() / 2 + 64;
+  nl_.reserve(room);
+  for (auto* v : {&old_i_, &old_j_}) v->reserve(room);
+  cstate_.reserve(room);
+  old_state_.reserve(room);
+  pload_.reserve(room);
 }
 
 void DemSystem::rebuild_neighbors() {
   // Keep the old pairs so contact history survives the rebuild.
+  reserve_with_headroom(old_i_, nl_.size());
+  reserve_with_headroom(old_j_, nl_.size());
   old_i_.assign(nl_.first().begin(), nl_.first().end());
   old_j_.assign(nl_.second().begin(), nl_.second().end());
   old_state_.swap(cstate_);
   nl_.set_parallel_min(settings.parallel_min);
   nl_.build(particles.pos, particles.radius, settings.skin);
   NeighborList::carry_over<ContactState>(old_i_, old_j_, old_state_, nl_.first(), nl_.second(), cstate_, ContactState{});
+  reserve_with_headroom(pload_, nl_.size());
   pload_.assign(nl_.size(), PairLoad{});
   // Wall candidates: particles within their radius + skin of the wall surface.
   wall_contacts_.resize(walls.size());
   for (std::size_t w = 0; w < walls.size(); ++w) {
     WallContacts& wc = wall_contacts_[w];
-    std::vector<Index> old_p = std::move(wc.particle);
-    std::vector<ContactState> old_s = std::move(wc.state);
+    // Swap with reused buffers: no allocation once the buffers have grown.
+    std::vector<Index>& old_p = old_wall_particle_;
+    std::vector<ContactState>& old_s = old_wall_state_;
+    old_p.swap(wc.particle);
+    old_s.swap(wc.state);
     wc.particle.clear();
     wc.state.clear();
     if (walls[w].active) {
@@ -137,6 +152,8 @@ void DemSystem::rebuild_neighbors() {
           wc.particle.push_back(static_cast<Index>(i));
       }
     }
+    reserve_with_headroom(wc.state, wc.particle.size());
+    reserve_with_headroom(wc.load, wc.particle.size());
     wc.state.assign(wc.particle.size(), ContactState{});
     std::size_t a = 0;
     for (std::size_t k = 0; k < wc.particle.size(); ++k) {

@@ -113,6 +113,9 @@ class DemSystem {
   std::vector<WallContacts> wall_contacts_;
   std::vector<Index> old_i_, old_j_;
   std::vector<ContactState> old_state_;
+  std::vector<std::int64_t> bond_fill_;
+  std::vector<Index> old_wall_particle_;
+  std::vector<ContactState> old_wall_state_;
   Real wall_motion_since_build_ = 0;
 };
 

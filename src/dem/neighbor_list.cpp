@@ -49,6 +49,9 @@ std::size_t NeighborList::build(std::span<const Vec3> pos, std::span<const Real>
     cz = std::clamp(static_cast<int>((x.z() - lo.z()) / h), 0, nz - 1);
   };
   // Counting sort of particles into cells (particles of a cell in increasing index).
+  // The grid never exceeds 2n + 27 cells (see above): reserve that once.
+  if (cell_start_.capacity() < 2 * n + 28) cell_start_.reserve(2 * n + 28);
+  if (count_.capacity() < 2 * n + 28) count_.reserve(2 * n + 28);  // also the per-cell fill counters
   cell_start_.assign(ncell + 1, 0);
   cell_of_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -97,6 +100,8 @@ std::size_t NeighborList::build(std::span<const Vec3> pos, std::span<const Real>
   }
   for (std::size_t i = 0; i < n; ++i) count_[i + 1] += count_[i];
   const std::size_t npairs = static_cast<std::size_t>(count_[n]);
+  reserve_with_headroom(pair_i_, npairs);
+  reserve_with_headroom(pair_j_, npairs);
   pair_i_.resize(npairs);
   pair_j_.resize(npairs);
 #pragma omp parallel for schedule(static) if (n > parallel_min_)
@@ -119,6 +124,7 @@ void NeighborList::build_adjacency(std::size_t n) {
     ++adj_offset_[pair_j_[p] + 1];
   }
   for (std::size_t i = 0; i < n; ++i) adj_offset_[i + 1] += adj_offset_[i];
+  reserve_with_headroom(adj_, static_cast<std::size_t>(adj_offset_[n]));
   adj_.resize(adj_offset_[n]);
   count_.assign(adj_offset_.begin(), adj_offset_.end());
   for (std::size_t p = 0; p < pair_i_.size(); ++p) {  // increasing pair index per particle

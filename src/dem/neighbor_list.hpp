@@ -11,6 +11,13 @@
 
 namespace ff::dem {
 
+// Grows a work buffer with 25% headroom, so that lists which grow slowly during a run (more
+// contacts as a sample is compressed) do not reallocate at every rebuild.
+template <class V>
+void reserve_with_headroom(V& v, std::size_t n) {
+  if (v.capacity() < n) v.reserve(n + n / 4 + 16);
+}
+
 class NeighborList {
  public:
   // Rebuilds the pair list; returns the number of pairs.
@@ -24,6 +31,12 @@ class NeighborList {
   std::size_t size() const { return pair_i_.size(); }
   Real skin() const { return skin_; }
   void set_parallel_min(std::size_t n) { parallel_min_ = n; }  // shorter loops run on one thread
+  // Room for `pairs` pairs before any buffer must grow (no allocation while a sample densifies).
+  void reserve(std::size_t pairs) {
+    pair_i_.reserve(pairs);
+    pair_j_.reserve(pairs);
+    adj_.reserve(2 * pairs);
+  }
   long builds() const { return builds_; }
   // For each particle, the pairs it belongs to, as (pair index << 1 | is_second) entries:
   // the gather adds +F for the second particle and -F for the first.
@@ -59,6 +72,7 @@ template <class T>
 void NeighborList::carry_over(std::span<const Index> old_i, std::span<const Index> old_j, const std::vector<T>& old_state,
                               std::span<const Index> new_i, std::span<const Index> new_j, std::vector<T>& new_state,
                               const T& fresh) {
+  reserve_with_headroom(new_state, new_i.size());
   new_state.assign(new_i.size(), fresh);
   std::size_t a = 0;
   for (std::size_t b = 0; b < new_i.size(); ++b) {

@@ -1,8 +1,9 @@
-// Flexible-wall (FW) membrane of a triaxial test: a cylindrical sleeve of independent triangular
-// wall elements, each servo-controlled to the confining pressure (METHODS.md 3; [S000] Zhao,
-// Konietzky & Herbst 2021, sec. 5.1 and Figs. 8-9; servo law of the Itasca PFC "wall servo"
-// command). The sleeve is a closed triangle mesh on shared vertices, so it never opens while it
-// bulges unevenly.
+// Flexible-wall (FW) membrane of a triaxial test: a cylindrical sleeve of triangular wall
+// elements whose target load is the confining pressure times their current area, moved by the
+// wall-servo law (METHODS.md 3; [S000] Zhao, Konietzky & Herbst 2021, sec. 5.1 and Figs. 8-9;
+// servo law of the Itasca PFC "wall servo" command). The elements are formed on shared vertices,
+// so the sleeve never opens while it bulges unevenly; how the vertices follow the servos is
+// MembraneVertexRule.
 //
 // Geometry (METHODS.md 3). N_theta x N_z square units on radius R_m, z0 <= z <= z0 + H; vertex
 // P(i,j) = (R cos(2 pi i/N_theta), R sin(2 pi i/N_theta), z0 + j H/N_z) + axis offset, i periodic.
@@ -15,7 +16,15 @@
 //   2. compute_forces<Law>(...) with the particle positions of this step;
 //   3. the particle gather adds, in candidate order, -load.f to the force and load.m to the moment
 //      of particle candidate_particles()[c] (add_loads_to() does exactly this);
-//   4. particles integrate; 5. move(dt): servo velocities, vertex update, new geometry.
+//   4. particles integrate; 5. move(dt, z_bottom, z_top) with the platen planes: servo
+//      velocities, vertex update, new geometry.
+//
+// Loaded band. The confining fluid acts on the whole sleeve, but only the part between the
+// platens presses on the sample; beyond them the real membrane rests on the platens. So the
+// target load of element k is p times its area between z_bottom and z_top (clipped), lumped
+// at its vertices like a finite-element pressure load (barycentric weights of the clipped
+// centroid). Elements outside the band have no target; with no contact they move inward at
+// v_max and stop at r_min.
 //
 // Contacts: each particle-element candidate gets the facet geometry of triangle_contact.hpp and
 // the engine's contact law (the element is body B with rB = 0, like a rigid wall). A particle
@@ -39,14 +48,25 @@
 
 namespace ff::dem {
 
-// How vertices follow the element servos (the sleeve stays closed with either).
+// How the vertices follow the servos (the sleeve stays closed with either: elements are formed
+// on shared vertices).
 enum class MembraneVertexRule : std::uint8_t {
-  // METHODS.md 3 reading of [S000] Fig. 9: vertex P(i,j) is owned by T1 of unit (i,j) and moves
-  // with that element's servo velocity; top-row vertices follow T2 of the unit below.
+  // Default. The servo law of METHODS.md 3 applied at each vertex to the loads lumped there:
+  // the target loads of its elements (loaded band, above) and the contact normal forces and
+  // stiffnesses split by the barycentric weights of their contact points. The vertex moves
+  // along its fixed horizontal radial line (mesh angles and heights never change, so elements
+  // cannot fold). At equilibrium every vertex balances, hence -sum F^c = p sum A_band (mean
+  // confinement = p), though single elements are balanced only on average. The update matrix
+  // D^-1 J (J = sum_c kn w w^T, D its row sums) has eigenvalues in [0, 1]: stable for alpha_s <= 1.
+  Nodal,
+  // METHODS.md 3 reading of [S000] Fig. 9, kept for comparison: vertex P(i,j) moves with the
+  // translation (servo velocity x normal) of T1 of unit (i,j); top-row vertices with T2 of the
+  // unit below. It does not converge: a T1 whose contacts sit far from its own vertex keeps
+  // driving that vertex into the particles (its force hardly changes), T2 elements get no
+  // feedback, and the checkerboard mode of the T1 errors grows by 1 + alpha_s/3 per step in the
+  // uncapped regime. Around a rigid cylinder of spheres it over-presses 16-100x (test
+  // MembraneCylinder.OwnerRuleOverPresses), also with a 40x smaller v_max.
   Owner,
-  // Each vertex moves along the area-weighted mean normal of its element fan with the servo law
-  // applied to the fan's pooled force error and stiffness (elements without contact left out).
-  Pooled,
 };
 
 struct MembraneSettings {
@@ -58,12 +78,13 @@ struct MembraneSettings {
   Real pressure = 0;             // confining pressure p [Pa]
   Real v_max = 0.01;             // servo speed cap [m/s] ([S000]: 0.01, above the platen speed)
   Real relaxation = 0.8;         // alpha_s, servo relaxation factor (PFC default 0.8) [-]
-  // Vertices never come closer to the axis than r_min [m]. Rows beyond the sample ends touch no
-  // particle and move inward at v_max; the clamp stops them (set it a little below the platen /
-  // smallest expected sample radius, so the membrane still follows a sample that contracts).
+  // Vertices never come closer to the axis than r_min (required, 0 < r_min < radius) [m]. Rows
+  // beyond the sample ends touch no particle and move inward at v_max; the clamp stops them. Set
+  // it a little below the platen radius (the smallest expected sample radius), so the membrane
+  // still follows a sample that contracts but free rows do not fold through the platens.
   Real r_min = 0;
   Real friction = 0;             // particle-membrane Coulomb friction (0: pure pressure) [-]
-  MembraneVertexRule rule = MembraneVertexRule::Owner;
+  MembraneVertexRule rule = MembraneVertexRule::Nodal;
   std::size_t parallel_min = 2048;  // contact loops with fewer candidates run on one thread
 };
 
@@ -79,8 +100,9 @@ struct MembraneParticles {
 
 // Result of one (particle, element) candidate.
 struct MembraneLoad {
-  Vec3 f = Vec3::Zero();  // force ON THE ELEMENT [N]; the particle receives -f
-  Vec3 m = Vec3::Zero();  // moment on the particle [N m]
+  Vec3 f = Vec3::Zero();   // force ON THE ELEMENT [N]; the particle receives -f
+  Vec3 m = Vec3::Zero();   // moment on the particle [N m]
+  Vec3 xc = Vec3::Zero();  // contact point (Love-Weber stress: branch xc - x_particle) [m]
 };
 
 class FlexibleMembrane {
@@ -104,6 +126,7 @@ class FlexibleMembrane {
   const Vec3& centroid(std::size_t k) const { return centroid_[k]; }
 
   // Servo quantities of the last compute_forces()/move() (METHODS.md 3).
+  Real loaded_area(std::size_t k) const { return area_band_[k]; }  // area between the platens [m^2]
   Real contact_force(std::size_t k) const { return fc_[k]; }  // F^c: signed, < 0 when pushed [N]
   Real contact_stiffness(std::size_t k) const { return kc_[k]; }  // K^c [N/m]
   int contacts(std::size_t k) const { return ncontact_[k]; }
@@ -120,15 +143,15 @@ class FlexibleMembrane {
   std::span<const Index> candidate_particles() const { return cand_p_; }
   std::span<const Index> candidate_elements() const { return cand_e_; }
   std::span<const MembraneLoad> candidate_loads() const { return load_; }
-  std::span<ContactState> contact_states() { return state_; }  // per candidate (checkpoints)
+  std::span<ContactState> contact_states() { return state_; }  // shear history per candidate
   void add_loads_to(std::span<Vec3> force, std::span<Vec3> moment) const;
-  void move(Real dt);
+  void move(Real dt, Real z_bottom, Real z_top);  // z of the platen planes [m]
   Real motion_since_build() const { return motion_; }  // max vertex travel since find_candidates [m]
-  Real max_step_motion(Real dt) const { return s_.v_max * dt; }
+  Real max_step_motion(Real dt) const { return s_.v_max * dt; }  // bound on the next move()
 
   // Measurements.
-  // Mean applied confinement -sum F^c / sum A over the elements in contact [Pa] (METHODS.md 3
-  // acceptance: equals p within ~1 % at equilibrium); 0 when nothing touches.
+  // Mean applied confinement -sum F^c / sum A_band [Pa], loaded areas of the last move()
+  // (METHODS.md 3 acceptance: equals p within ~1 % at equilibrium); 0 before the first move().
   Real mean_confinement() const;
   // Volume inside the sleeve between the planes z_lo < z_hi (the platens), by the divergence
   // theorem with the field (x - axis)/2 in the horizontal plane, which has no flux through the
@@ -146,16 +169,18 @@ class FlexibleMembrane {
  private:
   void update_geometry();
   void vertex_velocities_owner();
-  void vertex_velocities_pooled(Real dt);
+  void vertex_velocities_nodal(Real dt);
   bool keep_contact(std::size_t c, std::size_t begin, std::size_t end) const;
 
   MembraneSettings s_;
   Real tol_;  // coincidence tolerance of closest points (1e-9 R_m) [m]
   std::vector<Vec3> x_, xv_, x_build_;      // vertices, their velocities, positions at the last build
   std::vector<std::array<Index, 3>> tri_;   // element corners (vertex indices)
+  std::vector<Vec3> rdir_;                  // unit horizontal direction from the axis at construction
   std::vector<Index> owner_;                // Owner rule: element each vertex follows
-  std::vector<std::int64_t> fan_off_, fan_;  // elements around each vertex (CSR)
-  std::vector<Real> area_;
+  std::vector<Real> ftv_, fcv_, kcv_;        // Nodal rule: lumped target, contact force, stiffness
+  std::vector<Real> area_, area_band_;
+  std::vector<std::array<Real, 3>> load_w_;  // barycentric weights of the loaded part's centroid
   std::vector<Vec3> normal_, centroid_;
   std::vector<Real> fc_, kc_, vservo_;
   std::vector<int> ncontact_;

@@ -1,0 +1,87 @@
+// "No allocation inside the time loop" (issue 2, item 11): after a warm-up in which the
+// work buffers reach their size, stepping a bonded sample that is compressed by moving walls
+// (so neighbour lists are rebuilt, contacts form and bonds break) makes no heap allocation.
+// The global operator new of this test program counts allocations while `counting` is set.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+
+#include "core/rng.hpp"
+#include "dem/dem_system.hpp"
+
+namespace {
+std::atomic<bool> counting{false};
+std::atomic<long> allocations{0};
+}  // namespace
+
+void* operator new(std::size_t n) {
+  if (counting.load(std::memory_order_relaxed)) {
+    allocations.fetch_add(1, std::memory_order_relaxed);
+    if (std::getenv("FRACFLOW_ABORT_ON_ALLOC")) std::abort();  // for finding the culprit in gdb
+  }
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+
+using namespace ff;
+using namespace ff::dem;
+
+TEST(DemAllocation, StepsOfACompressedBondedSampleDoNotAllocate) {
+  omp_set_num_threads(1);
+  const Real r = 0.5e-3, a = 2 * r * 1.001;
+  DemSystem s;
+  s.settings.dim = 3;
+  s.settings.local_damping = 0.7;
+  s.settings.skin = 0.1 * r;
+  s.materials.group_names = {"rock"};
+  s.materials.density = {2600};
+  LinearContact::Params lc;
+  lc.emod = 1e9;
+  lc.kratio = 2;
+  lc.fric = 0.5;
+  s.materials.linear = {lc};
+  s.materials.hertz = {HertzMindlinContact::Params{}};
+  ParallelBond::Material pb;
+  pb.emod = 1e9;
+  pb.kratio = 2;
+  pb.ten = 2e6;
+  pb.coh = 2e6;
+  s.materials.parallel = {pb};
+  s.materials.rotational.resize(1);
+  Rng g(3);
+  const int n = 6, h = 12;
+  for (int k = 0; k < h; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const std::size_t p = s.particles.size();
+        s.particles.resize(p + 1);
+        s.particles.pos[p] = Vec3(a * i, a * j, a * k) + 0.02 * r * Vec3(g.uniform(-1, 1), g.uniform(-1, 1), g.uniform(-1, 1));
+        s.particles.radius[p] = r;
+        s.particles.set_mass_from_density(p, 2600, 3);
+      }
+  s.install_bonds(0.1 * r);
+  Wall bottom, top;
+  bottom.point = Vec3(0, 0, -r);
+  bottom.normal = Vec3::UnitZ();
+  bottom.velocity = Vec3(0, 0, 0.5);
+  top.point = Vec3(0, 0, a * (h - 1) + r);
+  top.normal = -Vec3::UnitZ();
+  top.velocity = Vec3(0, 0, -0.5);
+  s.walls = {bottom, top};
+  s.initialise();
+  s.settings.dt = 0.5 * s.critical_time_step();
+  s.run(500);  // warm-up: buffers grow to their working size
+  const long builds = s.neighbors().builds();
+  const long cracks = s.cracks.total();
+  counting = true;
+  s.run(3000);
+  counting = false;
+  EXPECT_GT(s.neighbors().builds(), builds + 2) << "the neighbour list must be rebuilt during the counted steps";
+  EXPECT_GT(s.cracks.total(), cracks) << "bonds must break during the counted steps";
+  EXPECT_EQ(allocations.load(), 0) << "over " << s.neighbors().builds() - builds << " rebuilds";
+}
