@@ -41,6 +41,12 @@ int clip_to_slab(const Vec3& a, const Vec3& b, const Vec3& c, Real z_lo, Real z_
   return np;
 }
 
+// Grows the capacity to 1.25 n when it is below n (amortised: later rebuilds reuse it).
+template <class T>
+void reserve_headroom(std::vector<T>& v, std::size_t n) {
+  if (v.capacity() < n) v.reserve(n + n / 4 + 16);
+}
+
 // Barycentric weights of q (in the plane of the triangle) on (a, b, c).
 std::array<Real, 3> barycentric(const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c) {
   const Vec3 v0 = b - a, v1 = c - a, v2 = q - a;
@@ -186,6 +192,7 @@ void FlexibleMembrane::find_candidates(std::span<const Vec3> pos, std::span<cons
   auto cell_of = [&](const Vec3& p, int d) {
     return std::clamp(static_cast<long>(std::floor((p[d] - lo[d]) / h)), 0L, n[d] - 1);
   };
+  reserve_headroom(cell_off_, ncell + 1);
   cell_off_.assign(ncell + 1, 0);
   for (int pass = 0; pass < 2; ++pass) {
     for (std::size_t k = 0; k < ne; ++k) {
@@ -200,6 +207,7 @@ void FlexibleMembrane::find_candidates(std::span<const Vec3> pos, std::span<cons
     }
     if (pass == 0) {
       for (long c = 0; c < ncell; ++c) cell_off_[c + 1] += cell_off_[c];
+      reserve_headroom(cell_elem_, cell_off_[ncell]);
       cell_elem_.resize(cell_off_[ncell]);
     } else {  // the fill advanced each start to the next cell's start: shift back
       for (long c = ncell; c > 0; --c) cell_off_[c] = cell_off_[c - 1];
@@ -224,8 +232,19 @@ void FlexibleMembrane::find_candidates(std::span<const Vec3> pos, std::span<cons
     }
     if (cand_p_.size() > before) group_off_.push_back(static_cast<std::int64_t>(cand_p_.size()));
   }
-  NeighborList::carry_over<ContactState>(old_p_, old_e_, old_state_, cand_p_, cand_e_, state_, ContactState{});
   const std::size_t nc = cand_p_.size();
+  // Headroom so that slowly growing lists do not allocate at every rebuild (no allocation in
+  // the time loop once the contact set has settled).
+  reserve_headroom(cand_p_, nc);
+  reserve_headroom(cand_e_, nc);
+  reserve_headroom(group_off_, group_off_.size());
+  reserve_headroom(state_, nc);
+  reserve_headroom(load_, nc);
+  reserve_headroom(cp_, nc);
+  reserve_headroom(dist_, nc);
+  reserve_headroom(kn_, nc);
+  reserve_headroom(touch_, nc);
+  NeighborList::carry_over<ContactState>(old_p_, old_e_, old_state_, cand_p_, cand_e_, state_, ContactState{});
   load_.assign(nc, MembraneLoad{});
   cp_.resize(nc);
   dist_.assign(nc, 0);

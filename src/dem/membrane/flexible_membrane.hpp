@@ -39,6 +39,7 @@
 // particle data are read through spans valid for the call. 3D only (spheres).
 #pragma once
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <span>
 #include <vector>
@@ -72,7 +73,9 @@ enum class MembraneVertexRule : std::uint8_t {
 struct MembraneSettings {
   int n_theta = 16;              // square units around the circumference ([S000] demo: 16)
   int n_z = 8;                   // rows of units along z
-  Real radius = 0;               // initial radius R_m (sample radius + clearance) [m]
+  // Initial radius R_m of the vertex circle [m]. The flat facets lie R_m cos(pi/N_theta) from the
+  // axis at their middle: take R_m = membrane_circumradius(sample radius + clearance, N_theta).
+  Real radius = 0;
   Real z0 = 0, height = 0;       // sleeve from z0 to z0 + height (longer than the sample) [m]
   Real axis_x = 0, axis_y = 0;   // the axis: the vertical line through (axis_x, axis_y) [m]
   Real pressure = 0;             // confining pressure p [Pa]
@@ -90,6 +93,8 @@ struct MembraneSettings {
 
 // Rows of nearly square units for a sleeve (chord 2 R sin(pi/N_theta) ~ H/N_z), at least 1.
 int membrane_square_rows(Real radius, int n_theta, Real height);
+// Vertex radius whose facets (N_theta-gon) clear a cylinder of radius inner_radius.
+inline Real membrane_circumradius(Real inner_radius, int n_theta) { return inner_radius / std::cos(kPi / n_theta); }
 
 // Particle arrays read by the contact loop (spans over the engine's ParticleStore).
 struct MembraneParticles {
@@ -143,9 +148,12 @@ class FlexibleMembrane {
   std::span<const Index> candidate_particles() const { return cand_p_; }
   std::span<const Index> candidate_elements() const { return cand_e_; }
   std::span<const MembraneLoad> candidate_loads() const { return load_; }
+  // Normal stiffness of each candidate's contact, 0 when it carries no force (time step) [N/m].
+  std::span<const Real> candidate_stiffness() const { return kn_; }
   std::span<ContactState> contact_states() { return state_; }  // shear history per candidate
   void add_loads_to(std::span<Vec3> force, std::span<Vec3> moment) const;
-  void move(Real dt, Real z_bottom, Real z_top);  // z of the platen planes [m]
+  // Servo + vertex update from the last compute_forces(); z of the platen planes [m].
+  void move(Real dt, Real z_bottom, Real z_top);
   Real motion_since_build() const { return motion_; }  // max vertex travel since find_candidates [m]
   Real max_step_motion(Real dt) const { return s_.v_max * dt; }  // bound on the next move()
 
