@@ -69,7 +69,8 @@ void Solver<L, T>::bulk_sweep(bool odd, bool sample) {
   const std::int64_t ns = std::int64_t(spans_.size());
   const Span* spans = spans_.data();
   const Grid& g = grid_;
-#pragma omp parallel for schedule(static)
+  // Small lattices run serially: a parallel region costs more than it saves there.
+#pragma omp parallel for schedule(static) if (num_bulk_cells_ > kParallelMinCells)
   for (std::int64_t s = 0; s < ns; ++s) {
     const Span& sp = spans[s];
     fn(g, f, N, sp.x0, sp.y, sp.z, sp.n, odd, r, drho, u);

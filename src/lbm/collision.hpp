@@ -20,7 +20,10 @@
 
 #include "lbm/descriptor.hpp"
 
+// The kernels are written with compile-time loops over lambdas; GCC must inline all of them
+// (D3Q19 bodies are large enough that it otherwise declines, and the loop no longer vectorises).
 #define FF_LBM_INLINE inline __attribute__((always_inline))
+#define FF_LBM_LAMBDA_INLINE __attribute__((always_inline))
 
 namespace ff::lbm {
 
@@ -52,7 +55,7 @@ Relax<T> make_relax(CollisionModel m, double tau, double magic, const double for
 // Compile-time loop: f(std::integral_constant<int, I>) for I = 0..N-1.
 template <int N, class F>
 FF_LBM_INLINE void static_for(F&& f) {
-  [&]<int... I>(std::integer_sequence<int, I...>) {
+  [&]<int... I>(std::integer_sequence<int, I...>) FF_LBM_LAMBDA_INLINE {
     (f(std::integral_constant<int, I>{}), ...);
   }(std::make_integer_sequence<int, N>{});
 }
@@ -84,24 +87,24 @@ FF_LBM_INLINE void collide(T* g, const Relax<T>& r, T& drho_out, T* u_out) {
   constexpr int P = (L::Q - 1) / 2;  // opposite pairs (2p+1, 2p+2)
   // Moments: sums and differences over opposite pairs.
   T gp[P], gm[P];
-  static_for<P>([&](auto p) {
+  static_for<P>([&](auto p) FF_LBM_LAMBDA_INLINE {
     constexpr int q = 2 * p + 1;
     gp[p] = g[q] + g[q + 1];
     gm[p] = g[q] - g[q + 1];
   });
   T drho = g[0];
-  static_for<P>([&](auto p) { drho += gp[p]; });
+  static_for<P>([&](auto p) FF_LBM_LAMBDA_INLINE { drho += gp[p]; });
   T j[3] = {0, 0, 0};
-  static_for<P>([&](auto p) {
+  static_for<P>([&](auto p) FF_LBM_LAMBDA_INLINE {
     constexpr int q = 2 * p + 1;
-    static_for<L::D>([&](auto a) {
+    static_for<L::D>([&](auto a) FF_LBM_LAMBDA_INLINE {
       constexpr int c = L::c[q][a];
       if constexpr (c > 0) j[a] += gm[p];
       if constexpr (c < 0) j[a] -= gm[p];
     });
   });
   if constexpr (kForce) {
-    static_for<L::D>([&](auto a) { j[a] += T(0.5) * r.force[a]; });
+    static_for<L::D>([&](auto a) FF_LBM_LAMBDA_INLINE { j[a] += T(0.5) * r.force[a]; });
   }
   const T rho = T(1) + drho;
   const T inv_rho = T(1) / rho;
@@ -129,7 +132,7 @@ FF_LBM_INLINE void collide(T* g, const Relax<T>& r, T& drho_out, T* u_out) {
   // (they are shared by all pairs of one weight class, and the compiler merges them).
   const T omw = T(1) - wp;
   const T hwp = T(0.5) * wp, hwm = T(0.5) * wm;
-  static_for<P>([&](auto p) {
+  static_for<P>([&](auto p) FF_LBM_LAMBDA_INLINE {
     constexpr int q = 2 * p + 1, o = q + 1;
     constexpr T w = T(L::w[q]);
     const T wpA = (wp * w) * base;   // w+ w (rho-1 - 1.5 rho u^2)

@@ -43,6 +43,7 @@ void Solver<L, T>::set_face(int f, const FaceCondition& c) {
                                  face_name(f), periodic ? "cannot be periodic:" : "cannot take a wall or open condition:",
                                  "xyz"[axis], grid_.periodic[axis] ? "" : "not "));
   faces_[f] = c;
+  inflow_wall_[f] = c.kind == FaceCondition::Kind::Wall && bool(c.profile);
   if (c.kind == FaceCondition::Kind::Wall) objects_[f].velocity = c.velocity;
 }
 
@@ -100,7 +101,8 @@ void Solver<L, T>::compute_link_velocities() {
     const BoundaryCell& b = bcells_[k.cell];
     const int o = L::opp[k.q];
     const Vec3 xw = Vec3(b.x, b.y, b.z) + double(k.delta) * Vec3(L::c[o][0], L::c[o][1], L::c[o][2]);
-    const Vec3 uw = wall_velocity(k.object, xw);
+    const Vec3 uw = k.object < kNumFaces && inflow_wall_[k.object] ? faces_[k.object].profile(b.x, b.y, b.z)
+                                                                   : wall_velocity(k.object, xw);
     for (int a = 0; a < 3; ++a) link_uw_[3 * l + a] = T(a < L::D ? uw[a] : 0.0);
   }
 }
@@ -123,6 +125,18 @@ void Solver<L, T>::initialize(const std::function<void(int, int, int, double&, V
         drho_[i] = T(rho - 1);
         for (int a = 0; a < 3; ++a) u_[a][i] = uu[a];
       }
+  // The first (even) step bounces the population found in the solid neighbour's slot
+  // f[opp q][x - c_q] and adds the moving-wall term: store the initial f_q(x) minus that term,
+  // so that step 0 starts from the initial state itself rather than from an empty wall.
+  for (std::size_t l = 0; l < links_.size(); ++l) {
+    const Link& k = links_[l];
+    const BoundaryCell& b = bcells_[k.cell];
+    const int q = k.q;
+    const CellIndex src = grid_.neighbour(b.x, b.y, b.z, -L::c[q][0], -L::c[q][1], -L::c[q][2]);
+    const T* uw = &link_uw_[3 * l];
+    const T mw = T(6 * L::w[q]) * (L::c[q][0] * uw[0] + L::c[q][1] * uw[1] + L::c[q][2] * uw[2]);
+    f_[L::opp[q] * N + src] = f_[q * N + b.cell] - mw;
+  }
   time_ = 0;
 }
 
@@ -144,9 +158,7 @@ Vec3 Solver<L, T>::velocity(int x, int y, int z) const {
 
 template <class L, class T>
 std::size_t Solver<L, T>::num_bulk_cells() const {
-  std::size_t n = 0;
-  for (auto& s : spans_) n += std::size_t(s.n);
-  return n;
+  return std::size_t(num_bulk_cells_);
 }
 
 template <class L, class T>
@@ -209,7 +221,7 @@ void Solver<L, T>::save_interpolation_inputs(bool odd) {
 template <class L, class T>
 void Solver<L, T>::boundary_sweep(bool odd, bool sample) {
   const std::int64_t nb = std::int64_t(bcells_.size());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nb > kParallelMinCells / 8)
   for (std::int64_t i = 0; i < nb; ++i) update_boundary_cell(std::size_t(i), odd, sample);
 }
 
@@ -234,7 +246,8 @@ void Solver<L, T>::update_boundary_cell(std::size_t i, bool odd, bool sample) {
     const T A = odd ? f_[q * N + b.cell] : f_[o * N + src[q]];  // g*_o(x, t), where the wall left it
     const T* uw = &link_uw_[3 * l];
     const T cu = L::c[q][0] * uw[0] + L::c[q][1] * uw[1] + L::c[q][2] * uw[2];
-    const T mw = T(6 * L::w[q]) * cu;  // rho_w = rho_0 = 1 (nearly incompressible, [S003] Sec. 2.3.2)
+    // rho_w = rho_0 = 1 (nearly incompressible, [S003] Sec. 2.3.2); inflow walls follow the ramp.
+    const T mw = T(6 * L::w[q]) * cu * (k.object < kNumFaces && inflow_wall_[k.object] ? inflow_scale_ : T(1));
     const T B = link_saved_[l];
     const T C = k.has_second ? g[o] : T(0);
     const T gq = reflect<T>(k.scheme, T(k.delta), k.has_second, A, B, C, mw);
@@ -245,7 +258,12 @@ void Solver<L, T>::update_boundary_cell(std::size_t i, bool odd, bool sample) {
       link_force_[3 * l + a] = double(L::c[o][a]) * (double(A) + double(gq)) - double(uw[a]) * (double(A) - double(gq));
   }
   // 3. Open faces (Zou-He / Hecht-Harting): needs every other population first.
-  if (b.open >= 0) zou_he<L, T>(g, open_[b.open]);
+  if (b.open >= 0) {
+    OpenNode<T> nd = open_[b.open];
+    if (!nd.pressure)
+      for (int a = 0; a < 3; ++a) nd.u[a] *= inflow_scale_;
+    zou_he<L, T>(g, nd);
+  }
   // 4. Collide.
   T drho, u[3];
   const bool force = settings_.body_force.squaredNorm() > 0;

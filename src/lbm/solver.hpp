@@ -42,7 +42,9 @@ struct FaceCondition {
   Kind kind = Kind::Wall;
   Vec3 velocity = Vec3::Zero();  // Wall: wall velocity (moving wall); Velocity: inflow velocity
   double density = 1;            // Pressure: prescribed density (p = c_s^2 rho)
-  std::function<Vec3(int x, int y, int z)> profile;  // Velocity: per-cell velocity, overrides `velocity`
+  // Velocity: per-cell velocity, overrides `velocity`. On a Wall it makes the face a moving-wall
+  // (bounce-back) inflow, [S003] Eq. 8, with the velocity of the adjacent fluid cell's profile.
+  std::function<Vec3(int x, int y, int z)> profile;
 };
 
 struct SolverSettings {
@@ -94,9 +96,13 @@ class Solver {
   // ---- motion of solids (enters the moving-wall term of bounce-back)
   void set_object_motion(int object, const Vec3& velocity, const Vec3& omega);
   void set_body_force(const Vec3& f);
+  // Multiplies every prescribed inflow velocity (Velocity faces, Wall faces with a profile), e.g. to ramp a flow up
+  // smoothly instead of starting it impulsively (which rings the domain acoustically).
+  void set_inflow_scale(double s) { inflow_scale_ = T(s); }
 
   // ---- state
   // f = f^eq(rho, u) from init(x, y, z, rho, u) on every fluid cell; time step 0.
+  // Call after finalize().
   void initialize(const std::function<void(int, int, int, double&, Vec3&)>& init);
   // One fused stream-collide step. With `sample`, the macroscopic fields of time t (the
   // moments the collision used) are stored for density()/velocity()/max_speed().
@@ -121,6 +127,8 @@ class Solver {
   struct Span {
     int x0, y, z, n;
   };
+  // Below this many bulk cells a step runs on one thread (the fork/join would dominate).
+  static constexpr std::int64_t kParallelMinCells = 16384;
   void bulk_sweep(bool odd, bool sample);
   void boundary_sweep(bool odd, bool sample);
   void update_boundary_cell(std::size_t i, bool odd, bool sample);
@@ -134,8 +142,10 @@ class Solver {
   SolverSettings settings_;
   Relax<T> relax_;
   std::array<FaceCondition, kNumFaces> faces_;
+  std::array<bool, kNumFaces> inflow_wall_{};  // Wall faces with a velocity profile
   std::vector<SolidObject> objects_;
   long time_ = 0;
+  T inflow_scale_ = 1;
 
   AlignedVector<T> f_;                 // Q * N populations
   std::vector<CellType> type_;         // N
@@ -144,6 +154,7 @@ class Solver {
   std::array<AlignedVector<T>, 3> u_;  // N: sampled velocity
 
   std::vector<Span> spans_;
+  std::int64_t num_bulk_cells_ = 0;
   std::vector<BoundaryCell> bcells_;
   std::vector<Link> links_;
   std::vector<OpenNode<T>> open_;

@@ -126,6 +126,8 @@ void Solver<L, T>::finalize() {
       }
       close_run(g.nx);
     }
+  num_bulk_cells_ = 0;
+  for (auto& sp : spans_) num_bulk_cells_ += sp.n;
   link_saved_.assign(links_.size(), T(0));
   link_force_.assign(3 * links_.size(), 0.0);
   compute_link_velocities();

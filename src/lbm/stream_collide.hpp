@@ -33,10 +33,10 @@ FF_LBM_INLINE void stream_collide_span(T* const* src_in, T* const* dst_in, std::
 #pragma GCC ivdep
   for (std::int64_t i = 0; i < n; ++i) {
     T g[Q];
-    static_for<Q>([&](auto q) { g[q] = src[q][i]; });
+    static_for<Q>([&](auto q) FF_LBM_LAMBDA_INLINE { g[q] = src[q][i]; });
     T drho, u[3];
     collide<L, T, M, kForce>(g, rl, drho, u);
-    static_for<Q>([&](auto q) { dst[q][i] = g[q]; });
+    static_for<Q>([&](auto q) FF_LBM_LAMBDA_INLINE { dst[q][i] = g[q]; });
     if constexpr (kMoments) {
       m.drho[i] = drho;
       m.u[0][i] = u[0];

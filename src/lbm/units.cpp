@@ -9,7 +9,7 @@
 namespace ff::lbm {
 
 namespace {
-constexpr double kMachWarn = 0.1, kMachError = 0.3, kTauWarn = 0.01;
+constexpr double kMachWarn = 0.1, kMachError = 0.3, kTauWarn = 0.01, kTauLarge = 3.0;
 const double kCs = 1.0 / std::sqrt(3.0);
 }  // namespace
 
@@ -78,6 +78,15 @@ StabilityCheck Units::check(double u, int resolution, const std::string& resolut
     r.warnings.push_back(fmt::format("relaxation time tau = {:.5g} is within {} of 1/2: BGK becomes unstable and walls "
                                      "inaccurate; {} and raise {} to at least {} to keep the Mach number",
                                      tau_, kTauWarn, fix, resolution_key, int(std::ceil(resolution * f))));
+  }
+  if (tau_ > kTauLarge) {
+    const double tau_target = 2.0, f = (tau_target - 0.5) / (tau_ - 0.5);
+    std::string fix = tau_mode ? fmt::format("lower lbm.tau to {}", tau_target)
+                               : fmt::format("lower lbm.time_step to {:.4g} s (tau = {})", dt_ * f, tau_target);
+    r.warnings.push_back(fmt::format("relaxation time tau = {:.4g} is large: BGK walls slip (an error growing as "
+                                     "tau^2) and open-face corners can become unstable with TRT; {} (the Mach number "
+                                     "only drops)",
+                                     tau_, fix));
   }
   return r;
 }

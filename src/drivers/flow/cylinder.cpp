@@ -13,6 +13,7 @@
 #include "drivers/flow/flow_runner.hpp"
 #include "io/plot.hpp"
 #include "lbm/analysis.hpp"
+#include "lbm/image_mask.hpp"
 
 namespace fs = std::filesystem;
 
@@ -25,9 +26,14 @@ void declare(ParamTable& t) {
   d.tau = 0.53;
   d.end_time = 80;
   d.steady_tolerance = 1e-7;
+  d.inflow_ramp_time = -1;
   declare_lbm_params(t, d);
   t.real("channel.height", 0.16, "m", "distance H between the plates").positive();
   t.real("channel.length", 0.4, "m", "length from the inlet to the outlet").positive();
+  t.string("channel.sides", "walls",
+           "y boundaries: walls (no-slip plates, [S003] 3.3) or periodic (a row of cylinders H apart, which "
+           "approximates a cylinder in unbounded flow when H >> D)")
+      .one_of({"walls", "periodic"});
   t.real("cylinder.diameter", 0.01, "m", "cylinder diameter D (lbm.resolution cells across it)").positive();
   t.real("cylinder.x", 0.1, "m", "distance of the cylinder centre from the inlet").positive();
   t.real("cylinder.y", -1, "m", "height of the centre above the lower plate; negative: mid-channel");
@@ -38,6 +44,14 @@ void declare(ParamTable& t) {
   t.real("cylinder.initial_perturbation", 0.05, "-",
          "transverse velocity kick behind the cylinder at t = 0, as a fraction of U (starts vortex shedding)")
       .non_negative();
+  t.string("obstacles.image", "",
+           "optional PGM image (P2/P5) stretched over the channel: dark pixels become extra solid cells (half-way "
+           "bounce-back), e.g. grains or a rough wall");
+  t.integer("obstacles.threshold", 128, "-", "grey level below which an image pixel is solid").range(0, 256);
+  t.string("inlet.condition", "zou_he",
+           "inflow boundary: zou_he (Zou & He 1997, velocity imposed on the first nodes) or bounce_back (moving-wall "
+           "bounce-back half a cell upstream, [S003] Eq. 8)")
+      .one_of({"zou_he", "bounce_back"});
   t.string("inlet.profile", "uniform", "inflow profile: uniform, or parabolic (Poiseuille)").one_of({"uniform", "parabolic"});
   t.real("inlet.velocity", 0.01, "m/s", "inflow velocity: the uniform value, or the maximum of the parabola").positive();
 }
@@ -48,19 +62,25 @@ class CylinderCase : public FlowCase {
       : H_(cfg.real("channel.height")), len_(cfg.real("channel.length")), D_(cfg.real("cylinder.diameter")),
         xc_(cfg.real("cylinder.x")), yc_(cfg.real("cylinder.y") < 0 ? 0.5 * H_ : cfg.real("cylinder.y")),
         U_(cfg.real("inlet.velocity")), rho_(cfg.real("fluid.density")), nu_(cfg.real("fluid.viscosity")),
-        kick_(cfg.real("cylinder.initial_perturbation")), n_(int(cfg.integer("lbm.resolution"))),
-        parabolic_(cfg.string("inlet.profile") == "parabolic") {
+        kick_(cfg.real("cylinder.initial_perturbation")), ramp_(cfg.real("run.inflow_ramp_time") != 0),
+        n_(int(cfg.integer("lbm.resolution"))),
+        parabolic_(cfg.string("inlet.profile") == "parabolic"), inlet_bb_(cfg.string("inlet.condition") == "bounce_back"),
+        periodic_(cfg.string("channel.sides") == "periodic"), image_(cfg.string("obstacles.image")),
+        threshold_(int(cfg.integer("obstacles.threshold"))) {
+    if (periodic_ && parabolic_)
+      cfg.fail("inlet.profile", "a parabolic inflow needs plates: use channel.sides = \"walls\" or a uniform inflow");
     const std::string w = cfg.string("cylinder.wall");
     scheme_ = w == "halfway" ? lbm::WallScheme::HalfwayBounceBack : w == "yu" ? lbm::WallScheme::Yu : lbm::WallScheme::Bouzidi;
     if (D_ >= H_) cfg.fail("cylinder.diameter", fmt::format("the cylinder (D = {} m) must be narrower than the channel (H = {} m)", D_, H_));
     if (xc_ - D_ / 2 <= 0 || xc_ + D_ / 2 >= len_)
       cfg.fail("cylinder.x", "the cylinder must lie wholly between the inlet and the outlet");
-    if (yc_ - D_ / 2 <= 0 || yc_ + D_ / 2 >= H_) cfg.fail("cylinder.y", "the cylinder must not touch the plates");
+    if (yc_ - D_ / 2 <= 0 || yc_ + D_ / 2 >= H_) cfg.fail("cylinder.y", "the cylinder must not touch the sides of the channel");
   }
 
   double cell_size() const override { return D_ / n_; }
   int resolution() const override { return n_; }
-  double characteristic_speed() const override { return parabolic_ ? U_ : 1.5 * U_; }
+  // The inflow speed (the maximum of a parabola) sets the Mach number, as usual for bluff bodies.
+  double characteristic_speed() const override { return U_; }
   // Reference velocity of Cd, Cl, Re and St: the uniform inflow, or the mean of the parabola.
   double u_ref() const { return parabolic_ ? 2.0 / 3.0 * U_ : U_; }
   // Largest velocity of the undisturbed (developed) channel flow, for lambda ([S003] Eq. 16).
@@ -73,8 +93,16 @@ class CylinderCase : public FlowCase {
     DomainSpec d;
     d.nx = int(std::lround(len_ / dx));
     d.ny = int(std::lround(H_ / dx));
-    d.faces[0].kind = lbm::FaceCondition::Kind::Velocity;
-    d.faces[0].profile = [this, dx](int, int y, int) { return Vec3(units_.to_lattice_velocity(inflow((y + 0.5) * dx)), 0, 0); };
+    d.periodic = {false, periodic_};
+    d.faces[0].kind = inlet_bb_ ? lbm::FaceCondition::Kind::Wall : lbm::FaceCondition::Kind::Velocity;
+    // A plug profile is singular where it meets the no-slip plates: the two Zou-He inflow nodes
+    // next to the plates get half the speed (the mean over their half cell); at full speed these
+    // corner nodes drive TRT unstable at large tau.
+    const int ny = d.ny;
+    d.faces[0].profile = [this, dx, ny](int, int y, int) {
+      const double corner = !parabolic_ && !inlet_bb_ && !periodic_ && (y == 0 || y == ny - 1) ? 0.5 : 1.0;
+      return Vec3(corner * units_.to_lattice_velocity(inflow((y + 0.5) * dx)), 0, 0);
+    };
     d.faces[1].kind = lbm::FaceCondition::Kind::Pressure;
     d.faces[1].density = 1;
     // Lattice coordinates: cell (i, j) has its centre at ((i + 1/2) dx, (j + 1/2) dx).
@@ -86,9 +114,16 @@ class CylinderCase : public FlowCase {
     cyl.center = c;
     cyl.shape = lbm::Circle{c, r};
     d.objects.push_back(cyl);
+    if (!image_.empty()) {
+      DomainSpec::Object img;
+      img.name = "image obstacles";
+      img.center = c;
+      img.cells = lbm::solid_cells(lbm::read_pgm(image_), d.nx, d.ny, threshold_);
+      d.objects.push_back(img);
+    }
     const double kick = kick_ * u.to_lattice_velocity(u_ref());
     d.init = [this, dx, c, r, kick](int x, int y, double&, Vec3& v) {
-      v = Vec3(units_.to_lattice_velocity(inflow((y + 0.5) * dx)), 0, 0);
+      v = ramp_ ? Vec3::Zero() : Vec3(units_.to_lattice_velocity(inflow((y + 0.5) * dx)), 0, 0);
       const double ex = x - (c.x() + 2 * r), ey = y - c.y();
       v.y() += kick * std::exp(-(ex * ex + ey * ey) / (r * r));
     };
@@ -106,7 +141,7 @@ class CylinderCase : public FlowCase {
     return fmt::format("Cd {:.4f}  Cl {:+.4f}", row[4], row[5]);
   }
 
-  void finish(const FlowSample&, const std::vector<std::vector<double>>& hist, const fs::path& out, bool plots,
+  void finish(const FlowSample& last, const std::vector<std::vector<double>>& hist, const fs::path& out, bool plots,
               nlohmann::json& res) const override {
     std::vector<double> t, cd, cl, fx;
     for (auto& r : hist) {
@@ -115,8 +150,9 @@ class CylinderCase : public FlowCase {
       cd.push_back(r[4]);
       cl.push_back(r[5]);
     }
-    // Statistics over the second half of the run (the first half is the start-up).
-    const double t_from = 0.5 * t.back();
+    // Statistics over the second half of the time after the inflow reached full speed (the
+    // first half of it is the start-up of the wake).
+    const double t_from = last.ramp_end_time + 0.5 * (t.back() - last.ramp_end_time);
     const auto lift = lbm::analyse_oscillation(t, cl, t_from);
     const auto drag = lbm::analyse_oscillation(t, cd, t_from);
     const bool shedding = lift.cycles >= 2 && (lift.max - lift.min) > 1e-3;
@@ -126,6 +162,7 @@ class CylinderCase : public FlowCase {
     res["blockage_D_over_H"] = D_ / H_;
     res["reference_velocity_m_per_s"] = u_ref();
     res["cd_mean"] = cd_mean;
+    res["averaging_from_s"] = t_from;
     res["cd_final"] = cd.back();
     res["cd_min"] = drag.min;
     res["cd_max"] = drag.max;
@@ -164,8 +201,11 @@ class CylinderCase : public FlowCase {
 
  private:
   double H_, len_, D_, xc_, yc_, U_, rho_, nu_, kick_;
+  bool ramp_;  // the inflow is ramped up: start from rest
   int n_;
-  bool parabolic_;
+  bool parabolic_, inlet_bb_, periodic_;
+  std::string image_;
+  int threshold_;
   lbm::WallScheme scheme_ = lbm::WallScheme::Bouzidi;
   lbm::Units units_;
 };

@@ -52,6 +52,7 @@ struct FlowSample {
   // (N/m and N), at time t - dt/2.
   std::vector<Vec3> force, torque;
   std::array<Vec3, 4> face_force{};  // walls x-, x+, y-, y+ (N/m)
+  double ramp_end_time = 0;          // s: the inflow has its full speed from here on
   double max_mach = 0;
   std::size_t at(int x, int y) const { return std::size_t(x) + std::size_t(nx) * std::size_t(y); }
 };

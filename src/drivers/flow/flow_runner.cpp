@@ -37,6 +37,11 @@ void declare_lbm_params(ParamTable& t, const LbmDefaults& d) {
   t.real("run.steady_tolerance", d.steady_tolerance, "-",
          "stop once the monitored result changes by less than this (relative) over 3 samples; 0: run to run.end_time")
       .non_negative();
+  t.real("run.inflow_ramp_time", d.inflow_ramp_time, "s",
+         "inflow velocities rise from zero as sin^2 over this time; 0: full inflow from the start; -1: automatic, "
+         "20 domain lengths at the lattice sound speed (5 periods of the slowest acoustic mode between a velocity "
+         "inlet and a pressure outlet, which an impulsive start leaves ringing almost undamped)")
+      .at_least(-1);
   t.integer("output.samples", 200, "-", "rows of series.csv over run.end_time").at_least(1);
   t.integer("output.snapshots", 10, "-", "VTK snapshots over run.end_time (plus the first and last)").non_negative();
   t.integer("output.checkpoints", 10, "-", "checkpoints over run.end_time (there is always one at the end)").non_negative();
@@ -106,6 +111,7 @@ class Runner {
   std::vector<Vec3> velocity_;
   std::vector<std::uint8_t> solid_;
   std::vector<double> row_;
+  double ramp_end_time_ = 0;
 };
 
 template <class L, class T>
@@ -172,6 +178,7 @@ void Runner<L, T>::sample(FlowSample& s) {
   }
   for (int f = 0; f < 4; ++f) s.face_force[f] = per_depth(objs[f].force);
   s.max_mach = std::sqrt(3.0) * sol_->max_speed();
+  s.ramp_end_time = ramp_end_time_;
 }
 
 template <class L, class T>
@@ -260,6 +267,21 @@ RunStatus Runner<L, T>::run() {
   const long vtk_every = cfg_.boolean("output.vtk") ? every(cfg_.integer("output.snapshots")) : 0;
   const long cp_every = every(cfg_.integer("output.checkpoints"));
   const double steady_tol = cfg_.real("run.steady_tolerance");
+  const double ramp_time = cfg_.real("run.inflow_ramp_time");
+  // The slowest acoustic mode runs along the axis of the inflow face(s).
+  int inflow_extent = 0;
+  for (int f = 0; f < 4; ++f) {
+    const auto& fc = dom_.faces[f];
+    if (!dom_.periodic[f / 2] && (fc.kind == lbm::FaceCondition::Kind::Velocity ||
+                                  (fc.kind == lbm::FaceCondition::Kind::Wall && fc.profile)))
+      inflow_extent = std::max(inflow_extent, f < 2 ? dom_.nx : dom_.ny);
+  }
+  const long ramp_steps = inflow_extent == 0 ? 0
+                          : ramp_time < 0    ? std::lround(20.0 * std::sqrt(3.0) * inflow_extent)
+                                             : std::lround(ramp_time / units_.dt());
+  ramp_end_time_ = double(ramp_steps) * units_.dt();
+  if (ramp_steps > 0)
+    log::info("inflow ramped up over {} steps ({:.4g} s)", ramp_steps, double(ramp_steps) * units_.dt());
   const auto steady_col = fc_.steady_column();
 
   std::vector<std::string> columns = {"step", "time"};
@@ -294,7 +316,14 @@ RunStatus Runner<L, T>::run() {
   const long loop_first_step = sol_->time_step();
   while (sol_->time_step() < steps_total) {
     const long n = std::min(sample_every, steps_total - sol_->time_step());
-    for (long i = 0; i < n; ++i) sol_->step(i == n - 1);
+    for (long i = 0; i < n; ++i) {
+      const long t = sol_->time_step();
+      if (t <= ramp_steps && ramp_steps > 0) {
+        const double a = std::sin(0.5 * M_PI * double(t) / double(ramp_steps));
+        sol_->set_inflow_scale(a * a);
+      }
+      sol_->step(i == n - 1);
+    }
     sample(s);
     if (!(s.max_mach == s.max_mach)) unstable("the velocity field holds NaN");
     if (s.max_mach > 0.3) unstable(fmt::format("the Mach number reached {:.3g} (limit 0.3)", s.max_mach));
@@ -307,7 +336,7 @@ RunStatus Runner<L, T>::run() {
     const long k = long(history_.size() / ncols_);
     const bool last = sol_->time_step() >= steps_total;
     bool steady = false;
-    if (steady_col && steady_tol > 0 && k >= 4) {
+    if (steady_col && steady_tol > 0 && k >= 4 && sol_->time_step() > ramp_steps + 3 * sample_every) {
       const std::size_t c = std::size_t(*steady_col) + 2;
       steady = true;
       for (long j = k - 3; j < k; ++j) {

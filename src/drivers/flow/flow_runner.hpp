@@ -18,6 +18,7 @@ struct LbmDefaults {
   double density = 1000;     // kg/m^3 (water)
   double viscosity = 1e-6;   // m^2/s (water at 20 C)
   double steady_tolerance = 1e-7;
+  double inflow_ramp_time = 0;  // s
 };
 
 // Declares lbm.*, fluid.*, run.* and output.* keys of the flow drivers.

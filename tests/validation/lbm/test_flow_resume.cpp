@@ -1,0 +1,92 @@
+// Runs of the flow drivers that are interrupted (wall-clock limit, checkpoint) and resumed give
+// bit-identical series, results and final populations, on both lattices and precisions; and
+// unstable numerics stop the run with a message that says what to change.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "core/error.hpp"
+#include "flow_driver_runner.hpp"
+
+namespace {
+
+std::string slurp(const std::filesystem::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+const char* kCylinder = R"(
+driver = "flow/cylinder"
+[channel]
+height = 0.04
+length = 0.12
+[cylinder]
+diameter = 0.01
+x = 0.03
+y = 0.021
+[inlet]
+velocity = 0.01
+[fluid]
+viscosity = 1.0e-5
+[lbm]
+resolution = 6
+time_step = 0.01
+[run]
+end_time = 40
+[output]
+samples = 40
+snapshots = 4
+checkpoints = 4
+plots = false
+)";
+
+void expect_resume_identical(const std::string& name, const std::vector<std::string>& sets) {
+  using namespace ff::testing;
+  ASSERT_EQ(run_flow_driver_status(name + "_full", kCylinder, sets), ff::RunStatus::Finished);
+  // A tiny wall-clock limit stops after the first sample, with a checkpoint.
+  ASSERT_EQ(run_flow_driver_status(name + "_cut", kCylinder, sets, false, 1e-9), ff::RunStatus::Interrupted);
+  const std::string partial = slurp(flow_test_dir(name + "_cut") / "series.csv");
+  EXPECT_GT(partial.size(), 0u);
+  ASSERT_EQ(run_flow_driver_status(name + "_cut", kCylinder, sets, true), ff::RunStatus::Finished);
+  const std::string a = slurp(flow_test_dir(name + "_full") / "series.csv");
+  const std::string b = slurp(flow_test_dir(name + "_cut") / "series.csv");
+  EXPECT_GT(std::count(a.begin(), a.end(), '\n'), 30);
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(read_summary(name + "_full")["results"], read_summary(name + "_cut")["results"]);
+  EXPECT_EQ(slurp(flow_test_dir(name + "_full") / "checkpoint" / "state.ffcp"),
+            slurp(flow_test_dir(name + "_cut") / "checkpoint" / "state.ffcp"));
+  EXPECT_EQ(slurp(flow_test_dir(name + "_full") / "vtk" / "flow.pvd"), slurp(flow_test_dir(name + "_cut") / "vtk" / "flow.pvd"));
+}
+
+}  // namespace
+
+TEST(LbmFlowResume, CylinderD2Q9DoubleBouzidi) { expect_resume_identical("resume_d2q9", {}); }
+
+TEST(LbmFlowResume, CylinderD3Q19FloatHalfway) {
+  expect_resume_identical("resume_d3q19", {"lbm.lattice=\"D3Q19\"", "lbm.depth_cells=2", "lbm.precision=\"float\"",
+                                           "cylinder.wall=\"halfway\""});
+}
+
+TEST(LbmFlowResume, UnstableRunStopsWithAFix) {
+  // A lattice inflow speed of 0.5 (Mach 0.87) is refused before the run starts, naming a fix.
+  try {
+    ff::testing::run_flow_driver_status("unstable_refused", kCylinder, {"lbm.time_step=0.05", "fluid.viscosity=1.0e-4"});
+    FAIL() << "expected an input error";
+  } catch (const ff::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("Mach number"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("lbm.resolution"), std::string::npos) << e.what();
+  }
+  // A run that blows up (BGK just above tau = 1/2 at cell Reynolds number ~70) stops with a
+  // NumericalError that says what to change, after saving its state.
+  try {
+    ff::testing::run_flow_driver_status("unstable_run", kCylinder,
+                                        {"lbm.collision=\"bgk\"", "fluid.viscosity=1.0e-8", "run.inflow_ramp_time=0"});
+    FAIL() << "expected a numerical error";
+  } catch (const ff::NumericalError& e) {
+    EXPECT_NE(std::string(e.what()).find("lbm.resolution"), std::string::npos) << e.what();
+    EXPECT_TRUE(std::filesystem::exists(ff::testing::flow_test_dir("unstable_run") / "checkpoint_failed" / "state.ffcp"));
+  }
+}
