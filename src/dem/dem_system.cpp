@@ -39,7 +39,6 @@ std::size_t DemSystem::install_bonds(Real max_gap) {
   NeighborList tmp;
   tmp.build(particles.pos, particles.radius, std::max(max_gap, Real(0)) + 1e-9 * r_max);
   const auto pi = tmp.first(), pj = tmp.second();
-  const int dim = settings.dim;
   std::size_t added = 0;
   for (std::size_t p = 0; p < pi.size(); ++p) {
     const Index a = pi[p], b = pj[p];
@@ -51,7 +50,7 @@ std::size_t DemSystem::install_bonds(Real max_gap) {
     bond_pair.push_back(pt);
     bond_broken.push_back(0);
     if (materials.bond_law == BondLaw::Parallel) {
-      pbond.push_back(ParallelBond::install(materials.parallel[pt], particles.radius[a], particles.radius[b], dim));
+      pbond.push_back(ParallelBond::install());
     } else if (materials.bond_law == BondLaw::Rotational) {
       const BondEnds e{particles.pos[a], particles.pos[b], particles.orient[a], particles.orient[b], particles.radius[a],
                        particles.radius[b]};
@@ -110,6 +109,7 @@ void DemSystem::initialise() {
   particles.moment.assign(particles.size(), Vec3::Zero());
   wall_contacts_.resize(walls.size());
   build_bond_adjacency();
+  pbond_coeffs_.reserve(materials.parallel.size());
   // Every crack is a broken bond: with this reserve, logging never allocates in the time loop.
   cracks.events.reserve(cracks.events.size() + bond_i.size());
   rebuild_neighbors();
@@ -218,8 +218,8 @@ void DemSystem::contact_forces(const std::vector<typename Law::Params>& params) 
   }
 }
 
-template <class Law>
-void DemSystem::bond_forces(const std::vector<typename Law::Material>& mats, std::vector<typename Law::State>& st) {
+template <class Law, class Mat>
+void DemSystem::bond_forces(const std::vector<Mat>& mats, std::vector<typename Law::State>& st) {
   const std::size_t nb = bond_i.size();
   const Real dt = settings.dt;
   const int dim = settings.dim;
@@ -268,7 +268,8 @@ void DemSystem::record_bond_failures() {
     const Vec3 n = dist > 0 ? Vec3(d / dist) : Vec3::UnitX();
     const Real gap = dist - particles.radius[i] - particles.radius[j];
     Real size = 0;
-    if (materials.bond_law == BondLaw::Parallel) size = pbond[b].R;
+    if (materials.bond_law == BondLaw::Parallel)
+      size = ParallelBond::section(materials.parallel[bond_pair[b]], particles.radius[i], particles.radius[j], settings.dim).R;
     else size = 0.5 * (particles.radius[i] + particles.radius[j]);
     cracks.add(CrackEvent{time, particles.pos[i] + (particles.radius[i] + 0.5 * gap) * n, n, size, bond_broken[b],
                           particles.group[i], particles.group[j], i, j});
@@ -405,7 +406,11 @@ void DemSystem::step() {
   if (materials.contact_law == ContactLaw::Linear) contact_forces<LinearContact>(materials.linear);
   else contact_forces<HertzMindlinContact>(materials.hertz);
   lap(stage_times.contacts);
-  if (materials.bond_law == BondLaw::Parallel) bond_forces<ParallelBond>(materials.parallel, pbond);
+  if (materials.bond_law == BondLaw::Parallel) {
+    pbond_coeffs_.resize(materials.parallel.size());  // no allocation after the first step
+    for (std::size_t k = 0; k < materials.parallel.size(); ++k) pbond_coeffs_[k] = ParallelBond::coeffs(materials.parallel[k]);
+    bond_forces<ParallelBond>(pbond_coeffs_, pbond);
+  }
   else if (materials.bond_law == BondLaw::Rotational) bond_forces<RotationalBond>(materials.rotational, rbond);
   record_bond_failures();
   lap(stage_times.bonds);
@@ -446,8 +451,9 @@ Real DemSystem::critical_time_step() const {
     const Index i = bond_i[b], j = bond_j[b];
     Real k = 0, krot = 0;
     if (materials.bond_law == BondLaw::Parallel) {
-      k = ParallelBond::translational_stiffness(pbond[b]);
-      krot = ParallelBond::rotational_stiffness(pbond[b]);
+      const auto sec = ParallelBond::section(materials.parallel[bond_pair[b]], particles.radius[i], particles.radius[j], settings.dim);
+      k = ParallelBond::translational_stiffness(sec);
+      krot = ParallelBond::rotational_stiffness(sec);
     } else if (materials.bond_law == BondLaw::Rotational) {
       k = std::max(rbond[b].kr, rbond[b].ks);
       krot = std::max(rbond[b].kt, rbond[b].kb);
@@ -530,8 +536,9 @@ Real DemSystem::strain_energy() const {
     for (std::size_t b = 0; b < bond_i.size(); ++b) {
       if (bond_broken[b]) continue;
       const auto& s = pbond[b];
-      e += 0.5 * s.Fn * s.Fn / (s.kn * s.A) + 0.5 * s.Fs.squaredNorm() / (s.ks * s.A) +
-           0.5 * s.Mb.squaredNorm() / (s.kn * s.I) + (s.J > 0 ? 0.5 * s.Mt * s.Mt / (s.ks * s.J) : 0.0);
+      const auto c = ParallelBond::section(materials.parallel[bond_pair[b]], r[bond_i[b]], r[bond_j[b]], settings.dim);
+      e += 0.5 * s.Fn * s.Fn / (c.kn * c.A) + 0.5 * s.Fs.squaredNorm() / (c.ks * c.A) +
+           0.5 * s.Mb.squaredNorm() / (c.kn * c.I) + (c.J > 0 ? 0.5 * s.Mt * s.Mt / (c.ks * c.J) : 0.0);
     }
   }
   return e;

@@ -99,7 +99,7 @@ class DemSystem {
 
  private:
   template <class Law> void contact_forces(const std::vector<typename Law::Params>& params);
-  template <class Law> void bond_forces(const std::vector<typename Law::Material>& mats, std::vector<typename Law::State>& st);
+  template <class Law, class Mat> void bond_forces(const std::vector<Mat>& mats, std::vector<typename Law::State>& st);
   template <class Law> void wall_forces(const std::vector<typename Law::Params>& params);
   void record_bond_failures();
   void gather_and_integrate();
@@ -109,6 +109,7 @@ class DemSystem {
   std::vector<ContactState> cstate_;
   std::vector<PairLoad> pload_, bload_;
   std::vector<std::uint8_t> bond_fail_flag_;
+  std::vector<ParallelBond::Coeffs> pbond_coeffs_;  // per group pair, refreshed each step
   std::vector<std::int64_t> bond_adj_offset_, bond_adj_;
   std::vector<WallContacts> wall_contacts_;
   std::vector<Index> old_i_, old_j_;

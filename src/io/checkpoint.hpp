@@ -35,7 +35,7 @@ struct Checksum {
 };
 }  // namespace detail
 
-inline constexpr std::uint32_t kCheckpointFormatVersion = 1;
+inline constexpr std::uint32_t kCheckpointFormatVersion = 2;  // 2: parallel-bond state holds loads only
 
 // Types stored as raw bytes: trivially copyable ones, plus Eigen fixed-size vectors/matrices and
 // quaternions of arithmetic scalars (memcpy-safe though Eigen declares copy constructors).

@@ -4,6 +4,10 @@
 // The bond is stress-free when installed; it breaks in tension when the peripheral normal
 // stress reaches `ten`, or in shear when the peripheral shear stress reaches coh - sigma tan(fa).
 // After failure it carries nothing; the linear contact (always present) takes over.
+//
+// Speed: the bond stage is limited by memory traffic, not arithmetic, so each bond stores only
+// what evolves (Fn, Mt, Fs, Mb: 64 bytes). The section (R, A, I, J, kn, ks) follows from the
+// material and the two radii and is recomputed in registers every step.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -25,63 +29,99 @@ struct ParallelBond {
     Real lambda = 1;       // radius multiplier [-]
     Real beta = 1;         // moment-contribution factor [-]
   };
+  // Material in the form the hot loop uses (no tan, no division); see coeffs().
+  struct Coeffs {
+    Real emod, inv_kratio, ten, coh, tan_fa, lambda, beta;
+  };
+  static Coeffs coeffs(const Material& m) {
+    return {m.emod, 1.0 / m.kratio, m.ten, m.coh, std::tan(m.fa_deg * kPi / 180.0), m.lambda, m.beta};
+  }
+  // Geometry and stiffness of one bond.
+  struct Section {
+    Real R, A, I, J;  // bond radius [m], area [m^2], moments of inertia [m^4]
+    Real kn, ks;      // [Pa/m]
+  };
+  // What a bond carries between steps.
   struct State {
-    Real R = 0, A = 0, I = 0, J = 0;  // bond radius and section properties
-    Real kn = 0, ks = 0;              // [Pa/m]
-    Real Fn = 0, Mt = 0;              // normal force (tension > 0) [N], twisting moment [N m]
+    Real Fn = 0, Mt = 0;  // normal force (tension > 0) [N], twisting moment [N m]
     Vec3 Fs = Vec3::Zero(), Mb = Vec3::Zero();
-    Real sigma = 0, tau = 0;          // peripheral stresses at the last evaluation [Pa]
-    Real tan_fa = 0;                  // tan(friction angle), cached at installation
-    Real inv_A = 0, R_over_I = 0, R_over_J = 0;  // cached so the hot loop multiplies instead of dividing
+  };
+  struct Stress {
+    Real sigma, tau;  // peripheral normal and shear stress [Pa]
   };
 
   // Section: R = lambda min(RA, RB); 3D A = pi R^2, I = pi R^4/4, J = pi R^4/2;
-  // 2D (thickness t = 1): A = 2 R, I = 2/3 R^3, J unused. kn = E/L with L = RA + RB.
-  static State install(const Material& m, Real rA, Real rB, int dim) {
-    State s;
-    s.R = m.lambda * std::min(rA, rB);
+  // 2D (thickness t = 1): A = 2 R, I = 2/3 R^3, J unused (0). kn = E/L with L = RA + RB.
+  static Section section(const Coeffs& c, Real rA, Real rB, int dim) {
+    Section s;
+    s.R = c.lambda * std::min(rA, rB);
     if (dim == 3) {
       s.A = kPi * s.R * s.R;
-      s.I = 0.25 * kPi * s.R * s.R * s.R * s.R;
+      s.I = 0.25 * s.A * s.R * s.R;
       s.J = 2 * s.I;
     } else {
       s.A = 2 * s.R;
       s.I = 2.0 / 3.0 * s.R * s.R * s.R;
       s.J = 0;
     }
-    s.kn = m.emod / (rA + rB);
-    s.ks = s.kn / m.kratio;
-    s.tan_fa = std::tan(m.fa_deg * kPi / 180.0);
-    s.inv_A = 1.0 / s.A;
-    s.R_over_I = s.R / s.I;
-    s.R_over_J = s.J > 0 ? s.R / s.J : 0.0;
+    s.kn = c.emod / (rA + rB);
+    s.ks = s.kn * c.inv_kratio;
     return s;
   }
-  // Translational and rotational stiffness the bond adds to each end (time-step estimate).
-  static Real translational_stiffness(const State& s) { return std::max(s.kn, s.ks) * s.A; }
-  static Real rotational_stiffness(const State& s) { return std::max(s.kn * s.I, s.ks * s.J); }
+  static Section section(const Material& m, Real rA, Real rB, int dim) { return section(coeffs(m), rA, rB, dim); }
+  static State install() { return State{}; }  // stress-free when installed
 
-  static BondFailure compute(const Material& m, State& s, const ContactGeom& g, Real dt, int dim, BondLoad& out) {
+  // Translational and rotational stiffness the bond adds to each end (time-step estimate).
+  static Real translational_stiffness(const Section& s) { return std::max(s.kn, s.ks) * s.A; }
+  static Real rotational_stiffness(const Section& s) { return std::max(s.kn * s.I, s.ks * s.J); }
+
+  // Peripheral stresses (P&C 2004 Eq. 6-7 with the moment-contribution factor); Mt = 0 in 2D.
+  static Stress stress(const Coeffs& c, const Section& sec, const State& s) {
+    const Real inv_A = 1.0 / sec.A;
+    Stress out;
+    out.sigma = s.Fn * inv_A + c.beta * s.Mb.norm() * sec.R / sec.I;
+    out.tau = s.Fs.norm() * inv_A + (sec.J > 0 ? c.beta * std::abs(s.Mt) * sec.R / sec.J : 0.0);
+    return out;
+  }
+
+  // One step: update the stored loads from the increments in g, check failure, and return the
+  // loads on both ends. Failure is judged on the loads after this step's increment.
+  static BondFailure compute(const Coeffs& c, State& s, const ContactGeom& g, Real dt, int dim, BondLoad& out,
+                             Stress* stress_out = nullptr) {
+    // Section and its ratios with a single division (the divide/sqrt unit is this loop's
+    // bottleneck): q = 1/(A R L) gives 1/L, 1/A and R/I = cI/(A R), R/J = 2/(A R), where
+    // cI = 4 in 3D (I = A R^2/4) and 3 in 2D (I = 2/3 R^3, A = 2R).
+    const Real R = c.lambda * std::min(g.rA, g.rB), L = g.rA + g.rB;
+    const Real A = dim == 3 ? kPi * R * R : 2 * R;
+    const Real q = 1.0 / (A * R * L);
+    const Real inv_A = q * R * L, inv_AR = q * L;
+    const Real kn = c.emod * (q * A * R), ks = kn * c.inv_kratio;
+    const Real I = dim == 3 ? 0.25 * A * R * R : 2.0 / 3.0 * R * R * R;
+    const Real R_over_I = (dim == 3 ? 4.0 : 3.0) * inv_AR, R_over_J = dim == 3 ? 2.0 * inv_AR : 0.0;
     // Stored shear force and bending moment follow the contact plane.
     rotate_into_plane(s.Fs, g, dt);
     rotate_into_plane(s.Mb, g, dt);
     const Real dtheta_t = g.d_theta.dot(g.n);
     const Vec3 dtheta_b = g.d_theta - dtheta_t * g.n;
-    s.Fn += s.kn * s.A * g.d_delta_n;
-    s.Fs -= s.ks * s.A * g.d_delta_s;
-    s.Mb -= s.kn * s.I * dtheta_b;
-    if (dim == 3) s.Mt -= s.ks * s.J * dtheta_t;
-    // Peripheral stresses (P&C 2004 Eq. 6-7 with the moment-contribution factor).
-    const Real mb = s.Mb.norm();
-    const Real normal_stress = s.Fn * s.inv_A;
-    s.sigma = normal_stress + m.beta * mb * s.R_over_I;
-    s.tau = s.Fs.norm() * s.inv_A + m.beta * std::abs(s.Mt) * s.R_over_J;  // Mt = 0 in 2D
+    s.Fn += kn * A * g.d_delta_n;
+    s.Fs -= ks * A * g.d_delta_s;
+    s.Mb -= kn * I * dtheta_b;
+    if (dim == 3) s.Mt -= ks * 2 * I * dtheta_t;  // J = 2 I
+    // Failure (P&C 2004 Eq. 6-7): sigma = Fn/A + beta |Mb| R/I >= ten, else
+    // tau = |Fs|/A + beta |Mt| R/J >= coh - (Fn/A) tan(fa). Compared on squares, no sqrt.
+    const Real normal_stress = s.Fn * inv_A;
+    const Real bend_room = c.ten - normal_stress;  // what the bending term may add before failure
+    const Real bend_k = c.beta * R_over_I;
     BondFailure fail = BondFailure::None;
-    if (s.sigma >= m.ten) {
+    if (bend_room <= 0 || bend_k * bend_k * s.Mb.squaredNorm() >= bend_room * bend_room) {
       fail = BondFailure::Tensile;
     } else {
-      const Real tau_c = m.coh - normal_stress * s.tan_fa;
-      if (s.tau >= tau_c) fail = BondFailure::Shear;
+      const Real shear_room = c.coh - normal_stress * c.tan_fa - c.beta * std::abs(s.Mt) * R_over_J;
+      if (shear_room <= 0 || s.Fs.squaredNorm() * inv_A * inv_A >= shear_room * shear_room) fail = BondFailure::Shear;
+    }
+    if (stress_out) {
+      stress_out->sigma = normal_stress + bend_k * s.Mb.norm();
+      stress_out->tau = s.Fs.norm() * inv_A + c.beta * std::abs(s.Mt) * R_over_J;
     }
     // Force on B: tension pulls B back along -n; shear force acts on B as stored.
     out.force_on_B = -s.Fn * g.n + s.Fs;

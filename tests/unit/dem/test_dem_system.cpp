@@ -260,7 +260,7 @@ TEST(DemTimeStep, CriticalStepOfTwoBondedBodies) {
       add_particle(s, Vec3(rA + rB + gap, 0, 0), rB);
       ASSERT_EQ(s.install_bonds(2e-5), 1u);
       s.initialise();
-      const auto& b = s.pbond[0];
+      const auto b = ParallelBond::section(s.materials.parallel[0], rA, rB, dim);
       const Real k = std::max(b.kn, b.ks) * b.A, krot = std::max(b.kn * b.I, b.ks * b.J);
       const Real kc = gap < 0 ? LinearContact::normal_stiffness(s.materials.linear[0], rA, rB, dim) : 0.0;
       Real want = 1e300;
@@ -305,7 +305,8 @@ TEST(DemTimeStep, AxialBondOscillatorStableBelowTwoOverOmega) {
     add_particle(s, Vec3(2.02 * kRadius, 0, 0), kRadius);
     ASSERT_EQ(s.install_bonds(0.03 * kRadius), 1u);
     s.initialise();
-    const Real m = s.particles.mass[0], k = s.pbond[0].kn * s.pbond[0].A;
+    const Real m = s.particles.mass[0], k = ParallelBond::section(s.materials.parallel[0], kRadius, kRadius, 3).kn *
+                                         ParallelBond::section(s.materials.parallel[0], kRadius, kRadius, 3).A;
     const Real dt_lim = std::sqrt(2 * m / k);
     EXPECT_LT(s.critical_time_step(), dt_lim);
     s.settings.dt = f * dt_lim;
