@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "commands.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "drivers/driver.hpp"
@@ -111,11 +112,18 @@ int main(int argc, char** argv) {
 
   auto* params = app.add_subcommand("params", "print the parameter reference of every driver (Markdown)");
   auto* drivers = app.add_subcommand("drivers", "list the drivers (loading protocols)");
+  std::vector<std::pair<CLI::App*, cli::Command::Run>> extra;
+  for (auto& c : cli::registered_commands()) {
+    auto r = c.setup(app);
+    extra.emplace_back(app.get_subcommand(c.name), std::move(r));
+  }
 
   CLI11_PARSE(app, argc, argv);
   log::quiet() = quiet;
 
   try {
+    for (auto& [sub, fn] : extra)
+      if (*sub) return fn();
     if (*drivers) {
       for (auto& d : all_drivers()) fmt::print("{:<22} {}\n", d.name, d.summary);
       return 0;

@@ -1,0 +1,135 @@
+#include "batch/calibration.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "core/error.hpp"
+
+namespace ff::batch {
+
+void check_calibration_input(const MicroParameters& p, const CalibrationSettings& s) {
+  auto positive = [](double v, const char* name, const char* allowed) {
+    if (!(v > 0) || !std::isfinite(v))
+      throw InputError(fmt::format("{} = {}: must be {}", name, v, allowed));
+  };
+  positive(s.target.youngs_modulus_Pa, "--target-E", "a positive Young's modulus in Pa, e.g. 2.37e9");
+  positive(s.target.ucs_Pa, "--target-ucs", "a positive strength in Pa, e.g. 14.97e6");
+  if (!(s.target.poisson_ratio > -1 && s.target.poisson_ratio < 0.5))
+    throw InputError(fmt::format("--target-nu = {}: must lie in (-1, 0.5), e.g. 0.35", s.target.poisson_ratio));
+  positive(s.youngs_modulus_tolerance, "--tol-E", "a positive relative tolerance, e.g. 0.05");
+  positive(s.ucs_tolerance, "--tol-ucs", "a positive relative tolerance, e.g. 0.05");
+  positive(s.poisson_tolerance, "--tol-nu", "a positive absolute tolerance, e.g. 0.03");
+  positive(s.poisson_slope_guess, "--nu-slope", "a positive d nu / d ln(kratio), e.g. 0.08");
+  if (s.max_iterations < 1) throw InputError(fmt::format("--max-iter = {}: must be at least 1", s.max_iterations));
+  if (!(s.max_factor > 1)) throw InputError(fmt::format("max_factor = {}: must be above 1", s.max_factor));
+  positive(p.bond_emod_Pa, "bond emod", "positive");
+  positive(p.contact_emod_Pa, "contact emod", "positive");
+  positive(p.bond_kratio, "bond kratio", "positive");
+  positive(p.contact_kratio, "contact kratio", "positive");
+  positive(p.tensile_strength_Pa, "bond tensile_strength", "positive");
+  positive(p.cohesion_Pa, "bond cohesion", "positive");
+}
+
+void score_step(CalibrationStep& st, const CalibrationSettings& s) {
+  st.youngs_modulus_error = (st.measured.youngs_modulus_Pa - s.target.youngs_modulus_Pa) / s.target.youngs_modulus_Pa;
+  st.poisson_error = st.measured.poisson_ratio - s.target.poisson_ratio;
+  st.ucs_error = (st.measured.ucs_Pa - s.target.ucs_Pa) / s.target.ucs_Pa;
+  st.converged = std::abs(st.youngs_modulus_error) < s.youngs_modulus_tolerance &&
+                 std::abs(st.poisson_error) < s.poisson_tolerance && std::abs(st.ucs_error) < s.ucs_tolerance;
+}
+
+double worst_scaled_error(const CalibrationStep& st, const CalibrationSettings& s) {
+  const double w = std::max({std::abs(st.youngs_modulus_error) / s.youngs_modulus_tolerance,
+                             std::abs(st.poisson_error) / s.poisson_tolerance, std::abs(st.ucs_error) / s.ucs_tolerance});
+  return std::isfinite(w) ? w : HUGE_VAL;
+}
+
+MicroParameters next_parameters(std::span<const CalibrationStep> history, const CalibrationSettings& s) {
+  if (history.empty()) throw Error("next_parameters: no run to update from");
+  const CalibrationStep& last = history.back();
+  const MacroProperties& m = last.measured;
+  if (!(m.youngs_modulus_Pa > 0) || !(m.ucs_Pa > 0) || !std::isfinite(m.youngs_modulus_Pa) || !std::isfinite(m.ucs_Pa) ||
+      !std::isfinite(m.poisson_ratio))
+    throw Error(fmt::format("calibration iteration {}: the run measured E = {}, nu = {}, UCS = {}; cannot update from "
+                            "that (see the run's folder)",
+                            last.iteration, m.youngs_modulus_Pa, m.poisson_ratio, m.ucs_Pa));
+  auto limit = [&](double f) { return std::clamp(f, 1 / s.max_factor, s.max_factor); };
+  MicroParameters p = last.params;
+
+  // E linear in the moduli (through the origin).
+  const double f_emod = limit(s.target.youngs_modulus_Pa / m.youngs_modulus_Pa);
+  p.bond_emod_Pa *= f_emod;
+  p.contact_emod_Pa *= f_emod;
+
+  // nu linear in ln(kratio): slope by least squares over the runs so far, when they span a range
+  // of kratio and give a positive slope; else the guess.
+  double slope = s.poisson_slope_guess;
+  {
+    double mx = 0, my = 0;
+    for (auto& h : history) {
+      mx += std::log(h.params.bond_kratio);
+      my += h.measured.poisson_ratio;
+    }
+    mx /= static_cast<double>(history.size());
+    my /= static_cast<double>(history.size());
+    double sxx = 0, sxy = 0;
+    for (auto& h : history) {
+      const double dx = std::log(h.params.bond_kratio) - mx;
+      sxx += dx * dx;
+      sxy += dx * (h.measured.poisson_ratio - my);
+    }
+    // A spread of at least 2% in kratio, and a slope no flatter than a tenth of the guess:
+    // otherwise the measurement scatter would send kratio far away.
+    if (sxx > 1e-4 * static_cast<double>(history.size()) && sxy / sxx > 0.1 * s.poisson_slope_guess) slope = sxy / sxx;
+  }
+  const double f_kratio = limit(std::exp((s.target.poisson_ratio - m.poisson_ratio) / slope));
+  p.bond_kratio *= f_kratio;
+  p.contact_kratio *= f_kratio;
+
+  // UCS linear in the strengths at fixed tensile_strength / cohesion.
+  const double f_strength = limit(s.target.ucs_Pa / m.ucs_Pa);
+  p.tensile_strength_Pa *= f_strength;
+  p.cohesion_Pa *= f_strength;
+  return p;
+}
+
+MicroParameters rounded(const MicroParameters& p, int digits) {
+  auto r = [digits](double v) { return std::stod(fmt::format("{:.{}g}", v, digits)); };
+  return {r(p.bond_emod_Pa), r(p.contact_emod_Pa), r(p.bond_kratio), r(p.contact_kratio), r(p.tensile_strength_Pa),
+          r(p.cohesion_Pa)};
+}
+
+CalibrationResult calibrate(const MicroParameters& start, const CalibrationSettings& s, const UcsModel& model,
+                            const std::function<void(const CalibrationStep&)>& on_step) {
+  check_calibration_input(start, s);
+  CalibrationResult r;
+  MicroParameters p = start;
+  for (int it = 1; it <= s.max_iterations; ++it) {
+    CalibrationStep st;
+    st.iteration = it;
+    st.params = p;
+    st.measured = model(p, it);
+    score_step(st, s);
+    r.steps.push_back(st);
+    if (on_step) on_step(st);
+    if (st.converged) {
+      r.converged = true;
+      break;
+    }
+    if (it < s.max_iterations) p = rounded(next_parameters(r.steps, s));
+  }
+  if (r.converged) {
+    r.chosen = static_cast<int>(r.steps.size()) - 1;
+  } else {
+    r.chosen = 0;
+    for (std::size_t i = 1; i < r.steps.size(); ++i)
+      if (worst_scaled_error(r.steps[i], s) < worst_scaled_error(r.steps[r.chosen], s)) r.chosen = static_cast<int>(i);
+  }
+  r.final_params = r.steps[r.chosen].params;
+  return r;
+}
+
+}  // namespace ff::batch

@@ -1,0 +1,85 @@
+// Calibration of parallel-bond micro-parameters against laboratory E, nu and UCS by repeated
+// UCS runs, with the relations seed 000 (Zhao, Konietzky & Herbst 2021, Sec. 5.2; METHODS.md 1.7)
+// reports for PFC's parallel-bond model:
+//   - E is linear in the bond (and contact) modulus:        emod   <- emod * E* / E
+//   - nu is linear in the logarithm of the stiffness ratio: ln k   <- ln k + (nu* - nu) / s,
+//     s = d nu / d ln k fitted by least squares to the runs so far (a guess for the first step)
+//   - UCS is linear in the bond strengths at a fixed tensile/cohesion ratio:
+//                                                           strengths <- strengths * UCS* / UCS
+// All three are updated every iteration from the latest run (stiffness hardly depends on the
+// strengths, and the multiplicative updates absorb the weaker cross effects as they go).
+#pragma once
+#include <functional>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace ff::batch {
+
+// The micro-parameters being calibrated, of one group pair. Bond and contact moduli are scaled
+// together (their ratio stays as given), and so are the two stiffness ratios.
+struct MicroParameters {
+  double bond_emod_Pa = 0, contact_emod_Pa = 0;
+  double bond_kratio = 0, contact_kratio = 0;
+  double tensile_strength_Pa = 0, cohesion_Pa = 0;
+};
+
+// What one UCS run measures.
+struct MacroProperties {
+  double youngs_modulus_Pa = 0, poisson_ratio = 0, ucs_Pa = 0;
+};
+
+struct CalibrationSettings {
+  MacroProperties target;
+  double youngs_modulus_tolerance = 0.05;  // relative
+  double ucs_tolerance = 0.05;             // relative
+  double poisson_tolerance = 0.03;         // absolute
+  int max_iterations = 12;                 // UCS runs at most
+  double poisson_slope_guess = 0.08;       // d nu / d ln(kratio) for the first step (seed 000 default sample:
+                                           // nu ~ 0.30 at kratio 14.65, ~0.1 near kratio 1)
+  double max_factor = 4;                   // no parameter changes by more than this factor per iteration
+};
+
+struct CalibrationStep {
+  int iteration = 0;  // 1-based
+  MicroParameters params;
+  MacroProperties measured;
+  double youngs_modulus_error = 0;  // (E - E*) / E*
+  double poisson_error = 0;         // nu - nu*
+  double ucs_error = 0;             // (UCS - UCS*) / UCS*
+  bool converged = false;           // all three within their tolerances
+};
+
+struct CalibrationResult {
+  std::vector<CalibrationStep> steps;
+  bool converged = false;
+  int chosen = -1;          // index into steps: the converged step, else the one with the smallest worst error
+  MicroParameters final_params;
+};
+
+// Stands in for one UCS run with the given parameters (iteration is 1-based).
+using UcsModel = std::function<MacroProperties(const MicroParameters&, int iteration)>;
+
+// Throws ff::InputError for non-positive targets, tolerances or parameters.
+void check_calibration_input(const MicroParameters& start, const CalibrationSettings& s);
+
+// Fills the error fields and `converged` of a step from its measurement.
+void score_step(CalibrationStep& step, const CalibrationSettings& s);
+
+// The parameters for the next run from the runs so far (the update rules above).
+// Throws ff::Error when the last measurement is not a positive finite number.
+MicroParameters next_parameters(std::span<const CalibrationStep> history, const CalibrationSettings& s);
+
+// Each parameter rounded to `digits` significant digits: the calibrated values are written as
+// short numbers, and the runs use exactly those numbers so the snippet reproduces them.
+MicroParameters rounded(const MicroParameters& p, int digits = 6);
+
+// Runs the loop: measure, stop when within tolerance, else update. `on_step` is called after
+// each measurement (for reporting as it goes).
+CalibrationResult calibrate(const MicroParameters& start, const CalibrationSettings& s, const UcsModel& model,
+                            const std::function<void(const CalibrationStep&)>& on_step = {});
+
+// How far a step is from the targets, in units of the tolerances (<= 1: converged).
+double worst_scaled_error(const CalibrationStep& step, const CalibrationSettings& s);
+
+}  // namespace ff::batch

@@ -1,0 +1,166 @@
+#include "batch/run_case.hpp"
+
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <omp.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <deque>
+#include <fstream>
+#include <limits>
+
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "io/scenario.hpp"
+
+extern char** environ;
+
+namespace fs = std::filesystem;
+
+namespace ff::batch {
+
+std::unique_ptr<LoadedScenario> load_scenario_for_run(const std::string& path, const std::vector<std::string>& overrides) {
+  const std::string text = path.empty() ? std::string(default_scenario_text()) : read_text_file(path);
+  const std::string source = path.empty() ? "<built-in default scenario>" : path;
+  std::string driver_name = peek_driver(text, source);
+  for (auto& o : overrides)
+    if (o.rfind("driver=", 0) == 0) driver_name = o.substr(7);
+  if (driver_name.empty()) {
+    if (all_drivers().empty()) throw InputError("no driver is built into this fracflow");
+    driver_name = std::string(all_drivers().front().name);
+  }
+  auto l = std::make_unique<LoadedScenario>();
+  l->driver = &find_driver(driver_name);
+  l->table = parameter_table(*l->driver);
+  l->config = load_scenario(l->table, path, text, overrides);
+  return l;
+}
+
+RunStatus run_in_process(const std::string& scenario_path, const std::vector<std::string>& overrides,
+                         const InProcessRun& run) {
+  auto l = load_scenario_for_run(scenario_path, overrides);  // every key validated before anything is written
+  if (fs::exists(run.out_dir) && !fs::is_empty(run.out_dir))
+    throw InputError(fmt::format("results folder '{}' already holds files; choose an empty or new folder",
+                                 run.out_dir.string()));
+  fs::create_directories(run.out_dir);
+  {
+    std::ofstream f(run.out_dir / "scenario.toml");
+    f << l->config.resolved_toml();
+    if (!f) throw Error(fmt::format("cannot write '{}'", (run.out_dir / "scenario.toml").string()));
+  }
+  RunOptions opt;
+  opt.out_dir = run.out_dir;
+  opt.threads = std::max(1, run.threads);
+  opt.max_steps = run.max_steps;
+  opt.max_wall_s = run.max_wall_s;
+  opt.abort_file = run.out_dir / "ABORT";
+  opt.progress_interval_s = run.quiet ? 0 : l->config.real("output.progress_interval");
+  // The driver reads the thread count from the OpenMP runtime; quiet is a process-wide flag,
+  // so both are restored afterwards.
+  const int threads_before = omp_get_max_threads();
+  const bool quiet_before = log::quiet();
+  omp_set_num_threads(opt.threads);
+  log::quiet() = run.quiet || quiet_before;
+  struct Restore {
+    int threads;
+    bool quiet;
+    ~Restore() {
+      omp_set_num_threads(threads);
+      log::quiet() = quiet;
+    }
+  } restore{threads_before, quiet_before};
+  return l->driver->run(l->config, opt);
+}
+
+namespace {
+double number_at(const nlohmann::json& j, std::initializer_list<const char*> path) {
+  const nlohmann::json* p = &j;
+  for (const char* k : path) {
+    if (!p->is_object() || !p->contains(k)) return std::numeric_limits<double>::quiet_NaN();
+    p = &(*p)[k];
+  }
+  return p->is_number() ? p->get<double>() : std::numeric_limits<double>::quiet_NaN();
+}
+}  // namespace
+
+RunSummary read_run_summary(const fs::path& out_dir) {
+  const fs::path file = out_dir / "summary.json";
+  std::ifstream in(file);
+  if (!in) throw Error(fmt::format("'{}' is missing: the run did not finish", file.string()));
+  RunSummary s;
+  try {
+    s.raw = nlohmann::json::parse(in);
+  } catch (const std::exception& e) {
+    throw Error(fmt::format("'{}' is not valid JSON: {}", file.string(), e.what()));
+  }
+  s.driver = s.raw.value("driver", std::string());
+  s.ucs_Pa = number_at(s.raw, {"ucs_Pa"});
+  s.peak_differential_stress_Pa = number_at(s.raw, {"peak_differential_stress_Pa"});
+  s.confining_pressure_Pa = number_at(s.raw, {"confining_pressure_Pa"});
+  s.youngs_modulus_Pa = number_at(s.raw, {"youngs_modulus_Pa"});
+  s.poisson_ratio = number_at(s.raw, {"poisson_ratio"});
+  s.strain_at_peak = number_at(s.raw, {"strain_at_peak"});
+  s.cracks_tensile = number_at(s.raw, {"cracks", "tensile"});
+  s.cracks_shear = number_at(s.raw, {"cracks", "shear"});
+  s.cracks_total = number_at(s.raw, {"cracks", "total"});
+  s.wall_time_s = number_at(s.raw, {"wall_time_s"});
+  return s;
+}
+
+std::optional<StrengthPoint> peak_strength(const RunSummary& s) {
+  StrengthPoint p;
+  if (s.driver == "ucs") {
+    p = {0.0, s.ucs_Pa};
+  } else if (s.driver == "triaxial") {
+    p = {s.confining_pressure_Pa, s.confining_pressure_Pa + s.peak_differential_stress_Pa};
+  } else {
+    return std::nullopt;
+  }
+  if (!std::isfinite(p.sigma3) || !std::isfinite(p.sigma_p)) return std::nullopt;
+  return p;
+}
+
+int run_child_process(const fs::path& executable, const std::vector<std::string>& args, const fs::path& log) {
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+  posix_spawn_file_actions_adddup2(&fa, STDOUT_FILENO, STDERR_FILENO);
+  posix_spawn_file_actions_addclose(&fa, STDIN_FILENO);
+  std::vector<std::string> argv_store;
+  argv_store.reserve(args.size() + 1);
+  argv_store.push_back(executable.string());
+  argv_store.insert(argv_store.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& a : argv_store) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  const int rc = posix_spawn(&pid, executable.c_str(), &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  if (rc != 0) return -1;
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0)
+    if (errno != EINTR) return -1;
+  if (WIFEXITED(status)) return WEXITSTATUS(status);
+  if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
+  return -1;
+}
+
+std::string tail_of_file(const fs::path& path, int lines) {
+  std::ifstream in(path);
+  std::deque<std::string> last;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty()) continue;
+    last.push_back(line);
+    if (static_cast<int>(last.size()) > lines) last.pop_front();
+  }
+  std::string out;
+  for (auto& l : last) out += (out.empty() ? "" : "\n") + l;
+  return out;
+}
+
+}  // namespace ff::batch

@@ -1,0 +1,68 @@
+// One run of a scenario, the way `fracflow run` does it (validate everything, then write the
+// folder, then call the driver), plus what the batch tools need around it: reading a run's
+// summary.json back and starting `fracflow run` as a child process.
+#pragma once
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "batch/mohr_coulomb.hpp"
+#include "drivers/driver.hpp"
+#include "io/params.hpp"
+
+namespace ff::batch {
+
+// A validated scenario. Config points into `table`, so the three live together (heap-held).
+struct LoadedScenario {
+  const Driver* driver = nullptr;
+  ParamTable table;
+  Config config;
+};
+
+// Reads the scenario file (or the built-in default when `path` is empty), applies the
+// "key=value" overrides (later ones win) and validates every key; throws ff::InputError.
+std::unique_ptr<LoadedScenario> load_scenario_for_run(const std::string& path, const std::vector<std::string>& overrides);
+
+struct InProcessRun {
+  std::filesystem::path out_dir;  // must be absent or empty
+  int threads = 1;                // OpenMP threads for the driver
+  bool quiet = true;              // no info/status lines while the driver runs
+  long max_steps = 0;             // as RunOptions
+  double max_wall_s = 0;
+};
+
+// Runs a scenario in this process: validate, create out_dir, write scenario.toml (the
+// resolved parameters), call the driver. Input errors are thrown before out_dir is created;
+// driver errors (ff::InputError from cross-parameter checks, ff::NumericalError) propagate.
+RunStatus run_in_process(const std::string& scenario_path, const std::vector<std::string>& overrides,
+                         const InProcessRun& run);
+
+// The headline numbers of a finished run's summary.json; absent numbers are NaN.
+struct RunSummary {
+  std::string driver;
+  double ucs_Pa = 0, peak_differential_stress_Pa = 0, confining_pressure_Pa = 0;
+  double youngs_modulus_Pa = 0, poisson_ratio = 0, strain_at_peak = 0;
+  double cracks_tensile = 0, cracks_shear = 0, cracks_total = 0;
+  double wall_time_s = 0;
+  nlohmann::json raw;  // the whole file
+};
+
+// Reads out_dir/summary.json; throws ff::Error naming the file when it is missing or unreadable.
+RunSummary read_run_summary(const std::filesystem::path& out_dir);
+
+// The peak strength of a UCS (sigma3 = 0) or triaxial run, compression positive; nullopt for
+// other drivers or when the numbers are missing.
+std::optional<StrengthPoint> peak_strength(const RunSummary& s);
+
+// Starts `executable args...` with stdout and stderr appended to `log` and waits for it.
+// Returns its exit status, 128 + signal when it was killed, or -1 when it could not start.
+int run_child_process(const std::filesystem::path& executable, const std::vector<std::string>& args,
+                      const std::filesystem::path& log);
+
+// The last `lines` non-empty lines of a text file ("" when unreadable): a failed run's reason.
+std::string tail_of_file(const std::filesystem::path& path, int lines);
+
+}  // namespace ff::batch

@@ -1,0 +1,139 @@
+// The calibration loop on a stand-in for the UCS run with the relations of seed 000 Sec. 5.2
+// plus cross effects, so the algorithm is tested in milliseconds.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "batch/calibration.hpp"
+#include "core/error.hpp"
+
+using namespace ff::batch;
+
+namespace {
+
+const MicroParameters kTable7{2.09e9, 2.09e9, 14.65, 14.65, 17.4e6, 4.35e6};
+
+CalibrationSettings table5_targets() {
+  CalibrationSettings s;
+  s.target = {2.37e9, 0.35, 14.97e6};
+  return s;
+}
+
+// E linear in emod and a little softer at high kratio; nu = a + b ln(kratio); UCS linear in the
+// strengths and a little stronger at high emod. Calibrated to the default sample's E = 0.95 GPa,
+// nu = 0.30, UCS = 14.1 MPa at the Table 7 parameters.
+MacroProperties stand_in(const MicroParameters& p) {
+  const double k1 = 0.95e9 / (2.09e9 * std::pow(14.65, -0.15));
+  const double b = 0.09, a = 0.30 - b * std::log(14.65);
+  const double k2 = 14.1e6 / 17.4e6;
+  return {k1 * p.bond_emod_Pa * std::pow(p.bond_kratio, -0.15), a + b * std::log(p.bond_kratio),
+          k2 * p.tensile_strength_Pa * (1 + 0.1 * std::log(p.bond_emod_Pa / 2.09e9))};
+}
+
+}  // namespace
+
+TEST(Calibration, StandInModelConvergesWithinTolerancesInFewRuns) {
+  const auto s = table5_targets();
+  int calls = 0;
+  const auto r = calibrate(kTable7, s, [&](const MicroParameters& p, int) {
+    ++calls;
+    return stand_in(p);
+  });
+  ASSERT_TRUE(r.converged);
+  EXPECT_LE(r.steps.size(), 6u);
+  EXPECT_EQ(calls, static_cast<int>(r.steps.size()));
+  const auto m = stand_in(r.final_params);
+  EXPECT_LT(std::abs(m.youngs_modulus_Pa / 2.37e9 - 1), 0.05);
+  EXPECT_LT(std::abs(m.poisson_ratio - 0.35), 0.03);
+  EXPECT_LT(std::abs(m.ucs_Pa / 14.97e6 - 1), 0.05);
+  // Ratios held fixed by the rules: bond/contact modulus, bond/contact kratio, tensile/cohesion.
+  const auto& p = r.final_params;
+  EXPECT_NEAR(p.bond_emod_Pa / p.contact_emod_Pa, 1.0, 1e-5);
+  EXPECT_NEAR(p.bond_kratio / p.contact_kratio, 1.0, 1e-5);
+  EXPECT_NEAR(p.tensile_strength_Pa / p.cohesion_Pa, 4.0, 1e-5);
+}
+
+TEST(Calibration, TighterTolerancesStillConverge) {
+  auto s = table5_targets();
+  s.youngs_modulus_tolerance = s.ucs_tolerance = 0.005;
+  s.poisson_tolerance = 0.002;
+  const auto r = calibrate(kTable7, s, [](const MicroParameters& p, int) { return stand_in(p); });
+  EXPECT_TRUE(r.converged);
+  EXPECT_LE(r.steps.size(), 8u);
+}
+
+TEST(Calibration, FirstStepUsesTheModulusRatioAndTheSlopeGuess) {
+  const auto s = table5_targets();
+  CalibrationStep st;
+  st.iteration = 1;
+  st.params = kTable7;
+  st.measured = {0.95e9, 0.30, 14.1e6};
+  score_step(st, s);
+  const std::vector<CalibrationStep> h = {st};
+  const auto p = next_parameters(h, s);
+  EXPECT_NEAR(p.bond_emod_Pa, 2.09e9 * 2.37 / 0.95, 1.0);
+  EXPECT_NEAR(p.contact_emod_Pa, 2.09e9 * 2.37 / 0.95, 1.0);
+  EXPECT_NEAR(p.bond_kratio, 14.65 * std::exp(0.05 / s.poisson_slope_guess), 1e-9);
+  EXPECT_NEAR(p.tensile_strength_Pa, 17.4e6 * 14.97 / 14.1, 1e-3);
+  EXPECT_NEAR(p.cohesion_Pa, 4.35e6 * 14.97 / 14.1, 1e-3);
+}
+
+// With two runs at different kratio the slope comes from them: for an exactly logarithmic
+// nu(kratio) the next kratio hits the target.
+TEST(Calibration, SecondStepUsesTheMeasuredSlope) {
+  const auto s = table5_targets();
+  std::vector<CalibrationStep> h(2);
+  const double b = 0.12, a = 0.30 - b * std::log(10.0);
+  for (int i = 0; i < 2; ++i) {
+    h[i].iteration = i + 1;
+    h[i].params = kTable7;
+    h[i].params.bond_kratio = h[i].params.contact_kratio = i == 0 ? 10.0 : 20.0;
+    h[i].measured = {2e9, a + b * std::log(h[i].params.bond_kratio), 14e6};
+    score_step(h[i], s);
+  }
+  const auto p = next_parameters(h, s);
+  EXPECT_NEAR(a + b * std::log(p.bond_kratio), 0.35, 1e-12);
+}
+
+TEST(Calibration, StepsAreLimited) {
+  const auto s = table5_targets();
+  CalibrationStep st;
+  st.params = kTable7;
+  st.measured = {0.01e9, 0.0, 100e6};  // far off: each factor is clamped to [1/4, 4]
+  const std::vector<CalibrationStep> h = {st};
+  const auto p = next_parameters(h, s);
+  EXPECT_NEAR(p.bond_emod_Pa / kTable7.bond_emod_Pa, 4.0, 1e-12);
+  EXPECT_NEAR(p.bond_kratio / kTable7.bond_kratio, 4.0, 1e-12);
+  EXPECT_NEAR(p.tensile_strength_Pa / kTable7.tensile_strength_Pa, 0.25, 1e-12);  // 14.97/100 clamped
+}
+
+TEST(Calibration, NotConvergedReturnsTheClosestRun) {
+  auto s = table5_targets();
+  s.max_iterations = 2;
+  const auto r = calibrate(kTable7, s, [](const MicroParameters& p, int) { return stand_in(p); });
+  EXPECT_FALSE(r.converged);
+  ASSERT_EQ(r.steps.size(), 2u);
+  EXPECT_EQ(r.chosen, 1);  // the second run is closer than the Table 7 start
+  EXPECT_EQ(r.final_params.bond_emod_Pa, r.steps[1].params.bond_emod_Pa);
+}
+
+TEST(Calibration, BadInputIsAnInputError) {
+  auto s = table5_targets();
+  s.target.poisson_ratio = 0.6;
+  EXPECT_THROW(calibrate(kTable7, s, [](const MicroParameters& p, int) { return stand_in(p); }), ff::InputError);
+  s = table5_targets();
+  s.max_iterations = 0;
+  EXPECT_THROW(check_calibration_input(kTable7, s), ff::InputError);
+}
+
+TEST(Calibration, FailedMeasurementStopsWithAnError) {
+  const auto s = table5_targets();
+  EXPECT_THROW(calibrate(kTable7, s, [](const MicroParameters&, int) { return MacroProperties{std::nan(""), 0.3, 1e7}; }),
+               ff::Error);
+}
+
+TEST(Calibration, ParametersAreRoundedToShortNumbers) {
+  const auto p = rounded({2.0912345678e9, 1, 14.6512345, 1, 17.4e6, 4.35e6});
+  EXPECT_EQ(p.bond_emod_Pa, 2.09123e9);
+  EXPECT_EQ(p.bond_kratio, 14.6512);
+}
