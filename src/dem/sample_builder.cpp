@@ -28,7 +28,7 @@ void declare_sample_params(ParamTable& t) {
   t.integer("sample.seed", 1, "-", "random seed of the packing (same seed, same sample)").non_negative();
   t.real("sample.locked_in_stress", 0.1e6, "Pa", "isotropic stress left in the packing when bonds are installed is reduced below this").positive();
   t.real("sample.bond_gap", 0.05e-3, "m", "bonds are installed between particles whose gap is at most this (seed 000: 0.05 mm)").non_negative();
-  t.string("sample.default_group", "", "group of particles outside every region (default: the first declared group)");
+  t.string("sample.default_group", "", "group of particles outside every region and image window (required when more than one group is declared)");
   t.real("sample.genesis_tolerance", 1e-2, "-", "equilibrium criterion of the genesis: mean unbalanced-force ratio").positive();
   t.integer("sample.genesis_max_steps", 1000, "-", "step cap of each genesis equilibration").positive();
   // Regions assigning groups (later regions win).
@@ -43,6 +43,21 @@ void declare_sample_params(ParamTable& t) {
   t.real_list("sample.region.*.semi_axes", {1e-3, 1e-3, 1e-3}, "m", "ellipsoid semi-axes").size(3).positive();
   t.real_list("sample.region.*.rotation", {0, 0, 0}, "deg", "ellipsoid rotation: angles about x, then y, then z").size(3);
   t.string("sample.region.*.file", "", "closed STL surface (relative paths from the scenario file's folder)");
+  // Voxel image (applied after the regions: a voxel window wins over every region).
+  t.string("sample.voxels.folder", "",
+           "folder of 8- or 16-bit binary PGM slices, one per z level in file-name order (relative paths from the "
+           "scenario file's folder; empty: no image). Groups from the image override sample.region.*; particles "
+           "outside the image or in voxels of no window keep their group");
+  t.real_list("sample.voxels.origin", {0, 0, 0}, "m", "centre of voxel (0, 0, 0): column 0, row 0 of the first slice").size(3);
+  t.real_list("sample.voxels.spacing", {1e-4, 1e-4, 1e-4}, "m", "voxel size along x (columns), y (rows), z (slices)")
+      .size(3)
+      .positive();
+  t.integer("sample.voxels.threshold.*.min", 0, "-",
+            "lowest grey value of window *, which maps to the declared group of that name or, for * = pore, removes the "
+            "particles before bonding")
+      .range(0, 65535);
+  t.integer("sample.voxels.threshold.*.max", 65535, "-", "highest grey value of the window (windows must not overlap)")
+      .range(0, 65535);
 }
 
 namespace {
@@ -93,6 +108,91 @@ std::vector<Region> read_regions(const Config& cfg, const Materials& mat, std::v
   }
   return regions;
 }
+
+std::string group_list(const Materials& mat) {
+  std::string s;
+  for (const auto& g : mat.group_names) s += (s.empty() ? "" : ", ") + g;
+  return s;
+}
+
+// Keeps the particles with !remove[i]. Called before bonds exist: every neighbour pair and wall
+// contact is dropped first, because the renumbering would attach their history to other particles.
+void remove_particles(DemSystem& sys, const std::vector<char>& remove) {
+  ParticleStore& P = sys.particles;
+  ParticleStore kept;
+  auto keep = [&](auto& from, auto& to) {
+    for (std::size_t i = 0; i < from.size(); ++i)
+      if (!remove[i]) to.push_back(from[i]);
+  };
+  keep(P.pos, kept.pos), keep(P.vel, kept.vel), keep(P.omega, kept.omega), keep(P.orient, kept.orient);
+  keep(P.disp, kept.disp), keep(P.radius, kept.radius), keep(P.mass, kept.mass), keep(P.inertia, kept.inertia);
+  keep(P.inv_mass, kept.inv_mass), keep(P.inv_inertia, kept.inv_inertia), keep(P.group, kept.group);
+  keep(P.force, kept.force), keep(P.moment, kept.moment);
+  P = ParticleStore{};
+  sys.wall_contacts().clear();
+  sys.rebuild_neighbors();
+  P = std::move(kept);
+  sys.initialise();
+}
+
+}  // namespace
+
+VoxelGroups read_voxel_groups(const Config& cfg, const Materials& mat) {
+  VoxelGroups vg;
+  const std::string folder_key = "sample.voxels.folder";
+  auto names = cfg.names("sample.voxels.threshold");
+  std::sort(names.begin(), names.end());
+  auto key_of = [&](const std::string& name) {  // the key the file set, for error messages
+    const std::string k = "sample.voxels.threshold." + name;
+    return cfg.has(k + ".min") ? k + ".min" : k + ".max";
+  };
+  std::filesystem::path folder = cfg.string(folder_key);
+  if (folder.empty()) {
+    if (!names.empty())
+      cfg.fail(key_of(names[0]), "grey-value windows need an image: set sample.voxels.folder = \"path/to/slices\"");
+    return vg;
+  }
+  if (names.empty())
+    cfg.fail(folder_key, fmt::format("the image needs at least one grey-value window: sample.voxels.threshold.NAME.min/max "
+                                     "with NAME a declared group ({}) or pore", group_list(mat)));
+  struct Window {
+    std::string name;
+    geom::GreyRange range;
+  };
+  std::vector<Window> windows;
+  for (const auto& name : names) {
+    const std::string k = "sample.voxels.threshold." + name;
+    const int label = name == "pore" ? kPoreLabel : mat.group_index(name);
+    if (name != "pore" && label < 0)
+      cfg.fail(key_of(name), fmt::format("'{}' is neither a declared group ({}) nor pore", name, group_list(mat)));
+    const long lo = cfg.integer(k + ".min"), hi = cfg.integer(k + ".max");
+    if (lo > hi) cfg.fail(k + ".max", fmt::format("max = {} is below min = {}; a window holds min <= grey value <= max", hi, lo));
+    windows.push_back({name, geom::GreyRange{static_cast<std::uint16_t>(lo), static_cast<std::uint16_t>(hi), label}});
+  }
+  std::sort(windows.begin(), windows.end(), [](const Window& a, const Window& b) { return a.range.min < b.range.min; });
+  for (std::size_t n = 1; n < windows.size(); ++n) {
+    const Window &a = windows[n - 1], &b = windows[n];
+    if (b.range.min <= a.range.max)
+      cfg.fail(key_of(b.name), fmt::format("window [{}, {}] of '{}' overlaps window [{}, {}] of '{}'; windows must be "
+                                           "disjoint so that every grey value maps to one group",
+                                           b.range.min, b.range.max, b.name, a.range.min, a.range.max, a.name));
+  }
+  if (folder.is_relative()) folder = std::filesystem::path(cfg.scenario_name()).parent_path() / folder;
+  auto v3 = [&](const std::string& key) {
+    const auto& l = cfg.real_list(key);
+    return Vec3(l[0], l[1], l[2]);
+  };
+  try {
+    vg.image = geom::read_pgm_stack(folder, v3("sample.voxels.origin"), v3("sample.voxels.spacing"));
+  } catch (const InputError& e) {
+    cfg.fail(folder_key, fmt::format("{} (allowed: a folder of equally sized 8- or 16-bit binary PGM slices, "
+                                     "relative to the scenario file's folder)", e.what()));
+  }
+  for (const Window& w : windows) vg.windows.push_back(w.range);
+  return vg;
+}
+
+namespace {
 
 // Spatial order (cells of two max radii, raster z-y-x) so neighbours sit close in memory.
 void sort_spatially(std::vector<Vec3>& pos, std::vector<Real>& rad) {
@@ -204,6 +304,7 @@ SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
   const Real min_por = dim == 3 ? geom::kMinPorosity3D : geom::kMinPorosity2D;
   if (spec.porosity < min_por)
     cfg.fail("sample.porosity", fmt::format("{} is denser than a random packing can be made here; use >= {}", spec.porosity, min_por));
+  const VoxelGroups voxels = read_voxel_groups(cfg, sys.materials);  // before the packing: bad input fails fast
   geom::Packing pk;
   try {
     pk = geom::dense_random_packing(spec);
@@ -212,15 +313,36 @@ SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
   }
   sort_spatially(pk.position, pk.radius);
 
-  // Groups.
+  // Groups: default, then regions (the last containing region wins), then voxel windows.
   std::vector<int> region_group;
   const auto regions = read_regions(cfg, sys.materials, region_group);
   int default_group = 0;
+  // Group tables come back from TOML in name order, not file order, so "the first group" would be
+  // a surprise (inclusion before matrix): with several groups the user must name it.
+  if (cfg.string("sample.default_group").empty() && sys.materials.groups() > 1)
+    cfg.fail("sample.default_group", fmt::format("{} groups are declared; name the one that fills the sample (e.g. \"{}\")",
+                                                 sys.materials.groups(), sys.materials.group_names[0]));
   if (!cfg.string("sample.default_group").empty()) {
     default_group = sys.materials.group_index(cfg.string("sample.default_group"));
     if (default_group < 0) cfg.fail("sample.default_group", "not a declared group ([dem.group.NAME])");
   }
-  const auto groups = geom::assign_groups(pk.position, regions, region_group, default_group);
+  auto groups = geom::assign_groups(pk.position, regions, region_group, default_group);
+  constexpr int kUnlabelled = -2;
+  if (!voxels.empty()) {
+    const auto label = geom::label_points(voxels.image, pk.position, voxels.windows, kUnlabelled);
+    std::size_t inside = 0, regrouped = 0;
+    for (std::size_t i = 0; i < groups.size(); ++i) {
+      inside += voxels.image.contains(pk.position[i]);
+      if (label[i] >= 0) {
+        groups[i] = label[i];
+        ++regrouped;
+      }
+    }
+    if (inside == 0)
+      log::warn("sample.voxels: no particle centre lies in the image (check sample.voxels.origin and spacing, in m)");
+    log::info("sample.voxels: {} of {} particle centres in the image, {} assigned a group from it", inside,
+              groups.size(), regrouped);
+  }
 
   auto& P = sys.particles;
   P.resize(pk.position.size());
@@ -302,6 +424,20 @@ SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
   // Bonds, with the real contact properties back.
   sys.materials = saved;
   sys.materials.bond_law = bond_law;
+  if (!voxels.empty()) {  // pores, from the settled positions
+    const auto label = geom::label_points(voxels.image, P.pos, voxels.windows, kUnlabelled);
+    std::vector<char> remove(P.size());
+    std::size_t removed = 0;
+    for (std::size_t i = 0; i < P.size(); ++i) {
+      remove[i] = label[i] == kPoreLabel;
+      removed += remove[i];
+    }
+    if (removed > 0) {
+      remove_particles(sys, remove);
+      log::info("sample.voxels: {} particles removed in pore voxels", removed);
+    }
+    info.pore_particles = removed;
+  }
   if (bond_law != BondLaw::None) info.bonds = sys.install_bonds(cfg.real("sample.bond_gap"));
   {  // Floaters: particles held by fewer than 3 (2D: 2) bonds (PFC counts contacts; we report them).
     std::vector<int> degree(P.size(), 0);

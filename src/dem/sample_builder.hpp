@@ -2,9 +2,14 @@
 // Cundall 2004, section 3.1): dense random packing in a rigid vessel -> frictionless
 // equilibration -> isotropic stress reduced below a set value (locked-in stress) -> bonds
 // installed between particles closer than a gap -> vessel removed. Groups are assigned from
-// primitives and closed STL surfaces (point-in-mesh of the particle centres).
+// primitives and closed STL surfaces (point-in-mesh of the particle centres), then from a
+// segmented voxel image (CT-like PGM stack, grey-value windows as in seed 000 s. 2.2), whose
+// "pore" window removes particles before bonding.
 #pragma once
+#include <vector>
+
 #include "dem/dem_system.hpp"
+#include "geometry/voxel_image.hpp"
 #include "io/params.hpp"
 
 namespace ff::dem {
@@ -21,10 +26,27 @@ struct SampleInfo {
   Real locked_in_stress = 0;  // mean stress when bonds were installed [Pa], compression > 0
   std::size_t bonds = 0;
   std::size_t floaters = 0;   // particles with fewer than 3 (3D) or 2 (2D) bonds
+  std::size_t pore_particles = 0;  // removed before bonding: centre in a voxel of the "pore" window
   double genesis_seconds = 0;
 };
 
 void declare_sample_params(ParamTable& t);
+
+// Label of the grey-value window named "pore": particles whose centre lies in such a voxel are removed.
+inline constexpr int kPoreLabel = -1;
+
+// The image of sample.voxels.* with its windows (label: group index or kPoreLabel); no windows
+// when sample.voxels.folder is empty.
+struct VoxelGroups {
+  geom::VoxelImage image;
+  std::vector<geom::GreyRange> windows;
+  bool empty() const { return windows.empty(); }
+};
+// Reads and checks sample.voxels.* (folder relative to the scenario file's folder). Throws
+// InputError naming the key for a missing or bad stack, windows that overlap or have min > max,
+// a name that is neither a group nor "pore", and windows without a folder (or the reverse).
+VoxelGroups read_voxel_groups(const Config& cfg, const Materials& materials);
+
 // Builds particles, groups, masses and bonds in `sys` (whose settings/materials are set),
 // removes the vessel and leaves no walls. Throws InputError for bad sample keys.
 SampleInfo build_sample(const Config& cfg, DemSystem& sys);

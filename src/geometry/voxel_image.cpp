@@ -20,6 +20,28 @@ std::uint16_t VoxelImage::at(const Vec3& point) const {
   return value[index(static_cast<int>(fi), static_cast<int>(fj), static_cast<int>(fk))];
 }
 
+bool VoxelImage::contains(const Vec3& point) const {
+  const Vec3 f = (point - origin).cwiseQuotient(spacing);
+  const Real fi = std::floor(f.x() + 0.5), fj = std::floor(f.y() + 0.5), fk = std::floor(f.z() + 0.5);
+  return fi >= 0 && fj >= 0 && fk >= 0 && fi < nx && fj < ny && fk < nz;  // false for NaN
+}
+
+std::vector<int> label_points(const VoxelImage& image, std::span<const Vec3> points,
+                              std::span<const GreyRange> ranges, int unlabelled) {
+  std::vector<int> label(points.size(), unlabelled);
+  for (std::size_t n = 0; n < points.size(); ++n) {
+    if (!image.contains(points[n])) continue;
+    const std::uint16_t v = image.at(points[n]);
+    for (const GreyRange& r : ranges) {
+      if (v >= r.min && v <= r.max) {
+        label[n] = r.label;
+        break;
+      }
+    }
+  }
+  return label;
+}
+
 namespace {
 
 [[noreturn]] void fail(const std::filesystem::path& file, const std::string& what) {

@@ -5,6 +5,7 @@
 #pragma once
 #include <cstdint>
 #include <filesystem>
+#include <span>
 #include <vector>
 
 #include "core/types.hpp"
@@ -22,7 +23,21 @@ struct VoxelImage {
   }
   // Value of the voxel containing `point` (nearest voxel centre); 0 outside the image.
   std::uint16_t at(const Vec3& point) const;
+  // Whether `point` lies in a voxel of the image (0 from at() is then a real grey value).
+  bool contains(const Vec3& point) const;
 };
+
+// A window of grey values [min, max] (both included) that maps to `label`: a material group, or
+// a caller's code such as "pore" (segmentation by thresholds, as for CT scans in seed 000 s. 2.2).
+struct GreyRange {
+  std::uint16_t min = 0, max = 0;
+  int label = 0;
+};
+
+// For each point: the label of the first range holding the value of the voxel that contains the
+// point, or `unlabelled` for points outside the image and values that no range holds.
+std::vector<int> label_points(const VoxelImage& image, std::span<const Vec3> points,
+                              std::span<const GreyRange> ranges, int unlabelled);
 
 // Reads every *.pgm file of `folder` (binary P5, maxval <= 65535: 8-bit for maxval < 256, else
 // 16-bit big-endian), sorted by file name (zero-pad the numbers: slice_010 sorts after slice_009).
@@ -36,6 +51,8 @@ void write_pgm_stack(const std::filesystem::path& folder, const VoxelImage& imag
 }  // namespace ff::geom
 
 namespace ff {
+using geom::GreyRange;
+using geom::label_points;
 using geom::read_pgm_stack;
 using geom::VoxelImage;
 using geom::write_pgm_stack;
