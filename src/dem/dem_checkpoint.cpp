@@ -10,6 +10,7 @@ template <> struct is_checkpoint_pod<dem::ParallelBond::State> : std::true_type 
 template <> struct is_checkpoint_pod<dem::RotationalBond::State> : std::true_type {};
 template <> struct is_checkpoint_pod<dem::ContactState> : std::true_type {};
 template <> struct is_checkpoint_pod<dem::CrackEvent> : std::true_type {};
+template <> struct is_checkpoint_pod<dem::PairLoad> : std::true_type {};
 }  // namespace ff
 
 namespace ff::dem {
@@ -74,9 +75,16 @@ void save_dem(CheckpointWriter& w, const DemSystem& s) {
   for (std::size_t k = 0; k < wc.size(); ++k) {
     w.put(fmt::format("dem.wall{}.particle", k), wc[k].particle);
     w.put(fmt::format("dem.wall{}.state", k), wc[k].state);
+    w.put(fmt::format("dem.wall{}.load", k), wc[k].load);  // servos read the last step's loads
   }
   w.put("dem.cracks", s.cracks.events);
   w.put_value("dem.wall_motion", s.wall_motion_since_build());
+  if (s.membrane) {
+    const auto x = s.membrane->vertices(), v = s.membrane->vertex_velocities();
+    w.put("dem.membrane.x", std::vector<Vec3>(x.begin(), x.end()));
+    w.put("dem.membrane.v", std::vector<Vec3>(v.begin(), v.end()));
+    w.put_value("dem.membrane.pressure", s.membrane->settings().pressure);
+  }
 }
 
 void load_dem(CheckpointReader& r, DemSystem& s) {
@@ -147,9 +155,21 @@ void load_dem(CheckpointReader& r, DemSystem& s) {
   for (std::size_t k = 0; k < wc.size(); ++k) {
     r.get(fmt::format("dem.wall{}.particle", k), wc[k].particle);
     r.get(fmt::format("dem.wall{}.state", k), wc[k].state);
-    wc[k].load.assign(wc[k].particle.size(), PairLoad{});
+    r.get(fmt::format("dem.wall{}.load", k), wc[k].load);
   }
   s.wall_motion_since_build() = r.get_value<Real>("dem.wall_motion");
+  // A membrane is built by the driver from its settings before load_dem(); its vertices come
+  // back here and its candidates are searched again (contact shear history starts afresh).
+  if (s.membrane) {
+    if (!r.has("dem.membrane.x"))
+      throw InputError("checkpoint holds no flexible membrane, but the scenario has one; resume with the scenario it was written with");
+    std::vector<Vec3> x, v;
+    r.get("dem.membrane.x", x);
+    r.get("dem.membrane.v", v);
+    s.membrane->restore_vertices(x, v);
+    s.membrane->set_pressure(r.get_value<Real>("dem.membrane.pressure"));
+    s.membrane->find_candidates(s.particles.pos, s.particles.radius, s.settings.skin);
+  }
 }
 
 }  // namespace ff::dem

@@ -9,7 +9,7 @@
 
 namespace ff::dem {
 
-void DemVtkWriter::open(const std::filesystem::path& dir, bool resume, double time) {
+void DemVtkWriter::open(const std::filesystem::path& dir, bool resume, double time, bool membrane) {
   dir_ = dir;
   std::filesystem::create_directories(dir);
   particles_.open(dir / "particles.pvd", resume, time);
@@ -17,6 +17,8 @@ void DemVtkWriter::open(const std::filesystem::path& dir, bool resume, double ti
   contacts_.open(dir / "contacts.pvd", resume, time);
   cracks_.open(dir / "cracks.pvd", resume, time);
   walls_.open(dir / "walls.pvd", resume, time);
+  with_membrane_ = membrane;
+  if (membrane) membrane_.open(dir / "membrane.pvd", resume, time);
 }
 
 namespace {
@@ -158,6 +160,11 @@ void DemVtkWriter::write(const DemSystem& sys, long index, Real wall_extent) {
     const std::string f = "walls_" + tag + ".vtp";
     write_vtp(dir_ / f, pts, VtpCells{VtpCells::Triangles, tri}, {}, cd);
     walls_.add(sys.time, f);
+  }
+  if (with_membrane_ && sys.membrane) {
+    const std::string f = "membrane_" + tag + ".vtp";
+    sys.membrane->write_vtk(dir_ / f);
+    membrane_.add(sys.time, f);
   }
 }
 

@@ -11,14 +11,16 @@ namespace ff::dem {
 class DemVtkWriter {
  public:
   // Opens the series under `dir` (created). With `resume`, keeps the snapshots up to `time`.
-  void open(const std::filesystem::path& dir, bool resume = false, double time = 0);
+  // `membrane`: also a series of the flexible membrane's triangles (membrane.pvd).
+  void open(const std::filesystem::path& dir, bool resume = false, double time = 0, bool membrane = false);
   // Writes snapshot number `index` at the system's current time.
   void write(const DemSystem& sys, long index, Real wall_extent);
   long snapshots() const { return static_cast<long>(particles_.entries().size()); }
 
  private:
   std::filesystem::path dir_;
-  PvdSeries particles_, bonds_, contacts_, cracks_, walls_;
+  PvdSeries particles_, bonds_, contacts_, cracks_, walls_, membrane_;
+  bool with_membrane_ = false;
 };
 
 // Writes all crack events in [from, end) to `csv` (appending; header written when from == 0).

@@ -163,6 +163,7 @@ void DemSystem::rebuild_neighbors() {
     wc.load.assign(wc.particle.size(), PairLoad{});
   }
   wall_motion_since_build_ = 0;
+  if (membrane) membrane->find_candidates(particles.pos, particles.radius, settings.skin);
   compact_bonds();
 }
 
@@ -319,6 +320,12 @@ void DemSystem::wall_forces(const std::vector<typename Law::Params>& params) {
   }
 }
 
+template <class Law>
+void DemSystem::membrane_forces(const std::vector<typename Law::Params>& params) {
+  const MembraneParticles p{particles.pos, particles.vel, particles.omega, particles.radius, particles.group};
+  membrane->compute_forces<Law>(p, std::span<const typename Law::Params>(params), materials.groups(), settings.dt);
+}
+
 void DemSystem::gather_and_integrate() {
   const std::size_t n = particles.size();
   const auto adj_off = nl_.adjacency_offsets();
@@ -348,6 +355,7 @@ void DemSystem::gather_and_integrate() {
       M[wc.particle[k]] += wc.load[k].mA;
     }
   }
+  if (membrane) membrane->add_loads_to(F, M);  // serial, in candidate order
   const Real dt = settings.dt, alpha = settings.local_damping;
   const Vec3 g = settings.gravity;
   const bool planar = settings.dim == 2;
@@ -401,7 +409,11 @@ void DemSystem::step() {
   };
   Real wall_step = 0;
   for (auto& w : walls) wall_step = std::max(wall_step, w.step_motion(settings.dt));
-  if (nl_.needs_rebuild(particles.pos, wall_motion_since_build_ + wall_step)) rebuild_neighbors();
+  // Boundaries that moved since the last build use up the skin like particles do.
+  Real boundary_motion = wall_motion_since_build_ + wall_step;
+  if (membrane)
+    boundary_motion = std::max(boundary_motion, membrane->motion_since_build() + membrane->max_step_motion(settings.dt));
+  if (nl_.needs_rebuild(particles.pos, boundary_motion)) rebuild_neighbors();
   lap(stage_times.neighbors);
   if (materials.contact_law == ContactLaw::Linear) contact_forces<LinearContact>(materials.linear);
   else contact_forces<HertzMindlinContact>(materials.hertz);
@@ -416,9 +428,15 @@ void DemSystem::step() {
   lap(stage_times.bonds);
   if (materials.contact_law == ContactLaw::Linear) wall_forces<LinearContact>(materials.linear);
   else wall_forces<HertzMindlinContact>(materials.hertz);
+  if (membrane) {
+    if (materials.contact_law == ContactLaw::Linear) membrane_forces<LinearContact>(materials.linear);
+    else membrane_forces<HertzMindlinContact>(materials.hertz);
+  }
   lap(stage_times.walls);
   gather_and_integrate();
   lap(stage_times.integrate);
+  if (membrane)
+    membrane->move(settings.dt, walls[membrane_bottom_wall].point.z(), walls[membrane_top_wall].point.z());
   for (auto& w : walls) w.move(settings.dt);
   wall_motion_since_build_ += wall_step;
   time += settings.dt;
@@ -470,6 +488,14 @@ Real DemSystem::critical_time_step() const {
       const Real kw = pair_stiffness(materials.pair(grp[i], grp[i]), r[i], 0, -g.gap);
       kt[i] += kw;
       kr[i] += kw * r[i] * r[i];
+    }
+  }
+  if (membrane) {
+    const auto cp = membrane->candidate_particles();
+    const auto ck = membrane->candidate_stiffness();
+    for (std::size_t c = 0; c < cp.size(); ++c) {
+      kt[cp[c]] += ck[c];
+      kr[cp[c]] += ck[c] * r[cp[c]] * r[cp[c]];
     }
   }
   Real dt = std::numeric_limits<Real>::infinity();

@@ -4,10 +4,12 @@
 // Every per-pair result is written to its own slot and gathered per particle in increasing
 // pair order, so results are bit-identical on any number of OpenMP threads.
 #pragma once
+#include <optional>
 #include <vector>
 
 #include "dem/crack_log.hpp"
 #include "dem/materials.hpp"
+#include "dem/membrane/flexible_membrane.hpp"
 #include "dem/neighbor_list.hpp"
 #include "dem/particle_store.hpp"
 #include "dem/walls.hpp"
@@ -47,6 +49,12 @@ class DemSystem {
   Materials materials;
   std::vector<Wall> walls;
   CrackLog cracks;
+  // Optional flexible membrane (triaxial tests). Its loaded band runs between the planes of
+  // walls[membrane_bottom_wall] and walls[membrane_top_wall] (the platens); it steps with the
+  // system: candidates at each neighbour rebuild, forces after the walls, loads in the gather,
+  // servo and vertex update after the particles move.
+  std::optional<FlexibleMembrane> membrane;
+  int membrane_bottom_wall = 0, membrane_top_wall = 1;
 
   // Bonds: flat (i, j) list with i < j, pair type, state of the active law.
   std::vector<Index> bond_i, bond_j;
@@ -101,6 +109,7 @@ class DemSystem {
   template <class Law> void contact_forces(const std::vector<typename Law::Params>& params);
   template <class Law, class Mat> void bond_forces(const std::vector<Mat>& mats, std::vector<typename Law::State>& st);
   template <class Law> void wall_forces(const std::vector<typename Law::Params>& params);
+  template <class Law> void membrane_forces(const std::vector<typename Law::Params>& params);
   void record_bond_failures();
   void gather_and_integrate();
   Real pair_stiffness(int pair_type, Real rA, Real rB, Real overlap) const;
@@ -153,6 +162,12 @@ Mat3 DemSystem::average_stress(Pred inside, Real volume) const {
       if (!walls[w].geometry(g, x[p], particles.radius[p])) continue;
       s += (g.xc - x[p]) * (-f_wall).transpose();
     }
+  }
+  if (membrane) {  // the element pushes the particle with -f at the contact point
+    const auto cp = membrane->candidate_particles();
+    const auto cl = membrane->candidate_loads();
+    for (std::size_t c = 0; c < cp.size(); ++c)
+      if (cl[c].f.squaredNorm() > 0 && inside(x[cp[c]])) s += (cl[c].xc - x[cp[c]]) * (-cl[c].f).transpose();
   }
   return s / volume;
 }

@@ -6,6 +6,7 @@
 #include "core/error.hpp"
 #include "drivers/common_params.hpp"
 #include "drivers/driver.hpp"
+#include "drivers/triaxial/triaxial_driver.hpp"
 #include "drivers/ucs/ucs_driver.hpp"
 #include "drivers/flow/flow_drivers.hpp"
 // Each driver's header declares one function returning its Driver record.
@@ -17,6 +18,7 @@ namespace {
 const std::vector<Driver>& driver_list() {
   static const std::vector<Driver> list = {
       drivers::ucs_driver(),
+      drivers::triaxial_driver(),
       drivers::flow_poiseuille_driver(),
       drivers::flow_cavity_driver(),
       drivers::flow_cylinder_driver(),

@@ -1,0 +1,53 @@
+// Boundary control and measurement of the triaxial test: the lateral confinement (flexible
+// membrane or servo-controlled rigid cylinder), the platen servo of the isotropic stage, and
+// the measurement spheres that check the stress inside the sample against the boundary.
+// Rock-mechanics signs here: compression positive.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "dem/dem_system.hpp"
+#include "dem/sample_builder.hpp"
+
+namespace ff::drivers {
+
+enum class LateralKind : std::uint8_t { Membrane = 0, RigidCylinder = 1 };
+
+// Servo gains shared by the platens and the rigid cylinder (PFC wall servo, METHODS.md 3):
+// v = G (F_target - F), G = alpha / (k dt), |v| <= v_max; v_max towards the sample when k = 0.
+struct ServoSettings {
+  Real v_max = 0.01;     // [m/s]
+  Real relaxation = 0.8; // alpha [-]
+};
+
+// Mean axial stress on the two platens (walls 0 and 1) over the area `area` [Pa].
+Real platen_stress(const dem::DemSystem& sys, Real area);
+// Sets both platens' velocities so their stress approaches `target` [Pa] (isotropic stage).
+void servo_platens(dem::DemSystem& sys, Real target, Real area, const ServoSettings& s);
+
+// Radial force of the particles on the rigid cylinder wall `w`, outward positive [N].
+Real cylinder_radial_force(dem::DemSystem& sys, std::size_t w);
+// Sets the cylinder's radial velocity so the pressure on its band between the platens
+// approaches `target` [Pa].
+void servo_cylinder(dem::DemSystem& sys, std::size_t w, Real target, const ServoSettings& s);
+
+// Lateral confinement actually applied [Pa]: the membrane's mean (-sum F^c / loaded area) or
+// the cylinder's radial force over its band area.
+Real applied_confinement(dem::DemSystem& sys, LateralKind kind, std::size_t cylinder_wall);
+// Volume enclosed between the platens by the lateral boundary [m^3].
+Real enclosed_volume(const dem::DemSystem& sys, LateralKind kind, std::size_t cylinder_wall);
+
+// Measurement spheres on the sample axis ([S000] sec. 5.1 checks the isotropic state with
+// PFC measurement spheres). Average stress over the particles whose centres lie in a sphere,
+// with PFC's porosity correction sigma = -(1 - n)/sum(V_p) sum_p sum_c (x_c - x_p) f_c
+// (Itasca PFC 5 "measure" logic; METHODS.md 1.7), n = the sample's porosity.
+struct SphereStress {
+  Vec3 centre;
+  Real radius;
+  int particles;
+  Real axial, lateral;  // -sigma_zz and -(sigma_xx + sigma_yy)/2 [Pa]
+};
+std::vector<SphereStress> measure_spheres(const dem::DemSystem& sys, const dem::SampleInfo& info, Real z_bottom,
+                                          Real z_top, Real radius_fraction);
+
+}  // namespace ff::drivers

@@ -1,0 +1,501 @@
+#include "drivers/triaxial/triaxial_driver.hpp"
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <filesystem>
+
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "core/progress.hpp"
+#include "dem/dem_checkpoint.hpp"
+#include "dem/dem_output.hpp"
+#include "dem/dem_params.hpp"
+#include "dem/sample_builder.hpp"
+#include "drivers/triaxial/triaxial_boundary.hpp"
+#include "drivers/ucs/ucs_measure.hpp"
+#include "fracflow/version.hpp"
+#include "io/csv.hpp"
+#include "io/json_out.hpp"
+#include "io/plot.hpp"
+
+namespace fs = std::filesystem;
+
+namespace ff::drivers {
+
+namespace {
+
+void declare(ParamTable& t) {
+  dem::declare_dem_params(t);
+  dem::declare_sample_params(t);
+  t.real("triaxial.confining_pressure", 5e6, "Pa", "confining pressure sigma3 (lateral, and axial in the isotropic stage)")
+      .positive();
+  t.string("triaxial.lateral", "membrane", "lateral confinement: flexible membrane of servo-controlled triangles, or a rigid cylinder with a servo on its radius")
+      .one_of({"membrane", "rigid_cylinder"});
+  t.real("triaxial.platen_velocity", 0.05, "m/s", "deviatoric stage: speed of each platen towards the sample").positive();
+  t.real("triaxial.platen_friction", 0.1, "-", "friction between platens and particles (seed 000: 0.1)").non_negative();
+  t.real("triaxial.servo_velocity", 1.0, "m/s",
+         "speed cap of every servo (isotropic-stage platens, membrane, cylinder); must exceed the sample's lateral bulging "
+         "speed, several times the platen velocity (seed 000 uses 0.01 with slower platens)")
+      .positive();
+  t.real("triaxial.servo_relaxation", 0.8, "-", "servo relaxation factor alpha (PFC default 0.8)").open_range(0, 1).at_most(1);
+  t.real("triaxial.isotropic_tolerance", 0.02, "-", "isotropic stage ends when platen stress and confinement are within this fraction of sigma3")
+      .open_range(0, 1);
+  t.integer("triaxial.isotropic_max_steps", 200000, "steps", "step cap of the isotropic stage").positive();
+  t.real("triaxial.measurement_sphere_radius", 0.6, "-", "radius of the three measurement spheres on the axis, as a fraction of the sample radius")
+      .open_range(0, 1);
+  t.real("triaxial.stop_fraction", 0.6, "-", "stop when the differential stress has fallen below this fraction of its peak").open_range(0, 1);
+  t.real("triaxial.max_strain", 0.06, "-", "stop at this axial strain (deviatoric stage) in any case").positive();
+  t.integer("triaxial.series_interval", 100, "steps", "steps between rows of series.csv").positive();
+  t.real("triaxial.vtk_strain_interval", 2e-3, "-", "axial strain between VTK snapshots").positive();
+  t.integer("triaxial.checkpoint_interval", 20000, "steps", "steps between checkpoints (0: only at the end and on interruption)").non_negative();
+  t.integer("membrane.n_theta", 24, "-", "membrane: square units around the circumference (seed 000 demo: 16)").at_least(6);
+  t.integer("membrane.n_z", 0, "-", "membrane: rows of units along the axis (0: nearly square units)").non_negative();
+  t.real("membrane.length_factor", 1.2, "-", "membrane sleeve length / sample height (longer than the sample)").at_least(1);
+  t.real("membrane.clearance", 0.01, "-", "initial gap between sample and membrane facets, as a fraction of the sample radius").non_negative();
+  t.real("membrane.min_radius_fraction", 0.9, "-", "vertices never come closer to the axis than this fraction of the sample radius")
+      .open_range(0, 1);
+  t.real("membrane.friction", 0.0, "-", "particle-membrane friction (0: pure pressure, as a rubber sleeve with a lubricated contact)")
+      .non_negative();
+}
+
+// Driver state that must survive a restart.
+struct TriaxialState {
+  int stage = 0;  // 0 isotropic, 1 deviatoric
+  long iso_steps = 0, iso_rows = 0, rows = 0, peak_row = 0, cracks_written = 0, vtk_index = 0;
+  int iso_converged = 0, finished = 0;
+  Real peak_diff = 0, strain_at_peak = 0, conf_at_peak = 0;
+  Real h_dev0 = 0, v_dev0 = 0, next_vtk_strain = 0;
+  Real iso_axial = 0, iso_conf = 0, iso_sphere_error = 0;
+  Real sphere_axial[3] = {0, 0, 0}, sphere_lateral[3] = {0, 0, 0};
+  int sphere_particles[3] = {0, 0, 0};
+  int iso_cracks = 0;
+  Real whole_axial = 0, whole_lateral = 0;  // Love-Weber average of the whole sample over the enclosed volume
+};
+
+struct SampleRecord {  // SampleInfo without its non-trivial members
+  int dim, axis, cylinder;
+  Real height, width, area, volume, porosity, locked_in_stress, genesis_seconds;
+  std::uint64_t bonds, floaters;
+};
+
+}  // namespace
+}  // namespace ff::drivers
+
+namespace ff {
+template <> struct is_checkpoint_pod<drivers::TriaxialState> : std::true_type {};
+template <> struct is_checkpoint_pod<drivers::SampleRecord> : std::true_type {};
+template <> struct is_checkpoint_pod<dem::MembraneSettings> : std::true_type {};
+}  // namespace ff
+
+namespace ff::drivers {
+namespace {
+
+SampleRecord record(const dem::SampleInfo& i) {
+  return {i.dim, i.axis, i.cylinder, i.height, i.width, i.area, i.volume, i.porosity, i.locked_in_stress,
+          i.genesis_seconds, i.bonds, i.floaters};
+}
+dem::SampleInfo info_from(const SampleRecord& s) {
+  dem::SampleInfo i;
+  i.dim = s.dim;
+  i.axis = s.axis;
+  i.cylinder = s.cylinder;
+  i.height = s.height;
+  i.width = s.width;
+  i.area = s.area;
+  i.volume = s.volume;
+  i.porosity = s.porosity;
+  i.locked_in_stress = s.locked_in_stress;
+  i.genesis_seconds = s.genesis_seconds;
+  i.bonds = s.bonds;
+  i.floaters = s.floaters;
+  return i;
+}
+
+// The membrane around a sample of radius R between the platens: a sleeve `length_factor`
+// times the sample height, centred on it, its facets `clearance` R outside the sample.
+dem::MembraneSettings membrane_settings(const Config& cfg, const dem::DemSystem& sys, const dem::SampleInfo& info) {
+  dem::MembraneSettings m;
+  const Real R = 0.5 * info.width;
+  const Real z0 = sys.walls[0].point.z(), z1 = sys.walls[1].point.z(), h = z1 - z0;
+  m.n_theta = static_cast<int>(cfg.integer("membrane.n_theta"));
+  m.radius = dem::membrane_circumradius(R * (1 + cfg.real("membrane.clearance")), m.n_theta);
+  m.height = cfg.real("membrane.length_factor") * h;
+  m.z0 = 0.5 * (z0 + z1) - 0.5 * m.height;
+  const long nz = cfg.integer("membrane.n_z");
+  m.n_z = nz > 0 ? static_cast<int>(nz) : dem::membrane_square_rows(m.radius, m.n_theta, m.height);
+  m.pressure = cfg.real("triaxial.confining_pressure");
+  m.v_max = cfg.real("triaxial.servo_velocity");
+  m.relaxation = cfg.real("triaxial.servo_relaxation");
+  m.r_min = cfg.real("membrane.min_radius_fraction") * R;
+  m.friction = cfg.real("membrane.friction");
+  m.parallel_min = sys.settings.parallel_min;
+  return m;
+}
+
+void add_rigid_cylinder(dem::DemSystem& sys, const dem::SampleInfo& info, Real friction) {
+  dem::Wall c;
+  c.name = "cylinder";
+  c.kind = dem::Wall::Kind::CylinderInside;
+  c.point = Vec3::Zero();
+  c.normal = Vec3::UnitZ();
+  c.radius = 0.5 * info.width;
+  c.friction = friction;
+  sys.walls.push_back(c);
+  sys.initialise();
+}
+
+void write_checkpoint(const fs::path& dir, const dem::DemSystem& sys, const TriaxialState& st, const dem::SampleInfo& info) {
+  fs::create_directories(dir);
+  CheckpointWriter w(dir / "state.ffcp");
+  if (sys.membrane) w.put_value("triaxial.membrane_settings", sys.membrane->settings());
+  dem::save_dem(w, sys);
+  w.put_value("triaxial.state", st);
+  w.put_value("triaxial.sample", record(info));
+  w.commit();
+}
+
+void read_checkpoint(const fs::path& dir, dem::DemSystem& sys, TriaxialState& st, dem::SampleInfo& info) {
+  CheckpointReader r(dir / "state.ffcp");
+  if (r.has("triaxial.membrane_settings")) sys.membrane.emplace(r.get_value<dem::MembraneSettings>("triaxial.membrane_settings"));
+  dem::load_dem(r, sys);
+  st = r.get_value<TriaxialState>("triaxial.state");
+  info = info_from(r.get_value<SampleRecord>("triaxial.sample"));
+}
+
+nlohmann::json params_json(const Config& cfg) {
+  nlohmann::json j = nlohmann::json::object();
+  for (auto& [k, v] : cfg.resolved_values()) std::visit([&](const auto& x) { j[k] = x; }, v);
+  return j;
+}
+
+std::vector<std::string> columns(const dem::Materials& mat) {
+  std::vector<std::string> c = {"step", "time", "axial_strain", "axial_stress", "differential_stress", "confinement",
+                                "lateral_strain", "volumetric_strain", "cracks_tensile", "cracks_shear", "cracks_total"};
+  for (int a = 0; a < mat.groups(); ++a)
+    for (int b = a; b < mat.groups(); ++b) {
+      const std::string p = mat.group_names[a] + "-" + mat.group_names[b];
+      c.push_back("cracks_" + p + "_tensile");
+      c.push_back("cracks_" + p + "_shear");
+    }
+  for (const char* s : {"intact_bonds", "kinetic_energy", "unbalanced_force_ratio"}) c.emplace_back(s);
+  return c;
+}
+
+void make_plots(const fs::path& out, const Config& cfg) {
+  if (!cfg.boolean("output.plots")) return;
+  fs::create_directories(out / "plots");
+  PlotSpec a;
+  a.title = fmt::format("Triaxial compression, sigma3 = {:g} MPa: stress and cracks", 1e-6 * cfg.real("triaxial.confining_pressure"));
+  a.x = "axial_strain";
+  a.x_scale = 100;
+  a.xlabel = "axial strain [%]";
+  a.y = {"differential_stress"};
+  a.y_scale = 1e-6;
+  a.ylabel = "differential stress [MPa]";
+  a.y2 = {"cracks_total", "cracks_tensile", "cracks_shear"};
+  a.y2label = "number of cracks";
+  plot_series(out / "series.csv", out / "plots" / "stress_strain_cracks.png", a);
+  PlotSpec b;
+  b.title = "Triaxial compression: strains";
+  b.x = "axial_strain";
+  b.x_scale = 100;
+  b.xlabel = "axial strain [%]";
+  b.y = {"lateral_strain", "volumetric_strain"};
+  b.y_scale = 100;
+  b.ylabel = "strain [%] (compression > 0)";
+  plot_series(out / "series.csv", out / "plots" / "strains.png", b);
+  PlotSpec c;
+  c.title = "Applied lateral confinement";
+  c.x = "axial_strain";
+  c.x_scale = 100;
+  c.xlabel = "axial strain [%]";
+  c.y = {"confinement"};
+  c.y_scale = 1e-6;
+  c.ylabel = "confinement [MPa]";
+  plot_series(out / "series.csv", out / "plots" / "confinement.png", c);
+}
+
+RunStatus run(const Config& cfg, const RunOptions& opt) {
+  const auto wall_start = std::chrono::steady_clock::now();
+  const Real p = cfg.real("triaxial.confining_pressure");
+  const LateralKind kind = cfg.string("triaxial.lateral") == "membrane" ? LateralKind::Membrane : LateralKind::RigidCylinder;
+  const ServoSettings servo{cfg.real("triaxial.servo_velocity"), cfg.real("triaxial.servo_relaxation")};
+  dem::DemSystem sys;
+  sys.settings = dem::build_settings(cfg);
+  sys.materials = dem::build_materials(cfg);
+  if (sys.settings.dim != 3) cfg.fail("dem.dim", "a triaxial test needs a 3D cylinder sample (dim = 3)");
+  if (cfg.string("sample.shape") != "cylinder") cfg.fail("sample.shape", "a triaxial test needs shape = \"cylinder\"");
+  dem::SampleInfo info;
+  TriaxialState st;
+  const std::size_t cyl = 2;  // the rigid cylinder is wall 2 (after the platens)
+  const fs::path cp_dir = opt.out_dir / "checkpoint";
+  if (opt.resume) {
+    read_checkpoint(cp_dir, sys, st, info);
+    if (st.finished) {
+      log::info("this run had already finished; nothing to resume");
+      return RunStatus::Finished;
+    }
+    log::info("resuming at step {} (t = {:.6g} s), {} stage", sys.step_count, sys.time, st.stage ? "deviatoric" : "isotropic");
+  } else {
+    info = dem::build_sample(cfg, sys);
+    dem::add_platens(sys, info, cfg.real("triaxial.platen_friction"));
+    if (kind == LateralKind::Membrane) {
+      sys.membrane.emplace(membrane_settings(cfg, sys, info));
+      sys.rebuild_neighbors();
+      log::info("flexible membrane: {} x {} units, {} triangles, sleeve radius {:.4g} m", sys.membrane->settings().n_theta,
+                sys.membrane->settings().n_z, sys.membrane->element_count(), sys.membrane->settings().radius);
+    } else {
+      add_rigid_cylinder(sys, info, cfg.real("membrane.friction"));
+    }
+    dem::choose_time_step(cfg, sys);
+  }
+  const Real area = info.area;  // initial cross-section (stresses on it, as the UCS test)
+
+  // Outputs. On resume, rows after the checkpoint are dropped (they are recomputed identically).
+  const auto cols = columns(sys.materials);
+  const std::vector<std::string> iso_cols = {"step", "time", "axial_stress", "confinement", "unbalanced_force_ratio"};
+  CsvWriter series, iso;
+  if (opt.resume) {
+    iso.reopen(opt.out_dir / "isotropic.csv", iso_cols, static_cast<std::size_t>(st.iso_rows));
+    if (st.stage == 1) series.reopen(opt.out_dir / "series.csv", cols, static_cast<std::size_t>(st.rows));
+  } else {
+    iso.open(opt.out_dir / "isotropic.csv", iso_cols);
+  }
+  const fs::path cracks_csv = opt.out_dir / "cracks.csv";
+  {
+    dem::CrackLog head;
+    head.events.assign(sys.cracks.events.begin(), sys.cracks.events.begin() + st.cracks_written);
+    dem::append_cracks_csv(cracks_csv, head, sys.materials, 0);
+  }
+  const bool vtk = cfg.boolean("output.vtk");
+  dem::DemVtkWriter writer;
+  const Real extent = 1.6 * std::max(info.width, info.height);
+  if (vtk) writer.open(opt.out_dir / "vtk", opt.resume, sys.time, kind == LateralKind::Membrane);
+  if (vtk && !opt.resume) writer.write(sys, st.vtk_index++, extent);
+
+  const long every = cfg.integer("triaxial.series_interval");
+  const long cp_every = cfg.integer("triaxial.checkpoint_interval");
+  const long iso_max = cfg.integer("triaxial.isotropic_max_steps");
+  const Real iso_tol = cfg.real("triaxial.isotropic_tolerance");
+  const Real stop_fraction = cfg.real("triaxial.stop_fraction"), max_strain = cfg.real("triaxial.max_strain");
+  const Real vtk_every = cfg.real("triaxial.vtk_strain_interval"), v_platen = cfg.real("triaxial.platen_velocity");
+  Progress progress("triaxial", opt.progress_interval_s);
+  std::vector<Real> e_hist, s_hist, l_hist;
+  if (opt.resume && st.stage == 1 && st.rows > 0) {  // the elastic fit needs the whole curve
+    const CsvTable t = read_csv(opt.out_dir / "series.csv");
+    e_hist = t.column("axial_strain");
+    s_hist = t.column("differential_stress");
+    l_hist = t.column("lateral_strain");
+  }
+  int iso_ok_rows = 0;
+  RunStatus status = RunStatus::Finished;
+  std::string stop_reason;
+
+  auto start_deviatoric = [&] {
+    st.stage = 1;
+    st.h_dev0 = sys.walls[1].point.z() - sys.walls[0].point.z();
+    st.v_dev0 = enclosed_volume(sys, kind, cyl);
+    sys.walls[0].velocity = Vec3(0, 0, v_platen);
+    sys.walls[1].velocity = Vec3(0, 0, -v_platen);
+    st.next_vtk_strain = vtk_every;
+    st.iso_cracks = static_cast<int>(sys.cracks.total());
+    series.open(opt.out_dir / "series.csv", cols);
+    if (vtk) writer.write(sys, st.vtk_index++, extent);
+  };
+
+  try {
+    for (;;) {
+      for (long k = 0; k < every; ++k) {  // servos act every step
+        if (st.stage == 0) servo_platens(sys, p, area, servo);
+        if (kind == LateralKind::RigidCylinder) servo_cylinder(sys, cyl, p, servo);
+        sys.step();
+      }
+      const Real axial = platen_stress(sys, area);
+      const Real conf = applied_confinement(sys, kind, cyl);
+      if (st.stage == 0) {
+        st.iso_steps += every;
+        const Real ubf = sys.max_unbalanced_force_ratio();
+        const double row[] = {static_cast<double>(sys.step_count), sys.time, axial, conf, ubf};
+        iso.row(row);
+        ++st.iso_rows;
+        // Converged when both boundary stresses have stayed within the tolerance for 5 rows
+        // and the sample is near equilibrium.
+        const bool ok = std::abs(axial - p) <= iso_tol * p && std::abs(conf - p) <= iso_tol * p && ubf < 0.05;
+        iso_ok_rows = ok ? iso_ok_rows + 1 : 0;
+        progress.update(sys.step_count, sys.time, std::min(1.0, static_cast<double>(st.iso_steps) / iso_max),
+                        fmt::format("isotropic: platens {:.3f} MPa, confinement {:.3f} MPa (target {:.3f})", 1e-6 * axial,
+                                    1e-6 * conf, 1e-6 * p));
+        if (iso_ok_rows >= 5 || st.iso_steps >= iso_max) {
+          st.iso_converged = iso_ok_rows >= 5;
+          if (!st.iso_converged)
+            log::warn("isotropic stage did not converge in {} steps (platens {:.3f} MPa, confinement {:.3f} MPa, target "
+                      "{:.3f} MPa); continuing. Raise triaxial.isotropic_max_steps or triaxial.servo_velocity",
+                      st.iso_steps, 1e-6 * axial, 1e-6 * conf, 1e-6 * p);
+          st.iso_axial = axial;
+          st.iso_conf = conf;
+          const auto spheres = measure_spheres(sys, info, sys.walls[0].point.z(), sys.walls[1].point.z(),
+                                               cfg.real("triaxial.measurement_sphere_radius"));
+          st.iso_sphere_error = 0;
+          {  // By equilibrium the whole sample's average stress equals the boundary stresses.
+            const Mat3 w = sys.average_stress([](const Vec3&) { return true; }, enclosed_volume(sys, kind, cyl));
+            st.whole_axial = -w(2, 2);
+            st.whole_lateral = -0.5 * (w(0, 0) + w(1, 1));
+          }
+          for (std::size_t s = 0; s < 3; ++s) {
+            st.sphere_axial[s] = spheres[s].axial;
+            st.sphere_lateral[s] = spheres[s].lateral;
+            st.sphere_particles[s] = spheres[s].particles;
+            st.iso_sphere_error = std::max({st.iso_sphere_error, std::abs(spheres[s].axial - axial) / axial,
+                                            std::abs(spheres[s].lateral - conf) / conf});
+          }
+          log::info("isotropic stage: {} steps; platens {:.3f} MPa, confinement {:.3f} MPa; measurement spheres: axial "
+                    "{:.3f}/{:.3f}/{:.3f} MPa, lateral {:.3f}/{:.3f}/{:.3f} MPa; largest deviation from the boundary {:.1f}% "
+                    "({} 5%)",
+                    st.iso_steps, 1e-6 * axial, 1e-6 * conf, 1e-6 * st.sphere_axial[0], 1e-6 * st.sphere_axial[1],
+                    1e-6 * st.sphere_axial[2], 1e-6 * st.sphere_lateral[0], 1e-6 * st.sphere_lateral[1],
+                    1e-6 * st.sphere_lateral[2], 100 * st.iso_sphere_error,
+                    st.iso_sphere_error <= 0.05 ? "within" : "NOT within");
+          start_deviatoric();
+        }
+      } else {
+        const Real h = sys.walls[1].point.z() - sys.walls[0].point.z();
+        const Real ea = (st.h_dev0 - h) / st.h_dev0;
+        const Real ev = (st.v_dev0 - enclosed_volume(sys, kind, cyl)) / st.v_dev0;
+        const Real el = 0.5 * (ev - ea);
+        const Real diff = axial - p;
+        std::vector<double> row = {static_cast<double>(sys.step_count), sys.time, ea, axial, diff, conf, el, ev,
+                                   static_cast<double>(sys.cracks.tensile), static_cast<double>(sys.cracks.shear),
+                                   static_cast<double>(sys.cracks.total())};
+        for (int a = 0; a < sys.materials.groups(); ++a)
+          for (int b = a; b < sys.materials.groups(); ++b) {
+            row.push_back(static_cast<double>(sys.cracks.count(a, b, 1)));
+            row.push_back(static_cast<double>(sys.cracks.count(a, b, 2)));
+          }
+        row.push_back(static_cast<double>(sys.intact_bonds()));
+        row.push_back(sys.kinetic_energy());
+        row.push_back(sys.max_unbalanced_force_ratio());
+        series.row(row);
+        e_hist.push_back(ea);
+        s_hist.push_back(diff);
+        l_hist.push_back(el);  // negative when bulging, as fit_elastic expects
+        if (diff > st.peak_diff) {
+          st.peak_diff = diff;
+          st.strain_at_peak = ea;
+          st.conf_at_peak = conf;
+          st.peak_row = st.rows;
+        }
+        ++st.rows;
+        if (vtk && ea >= st.next_vtk_strain) {
+          writer.write(sys, st.vtk_index++, extent);
+          while (st.next_vtk_strain <= ea) st.next_vtk_strain += vtk_every;
+        }
+        if (st.peak_diff > 0 && st.rows > 10 && ea > st.strain_at_peak && diff < stop_fraction * st.peak_diff)
+          stop_reason = fmt::format("differential stress fell below {} of the peak", stop_fraction);
+        if (ea >= max_strain) stop_reason = fmt::format("axial strain reached triaxial.max_strain = {}", max_strain);
+        Real fraction = ea / max_strain;
+        if (st.peak_diff > 0 && ea > st.strain_at_peak)
+          fraction = std::max(fraction, (st.peak_diff - diff) / (st.peak_diff * (1 - stop_fraction)));
+        progress.update(sys.step_count, sys.time, std::min(fraction, 1.0),
+                        fmt::format("strain {:.3f}%  q {:.3f} MPa  confinement {:.3f} MPa  cracks {}", 100 * ea,
+                                    1e-6 * diff, 1e-6 * conf, sys.cracks.total()));
+      }
+      dem::append_cracks_csv(cracks_csv, sys.cracks, sys.materials, static_cast<std::size_t>(st.cracks_written));
+      st.cracks_written = static_cast<long>(sys.cracks.events.size());
+      if (!stop_reason.empty()) break;
+      if (cp_every > 0 && (sys.step_count / every) % std::max(1L, cp_every / every) == 0)
+        write_checkpoint(cp_dir, sys, st, info);
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+      if ((opt.max_wall_s > 0 && elapsed >= opt.max_wall_s) || (opt.max_steps > 0 && sys.step_count >= opt.max_steps) ||
+          (!opt.abort_file.empty() && fs::exists(opt.abort_file))) {
+        write_checkpoint(cp_dir, sys, st, info);
+        status = RunStatus::Interrupted;
+        break;
+      }
+    }
+  } catch (const NumericalError&) {
+    write_checkpoint(opt.out_dir / "checkpoint_failed", sys, st, info);
+    series.close();
+    iso.close();
+    throw;
+  }
+  series.close();
+  iso.close();
+  if (status == RunStatus::Interrupted) return status;
+
+  st.finished = 1;
+  write_checkpoint(cp_dir, sys, st, info);
+  if (vtk) writer.write(sys, st.vtk_index++, extent);
+  const ElasticFit fit = fit_elastic(e_hist, s_hist, l_hist, static_cast<std::size_t>(st.peak_row));
+  nlohmann::json j;
+  j["fracflow_version"] = kVersion;
+  j["driver"] = "triaxial";
+  j["title"] = cfg.string("title");
+  j["lateral"] = cfg.string("triaxial.lateral");
+  j["stop_reason"] = stop_reason;
+  j["confining_pressure_Pa"] = p;
+  j["peak_differential_stress_Pa"] = st.peak_diff;
+  j["peak_axial_stress_Pa"] = st.peak_diff + p;
+  j["confinement_at_peak_Pa"] = st.conf_at_peak;
+  j["strain_at_peak"] = st.strain_at_peak;
+  j["youngs_modulus_Pa"] = fit.youngs_modulus;
+  j["poisson_ratio"] = fit.poisson_ratio;
+  j["elastic_fit"] = {{"method", "least squares on the pre-peak differential stress between 20% and 50% of its peak"},
+                      {"points", fit.points}};
+  nlohmann::json spheres = nlohmann::json::array();
+  for (int s = 0; s < 3; ++s)
+    spheres.push_back({{"axial_Pa", st.sphere_axial[s]}, {"lateral_Pa", st.sphere_lateral[s]}, {"particles", st.sphere_particles[s]}});
+  j["isotropic_stage"] = {{"steps", st.iso_steps},
+                          {"converged", st.iso_converged != 0},
+                          {"platen_stress_Pa", st.iso_axial},
+                          {"confinement_Pa", st.iso_conf},
+                          {"cracks", st.iso_cracks},
+                          {"measurement_spheres", spheres},
+                          {"whole_sample_axial_Pa", st.whole_axial},
+                          {"whole_sample_lateral_Pa", st.whole_lateral},
+                          {"sphere_radius_fraction", cfg.real("triaxial.measurement_sphere_radius")},
+                          {"largest_sphere_deviation", st.iso_sphere_error},
+                          {"spheres_within_5_percent", st.iso_sphere_error <= 0.05}};
+  j["cracks"] = {{"tensile", sys.cracks.tensile}, {"shear", sys.cracks.shear}, {"total", sys.cracks.total()}};
+  {
+    nlohmann::json by_pair = nlohmann::json::object();
+    const auto& g = sys.materials.group_names;
+    for (int a = 0; a < sys.materials.groups(); ++a)
+      for (int b = a; b < sys.materials.groups(); ++b)
+        by_pair[g[a] + "-" + g[b]] = {{"tensile", sys.cracks.count(a, b, 1)}, {"shear", sys.cracks.count(a, b, 2)}};
+    j["cracks"]["by_group_pair"] = by_pair;
+  }
+  if (sys.membrane) {
+    const auto& m = *sys.membrane;
+    std::vector<Real> rad(m.settings().n_z + 1), z(m.settings().n_z + 1);
+    m.radial_profile(rad, z);
+    j["membrane"] = {{"elements", m.element_count()}, {"n_theta", m.settings().n_theta}, {"n_z", m.settings().n_z},
+                     {"ring_radius_m", rad}, {"ring_z_m", z}};
+  }
+  j["sample"] = {{"particles", sys.particles.size()}, {"bonds", info.bonds}, {"porosity", info.porosity},
+                 {"height_m", info.height}, {"width_m", info.width}, {"locked_in_stress_Pa", info.locked_in_stress},
+                 {"floaters", info.floaters}};
+  j["time_step_s"] = sys.settings.dt;
+  j["steps"] = sys.step_count;
+  j["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  j["threads"] = opt.threads;
+  j["parameters"] = params_json(cfg);
+  write_json_atomic(opt.out_dir / "summary.json", j);
+  make_plots(opt.out_dir, cfg);
+  log::info("triaxial sigma3 = {:.3f} MPa: peak differential stress {:.3f} MPa at axial strain {:.3f}%, E = {:.3f} GPa, "
+            "nu = {:.3f}, cracks {} ({} tensile, {} shear); {}",
+            1e-6 * p, 1e-6 * st.peak_diff, 100 * st.strain_at_peak, 1e-9 * fit.youngs_modulus, fit.poisson_ratio,
+            sys.cracks.total(), sys.cracks.tensile, sys.cracks.shear, stop_reason);
+  return RunStatus::Finished;
+}
+
+}  // namespace
+
+Driver triaxial_driver() {
+  return Driver{"triaxial",
+                "triaxial compression in a flexible membrane or rigid cylinder (isotropic stage, then deviatoric loading)",
+                declare, run};
+}
+
+}  // namespace ff::drivers
