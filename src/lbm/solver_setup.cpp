@@ -126,6 +126,17 @@ void Solver<L, T>::finalize() {
       }
       close_run(g.nx);
     }
+  even_spans_.clear();
+  for (const Span& sp : spans_) {
+    if (!even_spans_.empty()) {
+      Span& b = even_spans_.back();
+      if (b.y == sp.y && b.z == sp.z && b.x0 + b.n == sp.x0) {
+        b.n += sp.n;
+        continue;
+      }
+    }
+    even_spans_.push_back(sp);
+  }
   num_bulk_cells_ = 0;
   for (auto& sp : spans_) num_bulk_cells_ += sp.n;
   link_saved_.assign(links_.size(), T(0));
