@@ -36,9 +36,15 @@ void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 using namespace ff;
 using namespace ff::dem;
 
-TEST(DemAllocation, StepsOfACompressedBondedSampleDoNotAllocate) {
-  omp_set_num_threads(1);
-  const Real r = 0.5e-3, a = 2 * r * 1.001;
+namespace {
+
+constexpr Real kR = 0.5e-3, kA = 2 * kR * 1.001;  // particle radius, lattice spacing
+constexpr int kN = 6, kH = 12;                     // 6 x 6 x 12 bonded block
+
+// A bonded block between two platens that approach at 0.5 m/s each (initialised).
+DemSystem compressed_block() {
+  const Real r = kR, a = kA;
+  const int n = kN, h = kH;
   DemSystem s;
   s.settings.dim = 3;
   s.settings.local_damping = 0.7;
@@ -59,7 +65,6 @@ TEST(DemAllocation, StepsOfACompressedBondedSampleDoNotAllocate) {
   s.materials.parallel = {pb};
   s.materials.rotational.resize(1);
   Rng g(3);
-  const int n = 6, h = 12;
   for (int k = 0; k < h; ++k)
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i) {
@@ -80,13 +85,53 @@ TEST(DemAllocation, StepsOfACompressedBondedSampleDoNotAllocate) {
   s.walls = {bottom, top};
   s.initialise();
   s.settings.dt = 0.5 * s.critical_time_step();
+  return s;
+}
+
+}  // namespace
+
+TEST(DemAllocation, StepsOfACompressedBondedSampleDoNotAllocate) {
+  omp_set_num_threads(1);
+  DemSystem s = compressed_block();
   s.run(500);  // warm-up: buffers grow to their working size
   const long builds = s.neighbors().builds();
   const long cracks = s.cracks.total();
+  allocations = 0;
   counting = true;
   s.run(3000);
   counting = false;
   EXPECT_GT(s.neighbors().builds(), builds + 2) << "the neighbour list must be rebuilt during the counted steps";
   EXPECT_GT(s.cracks.total(), cracks) << "bonds must break during the counted steps";
+  EXPECT_EQ(allocations.load(), 0) << "over " << s.neighbors().builds() - builds << " rebuilds";
+}
+
+TEST(DemAllocation, StepsInsideAFlexibleMembraneDoNotAllocate) {
+  // The same compressed block inside a flexible membrane at 2 MPa (issue 4): candidate
+  // searches at neighbour rebuilds, membrane contacts, servo and vertex updates reuse buffers.
+  omp_set_num_threads(1);
+  DemSystem s = compressed_block();
+  MembraneSettings m;
+  m.n_theta = 16;
+  const Real half = 0.5 * kA * (kN - 1);
+  m.axis_x = m.axis_y = half;
+  m.radius = membrane_circumradius(half * std::sqrt(2.0) + 1.05 * kR, m.n_theta);  // clears the block's corners
+  m.z0 = -2 * kR;
+  m.height = kA * (kH - 1) + 4 * kR;
+  m.n_z = membrane_square_rows(m.radius, m.n_theta, m.height);
+  m.pressure = 2e6;
+  m.v_max = 5.0;  // the side elements start ~1 mm from the block
+  m.r_min = half;
+  s.membrane.emplace(m);
+  s.rebuild_neighbors();
+  s.run(3000);  // warm-up: the membrane closes on the block, buffers reach their size
+  int touching = 0;
+  for (std::size_t k = 0; k < s.membrane->element_count(); ++k) touching += s.membrane->contacts(k) > 0;
+  ASSERT_GT(touching, 0) << "the membrane must press on the block during the counted steps";
+  const long builds = s.neighbors().builds();
+  allocations = 0;
+  counting = true;
+  s.run(3000);
+  counting = false;
+  EXPECT_GT(s.neighbors().builds(), builds + 2) << "the neighbour list must be rebuilt during the counted steps";
   EXPECT_EQ(allocations.load(), 0) << "over " << s.neighbors().builds() - builds << " rebuilds";
 }
