@@ -8,42 +8,17 @@
 #include <filesystem>
 #include <fstream>
 
+#include "batch/run_case.hpp"
 #include "commands.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "drivers/driver.hpp"
 #include "fracflow/version.hpp"
-#include "io/scenario.hpp"
 
 namespace fs = std::filesystem;
 using namespace ff;
 
 namespace {
-
-struct Loaded {
-  const Driver* driver;
-  ParamTable table;
-  Config config;
-};
-
-// Loads the scenario (file or built-in default) and validates every key, before anything is
-// written. The ParamTable must outlive the Config, so both are returned together.
-std::unique_ptr<Loaded> load(const std::string& path, const std::vector<std::string>& overrides) {
-  const std::string text = path.empty() ? std::string(default_scenario_text()) : read_text_file(path);
-  const std::string source = path.empty() ? "<built-in default scenario>" : path;
-  std::string driver_name = peek_driver(text, source);
-  for (auto& o : overrides)
-    if (o.rfind("driver=", 0) == 0) driver_name = o.substr(7);
-  if (driver_name.empty()) {
-    if (all_drivers().empty()) throw InputError("no driver is built into this fracflow");
-    driver_name = std::string(all_drivers().front().name);
-  }
-  auto l = std::make_unique<Loaded>();
-  l->driver = &find_driver(driver_name);
-  l->table = parameter_table(*l->driver);
-  l->config = load_scenario(l->table, path, text, overrides);
-  return l;
-}
 
 void apply_threads(int threads) {
   if (threads > 0) omp_set_num_threads(threads);
@@ -51,7 +26,7 @@ void apply_threads(int threads) {
 
 // Runs the driver in `out`. On an input error raised while setting up (before results exist),
 // a folder this call created is removed again so no half-written results remain.
-int execute(const Loaded& l, RunOptions opt, bool created_dir) {
+int execute(const batch::LoadedScenario& l, RunOptions opt, bool created_dir) {
   try {
     const RunStatus st = l.driver->run(l.config, opt);
     if (st == RunStatus::Interrupted)
@@ -135,7 +110,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (*check) {
-      auto l = load(scenario, sets);
+      auto l = batch::load_scenario_for_run(scenario, sets);
       fmt::print("{}: valid; driver '{}' ({})\n\n{}", scenario.empty() ? "built-in default scenario" : scenario,
                  l->driver->name, l->driver->summary, l->config.describe());
       return 0;
@@ -146,7 +121,7 @@ int main(int argc, char** argv) {
     opt.max_wall_s = max_wall;
     opt.max_steps = max_steps;
     if (*run) {
-      auto l = load(scenario, sets);  // every key validated before anything is written
+      auto l = batch::load_scenario_for_run(scenario, sets);  // every key validated before anything is written
       if (out_dir.empty())
         out_dir = "runs/" + (scenario.empty() ? std::string("default") : fs::path(scenario).stem().string());
       opt.out_dir = out_dir;
@@ -174,7 +149,7 @@ int main(int argc, char** argv) {
         throw InputError(fmt::format("'{}' is not a fracflow results folder (no scenario.toml)", resume_dir));
       if (!fs::exists(dir / "checkpoint"))
         throw InputError(fmt::format("'{}' has no checkpoint/ to resume from", resume_dir));
-      auto l = load((dir / "scenario.toml").string(), {});
+      auto l = batch::load_scenario_for_run((dir / "scenario.toml").string(), {});
       opt.out_dir = dir;
       opt.resume = true;
       opt.abort_file = dir / "ABORT";
