@@ -13,6 +13,7 @@
 #include "dem/dem_output.hpp"
 #include "dem/dem_params.hpp"
 #include "dem/sample_builder.hpp"
+#include "drivers/dem_results.hpp"
 #include "drivers/triaxial/triaxial_boundary.hpp"
 #include "drivers/ucs/ucs_measure.hpp"
 #include "fracflow/version.hpp"
@@ -74,44 +75,16 @@ struct TriaxialState {
   Real whole_axial = 0, whole_lateral = 0;  // Love-Weber average of the whole sample over the enclosed volume
 };
 
-struct SampleRecord {  // SampleInfo without its non-trivial members
-  int dim, axis, cylinder;
-  Real height, width, area, volume, porosity, locked_in_stress, genesis_seconds;
-  std::uint64_t bonds, floaters;
-};
-
 }  // namespace
 }  // namespace ff::drivers
 
 namespace ff {
 template <> struct is_checkpoint_pod<drivers::TriaxialState> : std::true_type {};
-template <> struct is_checkpoint_pod<drivers::SampleRecord> : std::true_type {};
 template <> struct is_checkpoint_pod<dem::MembraneSettings> : std::true_type {};
 }  // namespace ff
 
 namespace ff::drivers {
 namespace {
-
-SampleRecord record(const dem::SampleInfo& i) {
-  return {i.dim, i.axis, i.cylinder, i.height, i.width, i.area, i.volume, i.porosity, i.locked_in_stress,
-          i.genesis_seconds, i.bonds, i.floaters};
-}
-dem::SampleInfo info_from(const SampleRecord& s) {
-  dem::SampleInfo i;
-  i.dim = s.dim;
-  i.axis = s.axis;
-  i.cylinder = s.cylinder;
-  i.height = s.height;
-  i.width = s.width;
-  i.area = s.area;
-  i.volume = s.volume;
-  i.porosity = s.porosity;
-  i.locked_in_stress = s.locked_in_stress;
-  i.genesis_seconds = s.genesis_seconds;
-  i.bonds = s.bonds;
-  i.floaters = s.floaters;
-  return i;
-}
 
 // The membrane around a sample of radius R between the platens: a sleeve `length_factor`
 // times the sample height, centred on it, its facets `clearance` R outside the sample.
@@ -152,7 +125,7 @@ void write_checkpoint(const fs::path& dir, const dem::DemSystem& sys, const Tria
   if (sys.membrane) w.put_value("triaxial.membrane_settings", sys.membrane->settings());
   dem::save_dem(w, sys);
   w.put_value("triaxial.state", st);
-  w.put_value("triaxial.sample", record(info));
+  w.put_value("triaxial.sample", sample_record(info));
   w.commit();
 }
 
@@ -161,13 +134,7 @@ void read_checkpoint(const fs::path& dir, dem::DemSystem& sys, TriaxialState& st
   if (r.has("triaxial.membrane_settings")) sys.membrane.emplace(r.get_value<dem::MembraneSettings>("triaxial.membrane_settings"));
   dem::load_dem(r, sys);
   st = r.get_value<TriaxialState>("triaxial.state");
-  info = info_from(r.get_value<SampleRecord>("triaxial.sample"));
-}
-
-nlohmann::json params_json(const Config& cfg) {
-  nlohmann::json j = nlohmann::json::object();
-  for (auto& [k, v] : cfg.resolved_values()) std::visit([&](const auto& x) { j[k] = x; }, v);
-  return j;
+  info = sample_info(r.get_value<SampleRecord>("triaxial.sample"));
 }
 
 std::vector<std::string> columns(const dem::Materials& mat) {
@@ -457,15 +424,7 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
                           {"sphere_radius_fraction", cfg.real("triaxial.measurement_sphere_radius")},
                           {"largest_sphere_deviation", st.iso_sphere_error},
                           {"spheres_within_5_percent", st.iso_sphere_error <= 0.05}};
-  j["cracks"] = {{"tensile", sys.cracks.tensile}, {"shear", sys.cracks.shear}, {"total", sys.cracks.total()}};
-  {
-    nlohmann::json by_pair = nlohmann::json::object();
-    const auto& g = sys.materials.group_names;
-    for (int a = 0; a < sys.materials.groups(); ++a)
-      for (int b = a; b < sys.materials.groups(); ++b)
-        by_pair[g[a] + "-" + g[b]] = {{"tensile", sys.cracks.count(a, b, 1)}, {"shear", sys.cracks.count(a, b, 2)}};
-    j["cracks"]["by_group_pair"] = by_pair;
-  }
+  j["cracks"] = cracks_json(sys);
   if (sys.membrane) {
     const auto& m = *sys.membrane;
     std::vector<Real> rad(m.settings().n_z + 1), z(m.settings().n_z + 1);
@@ -473,9 +432,7 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
     j["membrane"] = {{"elements", m.element_count()}, {"n_theta", m.settings().n_theta}, {"n_z", m.settings().n_z},
                      {"ring_radius_m", rad}, {"ring_z_m", z}};
   }
-  j["sample"] = {{"particles", sys.particles.size()}, {"bonds", info.bonds}, {"porosity", info.porosity},
-                 {"height_m", info.height}, {"width_m", info.width}, {"locked_in_stress_Pa", info.locked_in_stress},
-                 {"floaters", info.floaters}};
+  j["sample"] = sample_json(sys, info);
   j["time_step_s"] = sys.settings.dt;
   j["steps"] = sys.step_count;
   j["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();

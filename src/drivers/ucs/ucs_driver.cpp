@@ -13,6 +13,7 @@
 #include "dem/dem_output.hpp"
 #include "dem/dem_params.hpp"
 #include "dem/sample_builder.hpp"
+#include "drivers/dem_results.hpp"
 #include "drivers/ucs/ucs_measure.hpp"
 #include "fracflow/version.hpp"
 #include "io/csv.hpp"
@@ -60,28 +61,12 @@ template <> struct is_checkpoint_pod<dem::SampleInfo> : std::false_type {};
 namespace ff::drivers {
 namespace {
 
-struct SampleRecord {  // SampleInfo without its non-trivial members
-  int dim, axis, cylinder;
-  Real height, width, area, volume, porosity, locked_in_stress, genesis_seconds;
-  std::uint64_t bonds, floaters;
-};
-
-}  // namespace
-}  // namespace ff::drivers
-namespace ff {
-template <> struct is_checkpoint_pod<drivers::SampleRecord> : std::true_type {};
-}
-
-namespace ff::drivers {
-namespace {
-
 void write_checkpoint(const fs::path& dir, const dem::DemSystem& sys, const UcsState& st, const dem::SampleInfo& info) {
   fs::create_directories(dir);
   CheckpointWriter w(dir / "state.ffcp");
   dem::save_dem(w, sys);
   w.put_value("ucs.state", st);
-  w.put_value("ucs.sample", SampleRecord{info.dim, info.axis, info.cylinder, info.height, info.width, info.area, info.volume,
-                                         info.porosity, info.locked_in_stress, info.genesis_seconds, info.bonds, info.floaters});
+  w.put_value("ucs.sample", sample_record(info));
   w.commit();
 }
 
@@ -89,25 +74,7 @@ void read_checkpoint(const fs::path& dir, dem::DemSystem& sys, UcsState& st, dem
   CheckpointReader r(dir / "state.ffcp");
   dem::load_dem(r, sys);
   st = r.get_value<UcsState>("ucs.state");
-  const auto s = r.get_value<SampleRecord>("ucs.sample");
-  info.dim = s.dim;
-  info.axis = s.axis;
-  info.cylinder = s.cylinder;
-  info.height = s.height;
-  info.width = s.width;
-  info.area = s.area;
-  info.volume = s.volume;
-  info.porosity = s.porosity;
-  info.locked_in_stress = s.locked_in_stress;
-  info.genesis_seconds = s.genesis_seconds;
-  info.bonds = s.bonds;
-  info.floaters = s.floaters;
-}
-
-nlohmann::json params_json(const Config& cfg) {
-  nlohmann::json j = nlohmann::json::object();
-  for (auto& [k, v] : cfg.resolved_values()) std::visit([&](const auto& x) { j[k] = x; }, v);
-  return j;
+  info = sample_info(r.get_value<SampleRecord>("ucs.sample"));
 }
 
 void make_plots(const fs::path& out, const Config& cfg) {
@@ -270,18 +237,8 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
   j["poisson_ratio"] = fit.poisson_ratio;
   j["elastic_fit"] = {{"method", "least squares on the pre-peak curve between 20% and 50% of the peak stress"},
                       {"points", fit.points}};
-  j["cracks"] = {{"tensile", sys.cracks.tensile}, {"shear", sys.cracks.shear}, {"total", sys.cracks.total()}};
-  {
-    nlohmann::json by_pair = nlohmann::json::object();
-    const auto& g = sys.materials.group_names;
-    for (int a = 0; a < sys.materials.groups(); ++a)
-      for (int b = a; b < sys.materials.groups(); ++b)
-        by_pair[g[a] + "-" + g[b]] = {{"tensile", sys.cracks.count(a, b, 1)}, {"shear", sys.cracks.count(a, b, 2)}};
-    j["cracks"]["by_group_pair"] = by_pair;
-  }
-  j["sample"] = {{"particles", sys.particles.size()}, {"bonds", info.bonds}, {"porosity", info.porosity},
-                 {"height_m", info.height}, {"width_m", info.width}, {"locked_in_stress_Pa", info.locked_in_stress},
-                 {"floaters", info.floaters}, {"dimension", info.dim}};
+  j["cracks"] = cracks_json(sys);
+  j["sample"] = sample_json(sys, info);
   j["time_step_s"] = sys.settings.dt;
   j["steps"] = sys.step_count;
   j["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();

@@ -1,0 +1,52 @@
+#include "drivers/dem_results.hpp"
+
+#include <variant>
+
+namespace ff::drivers {
+
+SampleRecord sample_record(const dem::SampleInfo& i) {
+  return {i.dim, i.axis, i.cylinder, i.height, i.width, i.area, i.volume, i.porosity, i.locked_in_stress,
+          i.genesis_seconds, i.bonds, i.floaters};
+}
+
+dem::SampleInfo sample_info(const SampleRecord& s) {
+  dem::SampleInfo i;
+  i.dim = s.dim;
+  i.axis = s.axis;
+  i.cylinder = s.cylinder;
+  i.height = s.height;
+  i.width = s.width;
+  i.area = s.area;
+  i.volume = s.volume;
+  i.porosity = s.porosity;
+  i.locked_in_stress = s.locked_in_stress;
+  i.genesis_seconds = s.genesis_seconds;
+  i.bonds = s.bonds;
+  i.floaters = s.floaters;
+  return i;
+}
+
+nlohmann::json params_json(const Config& cfg) {
+  nlohmann::json j = nlohmann::json::object();
+  for (auto& [k, v] : cfg.resolved_values()) std::visit([&](const auto& x) { j[k] = x; }, v);
+  return j;
+}
+
+nlohmann::json cracks_json(const dem::DemSystem& sys) {
+  nlohmann::json j = {{"tensile", sys.cracks.tensile}, {"shear", sys.cracks.shear}, {"total", sys.cracks.total()}};
+  nlohmann::json by_pair = nlohmann::json::object();
+  const auto& g = sys.materials.group_names;
+  for (int a = 0; a < sys.materials.groups(); ++a)
+    for (int b = a; b < sys.materials.groups(); ++b)
+      by_pair[g[a] + "-" + g[b]] = {{"tensile", sys.cracks.count(a, b, 1)}, {"shear", sys.cracks.count(a, b, 2)}};
+  j["by_group_pair"] = by_pair;
+  return j;
+}
+
+nlohmann::json sample_json(const dem::DemSystem& sys, const dem::SampleInfo& info) {
+  return {{"particles", sys.particles.size()}, {"bonds", info.bonds},        {"porosity", info.porosity},
+          {"height_m", info.height},          {"width_m", info.width},      {"locked_in_stress_Pa", info.locked_in_stress},
+          {"floaters", info.floaters},        {"dimension", info.dim}};
+}
+
+}  // namespace ff::drivers

@@ -1,0 +1,33 @@
+// What the bonded-particle drivers (ucs, triaxial) share around a run: the sample description
+// kept in their checkpoints, and the parts of summary.json that do not depend on the protocol.
+#pragma once
+#include <nlohmann/json.hpp>
+
+#include "dem/dem_system.hpp"
+#include "dem/sample_builder.hpp"
+#include "io/checkpoint.hpp"
+#include "io/params.hpp"
+
+namespace ff::drivers {
+
+// SampleInfo without its non-trivial members, stored as raw bytes in checkpoints.
+struct SampleRecord {
+  int dim, axis, cylinder;
+  Real height, width, area, volume, porosity, locked_in_stress, genesis_seconds;
+  std::uint64_t bonds, floaters;
+};
+SampleRecord sample_record(const dem::SampleInfo& info);
+dem::SampleInfo sample_info(const SampleRecord& record);
+
+// Every resolved parameter, key -> value.
+nlohmann::json params_json(const Config& cfg);
+// Crack counts by type and by group pair.
+nlohmann::json cracks_json(const dem::DemSystem& sys);
+// Particles, bonds, porosity, size, locked-in stress, floaters, dimension.
+nlohmann::json sample_json(const dem::DemSystem& sys, const dem::SampleInfo& info);
+
+}  // namespace ff::drivers
+
+namespace ff {
+template <> struct is_checkpoint_pod<drivers::SampleRecord> : std::true_type {};
+}
