@@ -36,10 +36,11 @@ struct ParallelBond {
   static Coeffs coeffs(const Material& m) {
     return {m.emod, 1.0 / m.kratio, m.ten, m.coh, std::tan(m.fa_deg * kPi / 180.0), m.lambda, m.beta};
   }
-  // Geometry and stiffness of one bond.
+  // Geometry and stiffness of one bond, and the ratios the peripheral stresses use.
   struct Section {
-    Real R, A, I, J;  // bond radius [m], area [m^2], moments of inertia [m^4]
-    Real kn, ks;      // [Pa/m]
+    Real R, A, I, J;                 // bond radius [m], area [m^2], moments of inertia [m^4]
+    Real kn, ks;                     // [Pa/m]
+    Real inv_A, R_over_I, R_over_J;  // 1/A, R/I, R/J (0 in 2D)
   };
   // What a bond carries between steps.
   struct State {
@@ -52,19 +53,21 @@ struct ParallelBond {
 
   // Section: R = lambda min(RA, RB); 3D A = pi R^2, I = pi R^4/4, J = pi R^4/2;
   // 2D (thickness t = 1): A = 2 R, I = 2/3 R^3, J unused (0). kn = E/L with L = RA + RB.
+  // One division (the divide/sqrt unit bounds the bond loop): q = 1/(A R L) gives 1/L, 1/A and
+  // R/I = cI/(A R), R/J = 2/(A R), where cI = 4 in 3D (I = A R^2/4) and 3 in 2D (A = 2R).
   static Section section(const Coeffs& c, Real rA, Real rB, int dim) {
     Section s;
+    const Real L = rA + rB;
     s.R = c.lambda * std::min(rA, rB);
-    if (dim == 3) {
-      s.A = kPi * s.R * s.R;
-      s.I = 0.25 * s.A * s.R * s.R;
-      s.J = 2 * s.I;
-    } else {
-      s.A = 2 * s.R;
-      s.I = 2.0 / 3.0 * s.R * s.R * s.R;
-      s.J = 0;
-    }
-    s.kn = c.emod / (rA + rB);
+    s.A = dim == 3 ? kPi * s.R * s.R : 2 * s.R;
+    const Real q = 1.0 / (s.A * s.R * L);
+    s.inv_A = q * s.R * L;
+    const Real inv_AR = q * L;
+    s.I = dim == 3 ? 0.25 * s.A * s.R * s.R : 2.0 / 3.0 * s.R * s.R * s.R;
+    s.J = dim == 3 ? 2 * s.I : 0.0;
+    s.R_over_I = (dim == 3 ? 4.0 : 3.0) * inv_AR;
+    s.R_over_J = dim == 3 ? 2.0 * inv_AR : 0.0;
+    s.kn = c.emod * (q * s.A * s.R);
     s.ks = s.kn * c.inv_kratio;
     return s;
   }
@@ -77,52 +80,38 @@ struct ParallelBond {
 
   // Peripheral stresses (P&C 2004 Eq. 6-7 with the moment-contribution factor); Mt = 0 in 2D.
   static Stress stress(const Coeffs& c, const Section& sec, const State& s) {
-    const Real inv_A = 1.0 / sec.A;
-    Stress out;
-    out.sigma = s.Fn * inv_A + c.beta * s.Mb.norm() * sec.R / sec.I;
-    out.tau = s.Fs.norm() * inv_A + (sec.J > 0 ? c.beta * std::abs(s.Mt) * sec.R / sec.J : 0.0);
-    return out;
+    return {s.Fn * sec.inv_A + c.beta * s.Mb.norm() * sec.R_over_I,
+            s.Fs.norm() * sec.inv_A + c.beta * std::abs(s.Mt) * sec.R_over_J};
   }
 
   // One step: update the stored loads from the increments in g, check failure, and return the
   // loads on both ends. Failure is judged on the loads after this step's increment.
   static BondFailure compute(const Coeffs& c, State& s, const ContactGeom& g, Real dt, int dim, BondLoad& out,
                              Stress* stress_out = nullptr) {
-    // Section and its ratios with a single division (the divide/sqrt unit is this loop's
-    // bottleneck): q = 1/(A R L) gives 1/L, 1/A and R/I = cI/(A R), R/J = 2/(A R), where
-    // cI = 4 in 3D (I = A R^2/4) and 3 in 2D (I = 2/3 R^3, A = 2R).
-    const Real R = c.lambda * std::min(g.rA, g.rB), L = g.rA + g.rB;
-    const Real A = dim == 3 ? kPi * R * R : 2 * R;
-    const Real q = 1.0 / (A * R * L);
-    const Real inv_A = q * R * L, inv_AR = q * L;
-    const Real kn = c.emod * (q * A * R), ks = kn * c.inv_kratio;
-    const Real I = dim == 3 ? 0.25 * A * R * R : 2.0 / 3.0 * R * R * R;
-    const Real R_over_I = (dim == 3 ? 4.0 : 3.0) * inv_AR, R_over_J = dim == 3 ? 2.0 * inv_AR : 0.0;
+    const Section sec = section(c, g.rA, g.rB, dim);
     // Stored shear force and bending moment follow the contact plane.
     rotate_into_plane(s.Fs, g, dt);
     rotate_into_plane(s.Mb, g, dt);
     const Real dtheta_t = g.d_theta.dot(g.n);
     const Vec3 dtheta_b = g.d_theta - dtheta_t * g.n;
-    s.Fn += kn * A * g.d_delta_n;
-    s.Fs -= ks * A * g.d_delta_s;
-    s.Mb -= kn * I * dtheta_b;
-    if (dim == 3) s.Mt -= ks * 2 * I * dtheta_t;  // J = 2 I
+    s.Fn += sec.kn * sec.A * g.d_delta_n;
+    s.Fs -= sec.ks * sec.A * g.d_delta_s;
+    s.Mb -= sec.kn * sec.I * dtheta_b;
+    if (dim == 3) s.Mt -= sec.ks * sec.J * dtheta_t;
     // Failure (P&C 2004 Eq. 6-7): sigma = Fn/A + beta |Mb| R/I >= ten, else
     // tau = |Fs|/A + beta |Mt| R/J >= coh - (Fn/A) tan(fa). Compared on squares, no sqrt.
-    const Real normal_stress = s.Fn * inv_A;
+    const Real normal_stress = s.Fn * sec.inv_A;
     const Real bend_room = c.ten - normal_stress;  // what the bending term may add before failure
-    const Real bend_k = c.beta * R_over_I;
+    const Real bend_k = c.beta * sec.R_over_I;
     BondFailure fail = BondFailure::None;
     if (bend_room <= 0 || bend_k * bend_k * s.Mb.squaredNorm() >= bend_room * bend_room) {
       fail = BondFailure::Tensile;
     } else {
-      const Real shear_room = c.coh - normal_stress * c.tan_fa - c.beta * std::abs(s.Mt) * R_over_J;
-      if (shear_room <= 0 || s.Fs.squaredNorm() * inv_A * inv_A >= shear_room * shear_room) fail = BondFailure::Shear;
+      const Real shear_room = c.coh - normal_stress * c.tan_fa - c.beta * std::abs(s.Mt) * sec.R_over_J;
+      if (shear_room <= 0 || s.Fs.squaredNorm() * sec.inv_A * sec.inv_A >= shear_room * shear_room)
+        fail = BondFailure::Shear;
     }
-    if (stress_out) {
-      stress_out->sigma = normal_stress + bend_k * s.Mb.norm();
-      stress_out->tau = s.Fs.norm() * inv_A + c.beta * std::abs(s.Mt) * R_over_J;
-    }
+    if (stress_out) *stress_out = stress(c, sec, s);
     // Force on B: tension pulls B back along -n; shear force acts on B as stored.
     out.force_on_B = -s.Fn * g.n + s.Fs;
     // Moments about each centre: the couples plus the lever arm of the force at the
