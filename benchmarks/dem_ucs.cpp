@@ -90,13 +90,10 @@ int main(int argc, char** argv) {
     // alternate so both see the same machine load. Overhead = best-block time ratio - 1.
     omp_set_num_threads(1);
     dem::DemSystem plain = base, wrapped = base;
-    dem::MembraneSettings m;
-    m.n_theta = 48;
-    const Real R = 0.5 * diameter, z0 = base.walls[0].point.z(), z1 = base.walls[1].point.z();
-    m.radius = dem::membrane_circumradius(1.001 * R, m.n_theta);  // closes in ~200 steps at v_max
-    m.height = 1.2 * (z1 - z0);
-    m.z0 = 0.5 * (z0 + z1) - 0.5 * m.height;
-    m.n_z = dem::membrane_square_rows(m.radius, m.n_theta, m.height);
+    const Real R = 0.5 * diameter;
+    // Clearance 0.1% of R: closes in ~200 steps at v_max.
+    dem::MembraneSettings m = dem::membrane_around_cylinder(R, base.walls[0].point.z(), base.walls[1].point.z(), 48, 0,
+                                                            1e-3, 1.2);
     m.pressure = 5e6;
     m.v_max = 1.0;
     m.r_min = 0.9 * R;

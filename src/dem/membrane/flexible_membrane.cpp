@@ -57,6 +57,17 @@ std::array<Real, 3> barycentric(const Vec3& q, const Vec3& a, const Vec3& b, con
 }
 }  // namespace
 
+MembraneSettings membrane_around_cylinder(Real sample_radius, Real z_bottom, Real z_top, int n_theta, int n_z,
+                                          Real clearance, Real length_factor) {
+  MembraneSettings m;
+  m.n_theta = n_theta;
+  m.radius = membrane_circumradius(sample_radius * (1 + clearance), n_theta);
+  m.height = length_factor * (z_top - z_bottom);
+  m.z0 = 0.5 * (z_bottom + z_top) - 0.5 * m.height;
+  m.n_z = n_z > 0 ? n_z : membrane_square_rows(m.radius, n_theta, m.height);
+  return m;
+}
+
 int membrane_square_rows(Real radius, int n_theta, Real height) {
   const Real chord = 2 * radius * std::sin(kPi / n_theta);
   return std::max(1, static_cast<int>(std::lround(height / chord)));

@@ -95,6 +95,11 @@ struct MembraneSettings {
 int membrane_square_rows(Real radius, int n_theta, Real height);
 // Vertex radius whose facets (N_theta-gon) clear a cylinder of radius inner_radius.
 inline Real membrane_circumradius(Real inner_radius, int n_theta) { return inner_radius / std::cos(kPi / n_theta); }
+// Sleeve geometry around a cylinder sample on the z axis between the platen planes z_bottom and
+// z_top: facets `clearance` x R outside it, `length_factor` x the sample height, centred on it;
+// n_z = 0 picks nearly square units. Other settings keep their defaults.
+MembraneSettings membrane_around_cylinder(Real sample_radius, Real z_bottom, Real z_top, int n_theta, int n_z,
+                                          Real clearance, Real length_factor);
 
 // Particle arrays read by the contact loop (spans over the engine's ParticleStore).
 struct MembraneParticles {

@@ -89,15 +89,10 @@ namespace {
 // The membrane around a sample of radius R between the platens: a sleeve `length_factor`
 // times the sample height, centred on it, its facets `clearance` R outside the sample.
 dem::MembraneSettings membrane_settings(const Config& cfg, const dem::DemSystem& sys, const dem::SampleInfo& info) {
-  dem::MembraneSettings m;
   const Real R = 0.5 * info.width;
-  const Real z0 = sys.walls[0].point.z(), z1 = sys.walls[1].point.z(), h = z1 - z0;
-  m.n_theta = static_cast<int>(cfg.integer("membrane.n_theta"));
-  m.radius = dem::membrane_circumradius(R * (1 + cfg.real("membrane.clearance")), m.n_theta);
-  m.height = cfg.real("membrane.length_factor") * h;
-  m.z0 = 0.5 * (z0 + z1) - 0.5 * m.height;
-  const long nz = cfg.integer("membrane.n_z");
-  m.n_z = nz > 0 ? static_cast<int>(nz) : dem::membrane_square_rows(m.radius, m.n_theta, m.height);
+  dem::MembraneSettings m = dem::membrane_around_cylinder(
+      R, sys.walls[0].point.z(), sys.walls[1].point.z(), static_cast<int>(cfg.integer("membrane.n_theta")),
+      static_cast<int>(cfg.integer("membrane.n_z")), cfg.real("membrane.clearance"), cfg.real("membrane.length_factor"));
   m.pressure = cfg.real("triaxial.confining_pressure");
   m.v_max = cfg.real("triaxial.servo_velocity");
   m.relaxation = cfg.real("triaxial.servo_relaxation");
