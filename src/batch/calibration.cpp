@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "core/types.hpp"
 
 namespace ff::batch {
 
@@ -31,19 +32,32 @@ void check_calibration_input(const MicroParameters& p, const CalibrationSettings
   positive(p.contact_kratio, "contact kratio", "positive");
   positive(p.tensile_strength_Pa, "bond tensile_strength", "positive");
   positive(p.cohesion_Pa, "bond cohesion", "positive");
+  if (s.target.slope_b != 0) {
+    if (!(s.target.slope_b > 0) || !std::isfinite(s.target.slope_b))
+      throw InputError(fmt::format("--target-b = {}: must be positive (the slope of the peak differential stress "
+                                   "against sigma3; seed 000 Eq. 1: 3.54)", s.target.slope_b));
+    positive(s.slope_tolerance, "--tol-b", "a positive relative tolerance, e.g. 0.1");
+    positive(s.slope_gradient_guess, "--b-gradient", "a positive d b / d tan(phi_b), e.g. 4.6");
+    if (!(p.friction_angle_deg >= 0 && p.friction_angle_deg < s.max_friction_angle_deg))
+      throw InputError(fmt::format("bond friction_angle = {} deg: must lie in [0, {}) to be calibrated",
+                                   p.friction_angle_deg, s.max_friction_angle_deg));
+  }
 }
 
 void score_step(CalibrationStep& st, const CalibrationSettings& s) {
   st.youngs_modulus_error = (st.measured.youngs_modulus_Pa - s.target.youngs_modulus_Pa) / s.target.youngs_modulus_Pa;
   st.poisson_error = st.measured.poisson_ratio - s.target.poisson_ratio;
   st.ucs_error = (st.measured.ucs_Pa - s.target.ucs_Pa) / s.target.ucs_Pa;
+  st.slope_error = s.calibrates_slope() ? (st.measured.slope_b - s.target.slope_b) / s.target.slope_b : 0.0;
   st.converged = std::abs(st.youngs_modulus_error) < s.youngs_modulus_tolerance &&
-                 std::abs(st.poisson_error) < s.poisson_tolerance && std::abs(st.ucs_error) < s.ucs_tolerance;
+                 std::abs(st.poisson_error) < s.poisson_tolerance && std::abs(st.ucs_error) < s.ucs_tolerance &&
+                 std::abs(st.slope_error) < s.slope_tolerance;
 }
 
 double worst_scaled_error(const CalibrationStep& st, const CalibrationSettings& s) {
   const double w = std::max({std::abs(st.youngs_modulus_error) / s.youngs_modulus_tolerance,
-                             std::abs(st.poisson_error) / s.poisson_tolerance, std::abs(st.ucs_error) / s.ucs_tolerance});
+                             std::abs(st.poisson_error) / s.poisson_tolerance, std::abs(st.ucs_error) / s.ucs_tolerance,
+                             std::abs(st.slope_error) / s.slope_tolerance});
   return std::isfinite(w) ? w : HUGE_VAL;
 }
 
@@ -56,6 +70,9 @@ MicroParameters next_parameters(std::span<const CalibrationStep> history, const 
     throw Error(fmt::format("calibration iteration {}: the run measured E = {}, nu = {}, UCS = {}; cannot update from "
                             "that (see the run's folder)",
                             last.iteration, m.youngs_modulus_Pa, m.poisson_ratio, m.ucs_Pa));
+  if (s.calibrates_slope() && !(std::isfinite(m.slope_b) && m.slope_b > 0))
+    throw Error(fmt::format("calibration iteration {}: the triaxial runs measured b = {}; cannot update from that (see "
+                            "the run's folder)", last.iteration, m.slope_b));
   auto limit = [&](double f) { return std::clamp(f, 1 / s.max_factor, s.max_factor); };
   MicroParameters p = last.params;
 
@@ -93,13 +110,36 @@ MicroParameters next_parameters(std::span<const CalibrationStep> history, const 
   const double f_strength = limit(s.target.ucs_Pa / m.ucs_Pa);
   p.tensile_strength_Pa *= f_strength;
   p.cohesion_Pa *= f_strength;
+
+  // b linear in tan(phi_b): gradient by least squares when the runs span a range of phi_b and
+  // give a positive gradient; else the guess.
+  if (s.calibrates_slope()) {
+    auto tan_deg = [](double deg) { return std::tan(deg * kPi / 180); };
+    double gradient = s.slope_gradient_guess;
+    double mx = 0, my = 0;
+    for (auto& h : history) {
+      mx += tan_deg(h.params.friction_angle_deg);
+      my += h.measured.slope_b;
+    }
+    mx /= static_cast<double>(history.size());
+    my /= static_cast<double>(history.size());
+    double sxx = 0, sxy = 0;
+    for (auto& h : history) {
+      const double dx = tan_deg(h.params.friction_angle_deg) - mx;
+      sxx += dx * dx;
+      sxy += dx * (h.measured.slope_b - my);
+    }
+    if (sxx > 1e-4 * static_cast<double>(history.size()) && sxy / sxx > 0.1 * s.slope_gradient_guess) gradient = sxy / sxx;
+    const double t = tan_deg(p.friction_angle_deg) + (s.target.slope_b - m.slope_b) / gradient;
+    p.friction_angle_deg = std::clamp(std::atan(std::max(t, 0.0)) * 180 / kPi, 0.0, s.max_friction_angle_deg);
+  }
   return p;
 }
 
 MicroParameters rounded(const MicroParameters& p, int digits) {
   auto r = [digits](double v) { return std::stod(fmt::format("{:.{}g}", v, digits)); };
-  return {r(p.bond_emod_Pa), r(p.contact_emod_Pa), r(p.bond_kratio), r(p.contact_kratio), r(p.tensile_strength_Pa),
-          r(p.cohesion_Pa)};
+  return {r(p.bond_emod_Pa),         r(p.contact_emod_Pa), r(p.bond_kratio), r(p.contact_kratio),
+          r(p.tensile_strength_Pa), r(p.cohesion_Pa),     r(p.friction_angle_deg)};
 }
 
 CalibrationResult calibrate(const MicroParameters& start, const CalibrationSettings& s, const UcsModel& model,

@@ -6,7 +6,14 @@
 //     s = d nu / d ln k fitted by least squares to the runs so far (a guess for the first step)
 //   - UCS is linear in the bond strengths at a fixed tensile/cohesion ratio:
 //                                                           strengths <- strengths * UCS* / UCS
-// All three are updated every iteration from the latest run (stiffness hardly depends on the
+// and, when a triaxial slope b* is asked for (peak differential stress sigma_p = a + b sigma3,
+// the form of seed 000 Eq. 1, b = 3.54; the slope of sigma1 = sigma3 + sigma_p is b + 1), the
+// pressure sensitivity of the bonds' shear strength (tau = c + sigma tan(phi_b), PFC 5's
+// pb_fa; METHODS.md 1.5):
+//   - b is taken as linear in tan(phi_b):                  tan(phi_b) <- tan(phi_b) + (b* - b) / s_b,
+//     s_b = d b / d tan(phi_b) by least squares over the runs so far (a guess for the first step).
+//     Measured on the C1-like example: phi_b = 4 deg -> b = 0.73, 30 deg -> b = 3.05 (s_b ~ 4.6).
+// All are updated every iteration from the latest run (stiffness hardly depends on the
 // strengths, and the multiplicative updates absorb the weaker cross effects as they go).
 #pragma once
 #include <functional>
@@ -22,11 +29,13 @@ struct MicroParameters {
   double bond_emod_Pa = 0, contact_emod_Pa = 0;
   double bond_kratio = 0, contact_kratio = 0;
   double tensile_strength_Pa = 0, cohesion_Pa = 0;
+  double friction_angle_deg = 0;  // bond friction angle phi_b (changed only when b is calibrated)
 };
 
 // What one UCS run measures.
 struct MacroProperties {
   double youngs_modulus_Pa = 0, poisson_ratio = 0, ucs_Pa = 0;
+  double slope_b = 0;  // d(peak differential stress)/d sigma3 (0 when not measured; as a target: not calibrated)
 };
 
 struct CalibrationSettings {
@@ -38,6 +47,10 @@ struct CalibrationSettings {
   double poisson_slope_guess = 0.08;       // d nu / d ln(kratio) for the first step (seed 000 default sample:
                                            // nu ~ 0.30 at kratio 14.65, ~0.1 near kratio 1)
   double max_factor = 4;                   // no parameter changes by more than this factor per iteration
+  double slope_tolerance = 0.10;           // relative, on b (when target.slope_b > 0)
+  double slope_gradient_guess = 4.6;       // d b / d tan(phi_b) for the first step (see above)
+  double max_friction_angle_deg = 60;      // phi_b stays in [0, this]
+  bool calibrates_slope() const { return target.slope_b > 0; }
 };
 
 struct CalibrationStep {
@@ -47,7 +60,8 @@ struct CalibrationStep {
   double youngs_modulus_error = 0;  // (E - E*) / E*
   double poisson_error = 0;         // nu - nu*
   double ucs_error = 0;             // (UCS - UCS*) / UCS*
-  bool converged = false;           // all three within their tolerances
+  double slope_error = 0;           // (b - b*) / b* (0 when b is not calibrated)
+  bool converged = false;           // all within their tolerances
 };
 
 struct CalibrationResult {
@@ -57,7 +71,8 @@ struct CalibrationResult {
   MicroParameters final_params;
 };
 
-// Stands in for one UCS run with the given parameters (iteration is 1-based).
+// Stands in for one UCS run (and, when b is calibrated, the triaxial runs that measure b) with
+// the given parameters (iteration is 1-based).
 using UcsModel = std::function<MacroProperties(const MicroParameters&, int iteration)>;
 
 // Throws ff::InputError for non-positive targets, tolerances or parameters.

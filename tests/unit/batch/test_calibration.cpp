@@ -137,3 +137,72 @@ TEST(Calibration, ParametersAreRoundedToShortNumbers) {
   EXPECT_EQ(p.bond_emod_Pa, 2.09123e9);
   EXPECT_EQ(p.bond_kratio, 14.6512);
 }
+
+namespace {
+
+// With the triaxial slope of the peak differential stress: b = 0.4 + 4.6 tan(phi_b), a little
+// less at high strength (the two runs measured on the C1-like example: 4 deg -> 0.73, 30 deg ->
+// 3.05), and the UCS rising with
+// phi_b as the compressed bonds' shear strength grows.
+MacroProperties stand_in_with_slope(const MicroParameters& p) {
+  MacroProperties m = stand_in(p);
+  const double t = std::tan(p.friction_angle_deg * 3.14159265358979 / 180);
+  m.ucs_Pa *= 1 + 0.4 * t;
+  m.slope_b = 0.4 + 4.6 * t - 0.05 * std::log(p.tensile_strength_Pa / 17.4e6);
+  return m;
+}
+
+MicroParameters table7_with_angle() {
+  MicroParameters p = kTable7;
+  p.friction_angle_deg = 4;
+  return p;
+}
+
+}  // namespace
+
+TEST(Calibration, TriaxialSlopeIsReachedThroughTheBondFrictionAngle) {
+  auto s = table5_targets();
+  s.target.slope_b = 3.54;  // seed 000 Eq. 1
+  const auto r = calibrate(table7_with_angle(), s, [](const MicroParameters& p, int) { return stand_in_with_slope(p); });
+  ASSERT_TRUE(r.converged);
+  EXPECT_LE(r.steps.size(), 8u);
+  const auto m = stand_in_with_slope(r.final_params);
+  EXPECT_LT(std::abs(m.slope_b / 3.54 - 1), 0.10);
+  EXPECT_LT(std::abs(m.ucs_Pa / 14.97e6 - 1), 0.05);
+  EXPECT_GT(r.final_params.friction_angle_deg, 25);
+  EXPECT_LT(r.final_params.friction_angle_deg, 40);
+}
+
+TEST(Calibration, FirstSlopeStepUsesTheGradientGuess) {
+  auto s = table5_targets();
+  s.target.slope_b = 3.54;
+  CalibrationStep st;
+  st.iteration = 1;
+  st.params = table7_with_angle();
+  st.measured = {2.37e9, 0.35, 14.97e6, 0.73};
+  score_step(st, s);
+  EXPECT_FALSE(st.converged);
+  const auto p = next_parameters(std::span<const CalibrationStep>(&st, 1), s);
+  const double expect = std::atan(std::tan(4 * 3.14159265358979 / 180) + (3.54 - 0.73) / 4.6) * 180 / 3.14159265358979;
+  EXPECT_NEAR(p.friction_angle_deg, expect, 1e-9);
+}
+
+TEST(Calibration, WithoutTargetSlopeTheAngleIsLeftAlone) {
+  const auto s = table5_targets();
+  const auto r = calibrate(table7_with_angle(), s, [](const MicroParameters& p, int) { return stand_in_with_slope(p); });
+  for (auto& st : r.steps) EXPECT_EQ(st.params.friction_angle_deg, 4);
+}
+
+TEST(Calibration, BadSlopeTargetOrMeasurementIsReported) {
+  auto s = table5_targets();
+  s.target.slope_b = -0.5;  // strength falling with confinement
+  EXPECT_THROW(check_calibration_input(table7_with_angle(), s), ff::InputError);
+  s.target.slope_b = 3.54;
+  EXPECT_THROW(calibrate(table7_with_angle(), s,
+                         [](const MicroParameters& p, int) {
+                           auto m = stand_in(p);
+                           m.slope_b = std::nan("");
+                           return m;
+                         }),
+               ff::Error);
+}

@@ -1,0 +1,98 @@
+// The triaxial validation of seed 000 (Zhao, Konietzky & Herbst 2021) as one reproducible job:
+// the scenarios it runs, the laboratory numbers it compares with, the checks it applies and the
+// report it writes (docs/validation/triaxial.md). `fracflow validate-triaxial` runs it.
+#pragma once
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace ff::batch {
+
+// Seed 000 Table 3: laboratory triaxial tests on coal (peak differential stress sigma1 - sigma3).
+// The same rows are in tests/data/dem/zhao2021_table3_triaxial_lab.csv (a test checks they agree).
+struct LabTriaxialTest {
+  const char* sample;
+  double sigma3_MPa, peak_differential_MPa;
+};
+const std::vector<LabTriaxialTest>& lab_table3();
+// Mean laboratory peak differential stress at a confining pressure [MPa]; nullopt when Table 3
+// has no test at that pressure (within 1 kPa).
+std::optional<double> lab_mean_peak_MPa(double sigma3_MPa);
+// Seed 000 Eq. 1 as printed: peak differential stress = 18.3432 + 3.5415 sigma3 [MPa].
+inline constexpr double kLabSlope = 3.5415, kLabIntercept_MPa = 18.3432;
+// Seed 000 Table 5 averages (coal matrix, UCS tests): the calibration targets.
+inline constexpr double kMatrixE_Pa = 2.37e9, kMatrixNu = 0.35, kMatrixUcs_Pa = 14.97e6;
+
+// Geometry and loading of the validation samples.
+struct ValidationSample {
+  double diameter_m = 25e-3, height_m = 50e-3;          // Table 3's samples: ~25 x 50 mm
+  double radius_min_m = 0.75e-3, radius_max_m = 1.125e-3;
+  double strain_rate = 10;                               // [1/s]: platens each move at rate * H / 2
+  double voxel_size_m = 0.5e-3;
+  unsigned seed = 2;                                     // packing and synthetic-sample seed
+};
+
+// Scenario text of the validation runs, seed 000 Table 7 micro-parameters (the matrix values are
+// the starting point; the calibrated ones are passed as overrides). `voxels` empty: a matrix-only
+// sample; else the folder of a segmented voxel stack (relative to the scenario file), made by
+// `fracflow make-sample` for the same geometry and voxel size.
+std::string validation_scenario(const ValidationSample& s, const std::string& driver, const std::string& voxels);
+
+// The numbers of one finished run that the report needs.
+struct TriaxialRunResult {
+  std::string label;               // e.g. "C1", "C4"
+  std::string lateral;             // membrane, rigid_cylinder, particle_membrane
+  double sigma3_Pa = 0;
+  double peak_differential_Pa = 0, strain_at_peak = 0, confinement_at_peak_Pa = 0;
+  double youngs_modulus_Pa = 0, poisson_ratio = 0;
+  double cracks_total = 0, cracks_tensile = 0, cracks_shear = 0;
+  double largest_sphere_deviation = 0;  // isotropic stage: measurement spheres vs boundary
+  int particles = 0;
+  double wall_time_s = 0;
+  std::vector<double> ring_radius_m, ring_z_m;  // final membrane profile (flexible membrane)
+  std::filesystem::path dir;
+};
+// Reads a triaxial run's summary.json; throws ff::Error when something needed is missing.
+TriaxialRunResult read_triaxial_result(const std::filesystem::path& run_dir, const std::string& label);
+
+// How uneven the final bulge is: radial expansion of each membrane ring between the platens
+// relative to the sample radius R0 (rings outside [z_bottom, z_top] are left out).
+struct BulgeProfile {
+  double max_expansion = 0, min_expansion = 0, mean_expansion = 0;  // (r - R0) / R0
+  double z_of_max_fraction = 0;  // height of the largest expansion as a fraction of the band
+};
+BulgeProfile bulge_profile(const TriaxialRunResult& r, double sample_radius_m);
+
+// Least-squares line of the peak differential stress on sigma3 (seed 000 Eq. 1's form).
+struct DifferentialFit {
+  double intercept_Pa = 0, slope = 0, r_squared = 0;
+};
+DifferentialFit fit_differential(const std::vector<TriaxialRunResult>& runs);
+
+struct ValidationCheck {
+  std::string what, measured, required;
+  bool passed = false;
+};
+
+// Everything the report says.
+struct ValidationReport {
+  ValidationSample sample;
+  nlohmann::json calibration;                 // calibration.json of `fracflow calibrate`
+  std::vector<TriaxialRunResult> c1, c4;      // flexible membrane, one per confining pressure
+  std::vector<TriaxialRunResult> laterals;    // C1 at the first pressure with other boundaries
+  std::string inclusions = "scaled";        // rule for inclusion/interface parameters (see the command)
+  std::vector<std::string> inclusion_sets;    // the overrides it gave
+  std::string command, date, machine;
+  double wall_time_s = 0;
+};
+
+// The checks of issue 4 / seed 000 Sec. 6, in report order.
+std::vector<ValidationCheck> validation_checks(const ValidationReport& r);
+
+// Writes the markdown report to `doc`, with its figures (PNG + the CSV they are drawn from) in
+// `doc`'s folder / images. Plotting problems only warn (src/io/plot.hpp).
+void write_validation_report(const ValidationReport& r, const std::filesystem::path& doc);
+
+}  // namespace ff::batch
