@@ -45,6 +45,7 @@ void save_dem(CheckpointWriter& w, const DemSystem& s) {
   w.put("dem.inv_mass", P.inv_mass);
   w.put("dem.inv_inertia", P.inv_inertia);
   w.put("dem.group", P.group);
+  w.put("dem.inward_force", P.inward_force);
   w.put("dem.bond_i", s.bond_i);
   w.put("dem.bond_j", s.bond_j);
   w.put("dem.bond_pair", s.bond_pair);
@@ -102,6 +103,7 @@ void load_dem(CheckpointReader& r, DemSystem& s) {
   r.get("dem.inv_mass", P.inv_mass);
   r.get("dem.inv_inertia", P.inv_inertia);
   r.get("dem.group", P.group);
+  if (r.has("dem.inward_force")) r.get("dem.inward_force", P.inward_force);  // older checkpoints: none
   r.get("dem.bond_i", s.bond_i);
   r.get("dem.bond_j", s.bond_j);
   r.get("dem.bond_pair", s.bond_pair);

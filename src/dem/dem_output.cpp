@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cstdio>
 
 #include "core/error.hpp"
@@ -99,8 +100,8 @@ void DemVtkWriter::write(const DemSystem& sys, long index, Real wall_extent) {
     write_vtp(dir_ / f, P.pos, VtpCells{VtpCells::Lines, conn}, {}, cd);
     bonds_.add(sys.time, f);
   }
-  // Contact-force network: compressive contacts as lines carrying the normal force
-  // (use a Tube filter scaled by "normal_force" for force chains).
+  // Contact-force network: compressive contacts between sample particles as lines carrying the
+  // normal force (use a Tube filter scaled by "normal_force" for force chains).
   {
     std::vector<std::int64_t> conn;
     std::vector<double> fn;
@@ -108,6 +109,7 @@ void DemVtkWriter::write(const DemSystem& sys, long index, Real wall_extent) {
     const auto& pl = sys.pair_loads();
     for (std::size_t k = 0; k < pi.size(); ++k) {
       if (pl[k].f.squaredNorm() == 0) continue;
+      if (static_cast<std::size_t>(std::max(pi[k], pj[k])) >= sample_particles_) continue;
       const Vec3 d = (P.pos[pj[k]] - P.pos[pi[k]]).normalized();
       conn.push_back(pi[k]);
       conn.push_back(pj[k]);

@@ -44,22 +44,28 @@ std::size_t DemSystem::install_bonds(Real max_gap) {
     const Index a = pi[p], b = pj[p];
     const Real gap = (particles.pos[b] - particles.pos[a]).norm() - particles.radius[a] - particles.radius[b];
     if (gap > max_gap) continue;
-    const int pt = materials.pair(particles.group[a], particles.group[b]);
-    bond_i.push_back(a);
-    bond_j.push_back(b);
-    bond_pair.push_back(pt);
-    bond_broken.push_back(0);
-    if (materials.bond_law == BondLaw::Parallel) {
-      pbond.push_back(ParallelBond::install());
-    } else if (materials.bond_law == BondLaw::Rotational) {
-      const BondEnds e{particles.pos[a], particles.pos[b], particles.orient[a], particles.orient[b], particles.radius[a],
-                       particles.radius[b]};
-      rbond.push_back(RotationalBond::install(materials.rotational[pt], e));
-    }
+    add_bond(a, b);
     ++added;
   }
   build_bond_adjacency();
   return added;
+}
+
+void DemSystem::add_bond(Index a, Index b) {
+  if (materials.bond_law == BondLaw::None) throw Error("internal: add_bond() with dem.bond_law = none");
+  if (a > b) std::swap(a, b);
+  const int pt = materials.pair(particles.group[a], particles.group[b]);
+  bond_i.push_back(a);
+  bond_j.push_back(b);
+  bond_pair.push_back(pt);
+  bond_broken.push_back(0);
+  if (materials.bond_law == BondLaw::Parallel) {
+    pbond.push_back(ParallelBond::install());
+  } else {
+    const BondEnds e{particles.pos[a], particles.pos[b], particles.orient[a], particles.orient[b], particles.radius[a],
+                     particles.radius[b]};
+    rbond.push_back(RotationalBond::install(materials.rotational[pt], e));
+  }
 }
 
 void DemSystem::build_bond_adjacency() {
@@ -107,6 +113,7 @@ void DemSystem::initialise() {
   if (settings.skin <= 0) throw Error("internal: DemSystem skin must be set before initialise()");
   particles.force.assign(particles.size(), Vec3::Zero());
   particles.moment.assign(particles.size(), Vec3::Zero());
+  particles.inward_force.resize(particles.size(), 0);
   wall_contacts_.resize(walls.size());
   build_bond_adjacency();
   pbond_coeffs_.reserve(materials.parallel.size());
@@ -332,9 +339,15 @@ void DemSystem::gather_and_integrate() {
   const auto adj = nl_.adjacency();
   auto& F = particles.force;
   auto& M = particles.moment;
+  const auto& inward = particles.inward_force;
+  const auto& pos = particles.pos;
 #pragma omp parallel for schedule(static) if (n > settings.parallel_min)
   for (std::size_t i = 0; i < n; ++i) {
     Vec3 f = Vec3::Zero(), m = Vec3::Zero();
+    if (inward[i] != 0) {  // constant magnitude, towards the z axis from where the particle is now
+      const Real rho = std::hypot(pos[i].x(), pos[i].y());
+      if (rho > 0) f = Vec3(pos[i].x(), pos[i].y(), 0) * (-inward[i] / rho);
+    }
     for (std::int64_t k = adj_off[i]; k < adj_off[i + 1]; ++k) {
       const std::int64_t e = adj[k];
       const PairLoad& L = pload_[e >> 1];

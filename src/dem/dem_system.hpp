@@ -68,6 +68,9 @@ class DemSystem {
 
   // Installs bonds between every pair whose gap is <= max_gap (stress-free).
   std::size_t install_bonds(Real max_gap);
+  // Installs one stress-free bond of the active law between particles a and b (e.g. the ring and
+  // row neighbours of a particle membrane); call initialise() afterwards.
+  void add_bond(Index a, Index b);
   // Prepares neighbour lists and per-pair storage; call after particles/bonds/walls change.
   void initialise();
   // One explicit step.
@@ -89,12 +92,18 @@ class DemSystem {
   // Love-Weber average stress of the particles whose centres lie in `inside` (tension +),
   // divided by `volume` [Pa] (METHODS.md 1.7).
   template <class Pred> Mat3 average_stress(Pred inside, Real volume) const;
+  // The same over the particles i with selected(i) (e.g. the sample without its membrane).
+  template <class Pred> Mat3 average_stress_of(Pred selected, Real volume) const;
+  // Normal stiffness of a contact of pair type `pair_type` (rB = 0: a wall) [N/m]; Hertz at
+  // `overlap`, at least 1% of the smaller radius (time-step estimates).
+  Real pair_stiffness(int pair_type, Real rA, Real rB, Real overlap) const;
 
   const NeighborList& neighbors() const { return nl_; }
   NeighborList& neighbors() { return nl_; }
   std::vector<ContactState>& contact_state() { return cstate_; }
   const std::vector<PairLoad>& pair_loads() const { return pload_; }
   std::vector<WallContacts>& wall_contacts() { return wall_contacts_; }
+  const std::vector<WallContacts>& wall_contacts() const { return wall_contacts_; }
   const std::vector<PairLoad>& bond_loads() const { return bload_; }
   void rebuild_neighbors();  // forced rebuild (also used after a checkpoint restore)
   void build_bond_adjacency();
@@ -112,7 +121,6 @@ class DemSystem {
   template <class Law> void membrane_forces(const std::vector<typename Law::Params>& params);
   void record_bond_failures();
   void gather_and_integrate();
-  Real pair_stiffness(int pair_type, Real rA, Real rB, Real overlap) const;
 
   NeighborList nl_;
   std::vector<ContactState> cstate_;
@@ -131,12 +139,17 @@ class DemSystem {
 
 template <class Pred>
 Mat3 DemSystem::average_stress(Pred inside, Real volume) const {
+  return average_stress_of([&](Index i) { return inside(particles.pos[i]); }, volume);
+}
+
+template <class Pred>
+Mat3 DemSystem::average_stress_of(Pred inside, Real volume) const {
   // sigma_ij = 1/V sum_p sum_c (x^c_i - x^p_i) F^{c,p}_j with F^{c,p} the force on p at c.
   Mat3 s = Mat3::Zero();
   const auto& x = particles.pos;
   auto add_pair = [&](Index a, Index b, const Vec3& xc, const Vec3& f_on_b) {
-    if (inside(x[b])) s += (xc - x[b]) * f_on_b.transpose();
-    if (inside(x[a])) s -= (xc - x[a]) * f_on_b.transpose();
+    if (inside(b)) s += (xc - x[b]) * f_on_b.transpose();
+    if (inside(a)) s -= (xc - x[a]) * f_on_b.transpose();
   };
   const auto pi = nl_.first(), pj = nl_.second();
   for (std::size_t p = 0; p < pi.size(); ++p) {
@@ -157,7 +170,7 @@ Mat3 DemSystem::average_stress(Pred inside, Real volume) const {
     for (std::size_t k = 0; k < wc.particle.size(); ++k) {
       const Index p = wc.particle[k];
       const Vec3& f_wall = wc.load[k].f;
-      if (f_wall.squaredNorm() == 0 || !inside(x[p])) continue;
+      if (f_wall.squaredNorm() == 0 || !inside(p)) continue;
       ContactGeom g;
       if (!walls[w].geometry(g, x[p], particles.radius[p])) continue;
       s += (g.xc - x[p]) * (-f_wall).transpose();
@@ -167,7 +180,7 @@ Mat3 DemSystem::average_stress(Pred inside, Real volume) const {
     const auto cp = membrane->candidate_particles();
     const auto cl = membrane->candidate_loads();
     for (std::size_t c = 0; c < cp.size(); ++c)
-      if (cl[c].f.squaredNorm() > 0 && inside(x[cp[c]])) s += (cl[c].xc - x[cp[c]]) * (-cl[c].f).transpose();
+      if (cl[c].f.squaredNorm() > 0 && inside(cp[c])) s += (cl[c].xc - x[cp[c]]) * (-cl[c].f).transpose();
   }
   return s / volume;
 }

@@ -16,6 +16,10 @@ struct ParticleStore {
   std::vector<Real> mass, inertia;        // physical mass [kg], moment of inertia [kg m^2]
   std::vector<Real> inv_mass, inv_inertia;  // inertial (possibly density-scaled) inverses
   std::vector<std::int32_t> group;        // material group index
+  // Load of constant magnitude towards the z axis: horizontal, along -(x, y, 0)/|(x, y)| from the
+  // current position every step, so it exerts no moment about the axis (the confining loads of a
+  // particle membrane); zero for most particles [N].
+  std::vector<Real> inward_force;
   // Per-step accumulators (not checkpointed: recomputed every step).
   std::vector<Vec3> force, moment;
 
@@ -24,7 +28,8 @@ struct ParticleStore {
     pos.resize(n, Vec3::Zero()); vel.resize(n, Vec3::Zero()); omega.resize(n, Vec3::Zero());
     orient.resize(n, Quat::Identity()); disp.resize(n, Vec3::Zero()); radius.resize(n, 0);
     mass.resize(n, 0); inertia.resize(n, 0); inv_mass.resize(n, 0); inv_inertia.resize(n, 0);
-    group.resize(n, 0); force.resize(n, Vec3::Zero()); moment.resize(n, Vec3::Zero());
+    group.resize(n, 0); inward_force.resize(n, 0);
+    force.resize(n, Vec3::Zero()); moment.resize(n, Vec3::Zero());
   }
   // Sets mass and inertia from density: spheres in 3D, disks of thickness 1 m in 2D.
   void set_mass_from_density(std::size_t i, Real density, int dim) {

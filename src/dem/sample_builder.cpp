@@ -127,6 +127,7 @@ void remove_particles(DemSystem& sys, const std::vector<char>& remove) {
   keep(P.pos, kept.pos), keep(P.vel, kept.vel), keep(P.omega, kept.omega), keep(P.orient, kept.orient);
   keep(P.disp, kept.disp), keep(P.radius, kept.radius), keep(P.mass, kept.mass), keep(P.inertia, kept.inertia);
   keep(P.inv_mass, kept.inv_mass), keep(P.inv_inertia, kept.inv_inertia), keep(P.group, kept.group);
+  keep(P.inward_force, kept.inward_force);
   keep(P.force, kept.force), keep(P.moment, kept.moment);
   P = ParticleStore{};
   sys.wall_contacts().clear();

@@ -32,19 +32,21 @@ nlohmann::json params_json(const Config& cfg) {
   return j;
 }
 
-nlohmann::json cracks_json(const dem::DemSystem& sys) {
+nlohmann::json cracks_json(const dem::DemSystem& sys, int groups) {
   nlohmann::json j = {{"tensile", sys.cracks.tensile}, {"shear", sys.cracks.shear}, {"total", sys.cracks.total()}};
   nlohmann::json by_pair = nlohmann::json::object();
   const auto& g = sys.materials.group_names;
-  for (int a = 0; a < sys.materials.groups(); ++a)
-    for (int b = a; b < sys.materials.groups(); ++b)
+  const int ng = groups < 0 ? sys.materials.groups() : groups;
+  for (int a = 0; a < ng; ++a)
+    for (int b = a; b < ng; ++b)
       by_pair[g[a] + "-" + g[b]] = {{"tensile", sys.cracks.count(a, b, 1)}, {"shear", sys.cracks.count(a, b, 2)}};
   j["by_group_pair"] = by_pair;
   return j;
 }
 
-nlohmann::json sample_json(const dem::DemSystem& sys, const dem::SampleInfo& info) {
-  return {{"particles", sys.particles.size()}, {"bonds", info.bonds},        {"porosity", info.porosity},
+nlohmann::json sample_json(const dem::DemSystem& sys, const dem::SampleInfo& info, long particles) {
+  const long n = particles < 0 ? static_cast<long>(sys.particles.size()) : particles;
+  return {{"particles", n},                   {"bonds", info.bonds},        {"porosity", info.porosity},
           {"height_m", info.height},          {"width_m", info.width},      {"locked_in_stress_Pa", info.locked_in_stress},
           {"floaters", info.floaters},        {"dimension", info.dim}};
 }

@@ -21,10 +21,12 @@ dem::SampleInfo sample_info(const SampleRecord& record);
 
 // Every resolved parameter, key -> value.
 nlohmann::json params_json(const Config& cfg);
-// Crack counts by type and by group pair.
-nlohmann::json cracks_json(const dem::DemSystem& sys);
-// Particles, bonds, porosity, size, locked-in stress, floaters, dimension.
-nlohmann::json sample_json(const dem::DemSystem& sys, const dem::SampleInfo& info);
+// Crack counts by type and by pair of the first `groups` groups (-1: all; a particle
+// membrane's group comes last and is left out).
+nlohmann::json cracks_json(const dem::DemSystem& sys, int groups = -1);
+// Particles (the first `particles` of the system; -1: all), bonds, porosity, size, locked-in
+// stress, floaters, dimension.
+nlohmann::json sample_json(const dem::DemSystem& sys, const dem::SampleInfo& info, long particles = -1);
 
 }  // namespace ff::drivers
 

@@ -32,13 +32,16 @@ void declare(ParamTable& t) {
   dem::declare_sample_params(t);
   t.real("triaxial.confining_pressure", 5e6, "Pa", "confining pressure sigma3 (lateral, and axial in the isotropic stage)")
       .positive();
-  t.string("triaxial.lateral", "membrane", "lateral confinement: flexible membrane of servo-controlled triangles, or a rigid cylinder with a servo on its radius")
-      .one_of({"membrane", "rigid_cylinder"});
+  t.string("triaxial.lateral", "membrane",
+           "lateral confinement: flexible membrane of servo-controlled triangles, a rigid cylinder with a servo on its "
+           "radius, or a particle membrane (bonded spheres, each pushed by a constant force; seed 000 Fig. 15)")
+      .one_of({"membrane", "rigid_cylinder", "particle_membrane"});
   t.real("triaxial.platen_velocity", 0.05, "m/s", "deviatoric stage: speed of each platen towards the sample").positive();
   t.real("triaxial.platen_friction", 0.1, "-", "friction between platens and particles (seed 000: 0.1)").non_negative();
   t.real("triaxial.servo_velocity", 1.0, "m/s",
-         "speed cap of every servo (isotropic-stage platens, membrane, cylinder); must exceed the sample's lateral bulging "
-         "speed, several times the platen velocity (seed 000 uses 0.01 with slower platens)")
+         "speed cap of every servo (isotropic-stage platens, membrane, cylinder) and of the particle membrane's spheres in "
+         "the isotropic stage; must exceed the sample's lateral bulging speed, several times the platen velocity (seed 000 "
+         "uses 0.01 with slower platens)")
       .positive();
   t.real("triaxial.servo_relaxation", 0.8, "-", "servo relaxation factor alpha (PFC default 0.8)").open_range(0, 1).at_most(1);
   t.real("triaxial.isotropic_tolerance", 0.02, "-", "isotropic stage ends when platen stress and confinement are within this fraction of sigma3")
@@ -54,11 +57,28 @@ void declare(ParamTable& t) {
   t.integer("membrane.n_theta", 24, "-", "membrane: square units around the circumference (seed 000 demo: 16)").at_least(6);
   t.integer("membrane.n_z", 0, "-", "membrane: rows of units along the axis (0: nearly square units)").non_negative();
   t.real("membrane.length_factor", 1.2, "-", "membrane sleeve length / sample height (longer than the sample)").at_least(1);
-  t.real("membrane.clearance", 0.01, "-", "initial gap between sample and membrane facets, as a fraction of the sample radius").non_negative();
+  t.real("membrane.clearance", 0.01, "-",
+         "initial gap between sample and membrane facets (particle membrane: its inner surface), as a fraction of the "
+         "sample radius")
+      .non_negative();
   t.real("membrane.min_radius_fraction", 0.9, "-", "vertices never come closer to the axis than this fraction of the sample radius")
       .open_range(0, 1);
-  t.real("membrane.friction", 0.0, "-", "particle-membrane friction (0: pure pressure, as a rubber sleeve with a lubricated contact)")
+  t.real("membrane.friction", 0.0, "-",
+         "friction between sample particles and the membrane (flexible or particle) or rigid cylinder (0: pure pressure, as "
+         "a rubber sleeve with a lubricated contact)")
       .non_negative();
+  t.real("particle_membrane.radius_fraction", 1.0, "-",
+         "particle membrane: sphere radius as a fraction of the sample's mean particle radius (adjusted by up to 15% so "
+         "that the rows fill the platen gap and the ring clears the sample by membrane.clearance)")
+      .range(0.2, 3);
+  t.real("particle_membrane.emod", 1e7, "Pa",
+         "particle membrane: modulus of its bonds and of its spheres' mutual contacts (latex-like; its hoop stress "
+         "~ emod pi r_m e_theta / (2 R) stays small beside sigma3 for e_theta of a few %)")
+      .positive();
+  t.real("particle_membrane.density", 1000, "kg/m^3",
+         "particle membrane: sphere density (latex ~ 950); inertial masses are scaled up where the sample's time step needs "
+         "it")
+      .positive();
 }
 
 // Driver state that must survive a restart.
@@ -81,6 +101,7 @@ struct TriaxialState {
 namespace ff {
 template <> struct is_checkpoint_pod<drivers::TriaxialState> : std::true_type {};
 template <> struct is_checkpoint_pod<dem::MembraneSettings> : std::true_type {};
+template <> struct is_checkpoint_pod<dem::ParticleMembraneLayout> : std::true_type {};
 }  // namespace ff
 
 namespace ff::drivers {
@@ -114,29 +135,77 @@ void add_rigid_cylinder(dem::DemSystem& sys, const dem::SampleInfo& info, Real f
   sys.initialise();
 }
 
-void write_checkpoint(const fs::path& dir, const dem::DemSystem& sys, const TriaxialState& st, const dem::SampleInfo& info) {
+dem::ParticleMembraneMaterial particle_membrane_material(const Config& cfg) {
+  dem::ParticleMembraneMaterial m;
+  m.emod = cfg.real("particle_membrane.emod");
+  m.density = cfg.real("particle_membrane.density");
+  m.friction = cfg.real("membrane.friction");
+  return m;
+}
+
+// The particle membrane around the sample between the platens, after the time step is chosen:
+// its spheres' inertial masses are scaled so that they do not lower it.
+dem::ParticleMembraneLayout add_particle_membrane(const Config& cfg, dem::DemSystem& sys, const dem::SampleInfo& info) {
+  const Real R = 0.5 * info.width;
+  Real rmean = 0;
+  for (Real r : sys.particles.radius) rmean += r;
+  rmean /= static_cast<Real>(sys.particles.size());
+  dem::ParticleMembraneSpec spec;
+  spec.sample_radius = R;
+  spec.z_bottom = sys.walls[0].point.z();
+  spec.z_top = sys.walls[1].point.z();
+  spec.particle_radius = cfg.real("particle_membrane.radius_fraction") * rmean;
+  spec.clearance = cfg.real("membrane.clearance") * R;
+  spec.pressure = cfg.real("triaxial.confining_pressure");
+  dem::ParticleMembraneLayout l;
+  try {
+    l = dem::add_particle_membrane(sys, spec, particle_membrane_material(cfg));
+  } catch (const InputError& e) {
+    cfg.fail("triaxial.lateral", e.what());
+  }
+  const Real f = dem::stabilise_particle_membrane(sys, l, sys.settings.dt, cfg.real("dem.time_step_safety"));
+  log::info("particle membrane: {} x {} spheres of radius {:.4g} m on radius {:.4g} m (inner surface {:.4g} m), {} bonds, "
+            "{:.4g} N on each{}",
+            l.n_theta, l.n_z, l.particle_radius, l.centre_radius, l.inner_radius(), dem::particle_membrane_bonds(sys, l),
+            l.force, f > 1 ? fmt::format("; inertial masses x {:.3g} for the time step", f) : "");
+  return l;
+}
+
+void write_checkpoint(const fs::path& dir, const dem::DemSystem& sys, const TriaxialState& st, const dem::SampleInfo& info,
+                      const Lateral& lat) {
   fs::create_directories(dir);
   CheckpointWriter w(dir / "state.ffcp");
   if (sys.membrane) w.put_value("triaxial.membrane_settings", sys.membrane->settings());
+  if (lat.kind == LateralKind::ParticleMembrane) w.put_value("triaxial.particle_membrane", lat.particles);
   dem::save_dem(w, sys);
   w.put_value("triaxial.state", st);
   w.put_value("triaxial.sample", sample_record(info));
   w.commit();
 }
 
-void read_checkpoint(const fs::path& dir, dem::DemSystem& sys, TriaxialState& st, dem::SampleInfo& info) {
+void read_checkpoint(const Config& cfg, const fs::path& dir, dem::DemSystem& sys, TriaxialState& st, dem::SampleInfo& info,
+                     Lateral& lat) {
   CheckpointReader r(dir / "state.ffcp");
   if (r.has("triaxial.membrane_settings")) sys.membrane.emplace(r.get_value<dem::MembraneSettings>("triaxial.membrane_settings"));
+  if ((lat.kind == LateralKind::ParticleMembrane) != r.has("triaxial.particle_membrane"))
+    cfg.fail("triaxial.lateral", "the checkpoint was written with another lateral boundary; resume with the scenario it was "
+                                 "written with");
   dem::load_dem(r, sys);
+  if (lat.kind == LateralKind::ParticleMembrane) {  // its group comes after the scenario's, as when it was built
+    lat.particles = r.get_value<dem::ParticleMembraneLayout>("triaxial.particle_membrane");
+    if (dem::add_particle_membrane_group(sys.materials, particle_membrane_material(cfg)) != lat.particles.group)
+      cfg.fail("triaxial.lateral", "the checkpoint's particle groups differ from the scenario's");
+  }
   st = r.get_value<TriaxialState>("triaxial.state");
   info = sample_info(r.get_value<SampleRecord>("triaxial.sample"));
 }
 
-std::vector<std::string> columns(const dem::Materials& mat) {
+// Series columns; crack counts by pair of the sample's groups (the first `groups`).
+std::vector<std::string> columns(const dem::Materials& mat, int groups) {
   std::vector<std::string> c = {"step", "time", "axial_strain", "axial_stress", "differential_stress", "confinement",
                                 "lateral_strain", "volumetric_strain", "cracks_tensile", "cracks_shear", "cracks_total"};
-  for (int a = 0; a < mat.groups(); ++a)
-    for (int b = a; b < mat.groups(); ++b) {
+  for (int a = 0; a < groups; ++a)
+    for (int b = a; b < groups; ++b) {
       const std::string p = mat.group_names[a] + "-" + mat.group_names[b];
       c.push_back("cracks_" + p + "_tensile");
       c.push_back("cracks_" + p + "_shear");
@@ -182,7 +251,12 @@ void make_plots(const fs::path& out, const Config& cfg) {
 RunStatus run(const Config& cfg, const RunOptions& opt) {
   const auto wall_start = std::chrono::steady_clock::now();
   const Real p = cfg.real("triaxial.confining_pressure");
-  const LateralKind kind = cfg.string("triaxial.lateral") == "membrane" ? LateralKind::Membrane : LateralKind::RigidCylinder;
+  const std::string lateral_name = cfg.string("triaxial.lateral");
+  Lateral lat;
+  lat.kind = lateral_name == "membrane"         ? LateralKind::Membrane
+             : lateral_name == "rigid_cylinder" ? LateralKind::RigidCylinder
+                                                : LateralKind::ParticleMembrane;
+  const LateralKind kind = lat.kind;
   const ServoSettings servo{cfg.real("triaxial.servo_velocity"), cfg.real("triaxial.servo_relaxation")};
   dem::DemSystem sys;
   sys.settings = dem::build_settings(cfg);
@@ -191,10 +265,10 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
   if (cfg.string("sample.shape") != "cylinder") cfg.fail("sample.shape", "a triaxial test needs shape = \"cylinder\"");
   dem::SampleInfo info;
   TriaxialState st;
-  const std::size_t cyl = 2;  // the rigid cylinder is wall 2 (after the platens)
+  const std::size_t cyl = lat.cylinder_wall;  // the rigid cylinder is wall 2 (after the platens)
   const fs::path cp_dir = opt.out_dir / "checkpoint";
   if (opt.resume) {
-    read_checkpoint(cp_dir, sys, st, info);
+    read_checkpoint(cfg, cp_dir, sys, st, info, lat);
     if (st.finished) {
       log::info("this run had already finished; nothing to resume");
       return RunStatus::Finished;
@@ -208,15 +282,20 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
       sys.rebuild_neighbors();
       log::info("flexible membrane: {} x {} units, {} triangles, sleeve radius {:.4g} m", sys.membrane->settings().n_theta,
                 sys.membrane->settings().n_z, sys.membrane->element_count(), sys.membrane->settings().radius);
-    } else {
+    } else if (kind == LateralKind::RigidCylinder) {
       add_rigid_cylinder(sys, info, cfg.real("membrane.friction"));
     }
     dem::choose_time_step(cfg, sys);
+    if (kind == LateralKind::ParticleMembrane) lat.particles = add_particle_membrane(cfg, sys, info);
   }
   const Real area = info.area;  // initial cross-section (stresses on it, as the UCS test)
+  // The sample proper: a particle membrane's spheres and group come after the sample's.
+  const std::size_t n_sample = lat.sample_particles(sys);
+  const int sample_groups = sys.materials.groups() - (kind == LateralKind::ParticleMembrane ? 1 : 0);
+  auto is_sample = [n_sample](Index i) { return static_cast<std::size_t>(i) < n_sample; };
 
   // Outputs. On resume, rows after the checkpoint are dropped (they are recomputed identically).
-  const auto cols = columns(sys.materials);
+  const auto cols = columns(sys.materials, sample_groups);
   const std::vector<std::string> iso_cols = {"step", "time", "axial_stress", "confinement", "unbalanced_force_ratio"};
   CsvWriter series, iso;
   if (opt.resume) {
@@ -235,6 +314,7 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
   dem::DemVtkWriter writer;
   const Real extent = 1.6 * std::max(info.width, info.height);
   if (vtk) writer.open(opt.out_dir / "vtk", opt.resume, sys.time, kind == LateralKind::Membrane);
+  writer.set_sample_particles(n_sample);
   if (vtk && !opt.resume) writer.write(sys, st.vtk_index++, extent);
 
   const long every = cfg.integer("triaxial.series_interval");
@@ -258,7 +338,7 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
   auto start_deviatoric = [&] {
     st.stage = 1;
     st.h_dev0 = sys.walls[1].point.z() - sys.walls[0].point.z();
-    st.v_dev0 = enclosed_volume(sys, kind, cyl);
+    st.v_dev0 = enclosed_volume(sys, lat);
     sys.walls[0].velocity = Vec3(0, 0, v_platen);
     sys.walls[1].velocity = Vec3(0, 0, -v_platen);
     st.next_vtk_strain = vtk_every;
@@ -270,12 +350,14 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
   try {
     for (;;) {
       for (long k = 0; k < every; ++k) {  // servos act every step
-        if (st.stage == 0) servo_platens(sys, p, area, servo);
+        if (st.stage == 0) servo_platens(sys, p, area, servo, n_sample);
         if (kind == LateralKind::RigidCylinder) servo_cylinder(sys, cyl, p, servo);
         sys.step();
+        if (st.stage == 0 && kind == LateralKind::ParticleMembrane)
+          dem::limit_particle_membrane_speed(sys.particles, lat.particles, servo.v_max);
       }
-      const Real axial = platen_stress(sys, area);
-      const Real conf = applied_confinement(sys, kind, cyl);
+      const Real axial = platen_stress(sys, area, n_sample);
+      const Real conf = applied_confinement(sys, lat);
       if (st.stage == 0) {
         st.iso_steps += every;
         const Real ubf = sys.max_unbalanced_force_ratio();
@@ -283,8 +365,10 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
         iso.row(row);
         ++st.iso_rows;
         // Converged when both boundary stresses have stayed within the tolerance for 5 rows
-        // and the sample is near equilibrium.
-        const bool ok = std::abs(axial - p) <= iso_tol * p && std::abs(conf - p) <= iso_tol * p && ubf < 0.05;
+        // and the sample is near equilibrium. A particle membrane's forces are constant: there
+        // is no lateral servo to wait for (its reported confinement follows the sample's radius).
+        const bool lateral_ok = kind == LateralKind::ParticleMembrane || std::abs(conf - p) <= iso_tol * p;
+        const bool ok = std::abs(axial - p) <= iso_tol * p && lateral_ok && ubf < 0.05;
         iso_ok_rows = ok ? iso_ok_rows + 1 : 0;
         progress.update(sys.step_count, sys.time, std::min(1.0, static_cast<double>(st.iso_steps) / iso_max),
                         fmt::format("isotropic: platens {:.3f} MPa, confinement {:.3f} MPa (target {:.3f})", 1e-6 * axial,
@@ -298,10 +382,10 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
           st.iso_axial = axial;
           st.iso_conf = conf;
           const auto spheres = measure_spheres(sys, info, sys.walls[0].point.z(), sys.walls[1].point.z(),
-                                               cfg.real("triaxial.measurement_sphere_radius"));
+                                               cfg.real("triaxial.measurement_sphere_radius"), n_sample);
           st.iso_sphere_error = 0;
           {  // By equilibrium the whole sample's average stress equals the boundary stresses.
-            const Mat3 w = sys.average_stress([](const Vec3&) { return true; }, enclosed_volume(sys, kind, cyl));
+            const Mat3 w = sys.average_stress_of(is_sample, enclosed_volume(sys, lat));
             st.whole_axial = -w(2, 2);
             st.whole_lateral = -0.5 * (w(0, 0) + w(1, 1));
           }
@@ -319,23 +403,33 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
                     1e-6 * st.sphere_axial[2], 1e-6 * st.sphere_lateral[0], 1e-6 * st.sphere_lateral[1],
                     1e-6 * st.sphere_lateral[2], 100 * st.iso_sphere_error,
                     st.iso_sphere_error <= 0.05 ? "within" : "NOT within");
+          if (kind == LateralKind::ParticleMembrane) {  // the estimate of add_particle_membrane(), now with contacts
+            const Real crit = sys.critical_time_step();
+            if (sys.settings.dt > crit)
+              log::warn("particle membrane: the time step {:.4g} s exceeds the critical step {:.4g} s with the membrane "
+                        "pressing; lower dem.time_step_safety", sys.settings.dt, crit);
+            else
+              log::info("particle membrane pressing: critical time step {:.4g} s (time step {:.4g} s)", crit, sys.settings.dt);
+          }
           start_deviatoric();
         }
       } else {
         const Real h = sys.walls[1].point.z() - sys.walls[0].point.z();
         const Real ea = (st.h_dev0 - h) / st.h_dev0;
-        const Real ev = (st.v_dev0 - enclosed_volume(sys, kind, cyl)) / st.v_dev0;
+        const Real ev = (st.v_dev0 - enclosed_volume(sys, lat)) / st.v_dev0;
         const Real el = 0.5 * (ev - ea);
         const Real diff = axial - p;
         std::vector<double> row = {static_cast<double>(sys.step_count), sys.time, ea, axial, diff, conf, el, ev,
                                    static_cast<double>(sys.cracks.tensile), static_cast<double>(sys.cracks.shear),
                                    static_cast<double>(sys.cracks.total())};
-        for (int a = 0; a < sys.materials.groups(); ++a)
-          for (int b = a; b < sys.materials.groups(); ++b) {
+        for (int a = 0; a < sample_groups; ++a)
+          for (int b = a; b < sample_groups; ++b) {
             row.push_back(static_cast<double>(sys.cracks.count(a, b, 1)));
             row.push_back(static_cast<double>(sys.cracks.count(a, b, 2)));
           }
-        row.push_back(static_cast<double>(sys.intact_bonds()));
+        std::size_t bonds = sys.intact_bonds();
+        if (kind == LateralKind::ParticleMembrane) bonds -= dem::particle_membrane_bonds(sys, lat.particles);
+        row.push_back(static_cast<double>(bonds));
         row.push_back(sys.kinetic_energy());
         row.push_back(sys.max_unbalanced_force_ratio());
         series.row(row);
@@ -367,17 +461,17 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
       st.cracks_written = static_cast<long>(sys.cracks.events.size());
       if (!stop_reason.empty()) break;
       if (cp_every > 0 && (sys.step_count / every) % std::max(1L, cp_every / every) == 0)
-        write_checkpoint(cp_dir, sys, st, info);
+        write_checkpoint(cp_dir, sys, st, info, lat);
       const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
       if ((opt.max_wall_s > 0 && elapsed >= opt.max_wall_s) || (opt.max_steps > 0 && sys.step_count >= opt.max_steps) ||
           (!opt.abort_file.empty() && fs::exists(opt.abort_file))) {
-        write_checkpoint(cp_dir, sys, st, info);
+        write_checkpoint(cp_dir, sys, st, info, lat);
         status = RunStatus::Interrupted;
         break;
       }
     }
   } catch (const NumericalError&) {
-    write_checkpoint(opt.out_dir / "checkpoint_failed", sys, st, info);
+    write_checkpoint(opt.out_dir / "checkpoint_failed", sys, st, info, lat);
     series.close();
     iso.close();
     throw;
@@ -387,7 +481,7 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
   if (status == RunStatus::Interrupted) return status;
 
   st.finished = 1;
-  write_checkpoint(cp_dir, sys, st, info);
+  write_checkpoint(cp_dir, sys, st, info, lat);
   if (vtk) writer.write(sys, st.vtk_index++, extent);
   const ElasticFit fit = fit_elastic(e_hist, s_hist, l_hist, static_cast<std::size_t>(st.peak_row));
   nlohmann::json j;
@@ -419,7 +513,7 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
                           {"sphere_radius_fraction", cfg.real("triaxial.measurement_sphere_radius")},
                           {"largest_sphere_deviation", st.iso_sphere_error},
                           {"spheres_within_5_percent", st.iso_sphere_error <= 0.05}};
-  j["cracks"] = cracks_json(sys);
+  j["cracks"] = cracks_json(sys, sample_groups);
   if (sys.membrane) {
     const auto& m = *sys.membrane;
     std::vector<Real> rad(m.settings().n_z + 1), z(m.settings().n_z + 1);
@@ -427,7 +521,24 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
     j["membrane"] = {{"elements", m.element_count()}, {"n_theta", m.settings().n_theta}, {"n_z", m.settings().n_z},
                      {"ring_radius_m", rad}, {"ring_z_m", z}};
   }
-  j["sample"] = sample_json(sys, info);
+  if (kind == LateralKind::ParticleMembrane) {
+    const auto& l = lat.particles;
+    std::vector<Real> rad(static_cast<std::size_t>(l.n_z)), z(rad.size());
+    dem::particle_membrane_profile(sys.particles, l, rad, z);
+    j["particle_membrane"] = {{"particles", l.count()},
+                              {"n_theta", l.n_theta},
+                              {"n_z", l.n_z},
+                              {"particle_radius_m", l.particle_radius},
+                              {"initial_centre_radius_m", l.centre_radius},
+                              {"initial_inner_radius_m", l.inner_radius()},
+                              {"force_per_particle_N", l.force},
+                              {"total_force_N", l.total_force()},
+                              {"bonds", dem::particle_membrane_bonds(sys, l)},
+                              {"inertial_mass_factor", l.mass_factor},
+                              {"ring_centre_radius_m", rad},
+                              {"ring_z_m", z}};
+  }
+  j["sample"] = sample_json(sys, info, static_cast<long>(n_sample));
   j["time_step_s"] = sys.settings.dt;
   j["steps"] = sys.step_count;
   j["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
@@ -446,7 +557,8 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
 
 Driver triaxial_driver() {
   return Driver{"triaxial",
-                "triaxial compression in a flexible membrane or rigid cylinder (isotropic stage, then deviatoric loading)",
+                "triaxial compression in a flexible membrane, rigid cylinder or particle membrane (isotropic stage, then "
+                "deviatoric loading)",
                 declare, run};
 }
 

@@ -4,8 +4,11 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 
+#include "io/checkpoint.hpp"
 #include "ucs_test_support.hpp"
 
 using namespace ff;
@@ -23,6 +26,18 @@ std::string small_triaxial(const std::string& lateral, double sigma3) {
   replace(s, "driver = \"ucs\"", "driver = \"triaxial\"");
   replace(s, "[ucs]\n", "[triaxial]\nlateral = \"" + lateral + "\"\nconfining_pressure = " + std::to_string(sigma3) + "\n");
   return s;
+}
+
+// Bit-for-bit equality of two checkpointed particle states.
+void expect_same_state(const std::filesystem::path& a, const std::filesystem::path& b) {
+  CheckpointReader ra(a / "checkpoint" / "state.ffcp"), rb(b / "checkpoint" / "state.ffcp");
+  for (const char* tag : {"dem.pos", "dem.vel", "dem.omega"}) {
+    std::vector<Vec3> va, vb;
+    ra.get(tag, va);
+    rb.get(tag, vb);
+    ASSERT_EQ(va.size(), vb.size()) << tag;
+    EXPECT_EQ(std::memcmp(va.data(), vb.data(), va.size() * sizeof(Vec3)), 0) << tag;
+  }
 }
 
 }  // namespace
@@ -110,6 +125,66 @@ TEST(TriaxialValidation, ResumeContinuesTheRun) {
       EXPECT_NEAR(qb, qa, 0.01 * qa);
     }
   }
+  std::filesystem::remove_all(a);
+  std::filesystem::remove_all(b);
+}
+
+TEST(TriaxialValidation, ParticleMembraneConfinesTheSampleLikeTheFlexibleMembrane) {
+  // Particle membrane ([S000] sec. 6 and Fig. 15; de Bono et al. 2012; METHODS.md 3): bonded
+  // spheres, each pushed towards the axis by a force of constant magnitude p A_i fixed when it is
+  // built. Isotropic stage: platen stress within the stage tolerance (2%) of sigma3; by
+  // equilibrium the lateral stress the sample carries (Love-Weber average over the volume inside
+  // the membrane, METHODS.md 1.7) and the reported confinement (total force / current inner
+  // surface) within 10% of sigma3 (spheres nestling in the sample's surface hollows make the inner
+  // surface uneven; measured +2% and +7%). Peak: [S000] Fig. 15 finds a clearly lower strength
+  // than with its flexible wall. Not reproduced here, so not asserted: the membrane's mean radius
+  // hardly grows before the peak while the platens close, so the constant forces act on a
+  // slightly smaller area and the applied confinement rises (+8% at the peak). Measured peaks,
+  // particle vs flexible membrane: 15.26 vs 15.31 MPa in this run, 14.95 vs 15.12 MPa at the
+  // default 0.1 m/s, 14.50 vs 14.43 MPa for examples/triaxial_c1.toml. Asserted: within 10%.
+  const double p = 5e6;
+  const auto out = test::scratch("triax_particle_membrane");
+  const std::vector<std::string> faster = {"triaxial.platen_velocity=0.2", "triaxial.stop_fraction=0.85"};
+  ASSERT_EQ(test::run_scenario(small_triaxial("particle_membrane", p), faster, out, 1), RunStatus::Finished);
+  const auto r = test::collect(out);
+  const auto& iso = r.summary["isotropic_stage"];
+  EXPECT_TRUE(iso["converged"].get<bool>());
+  EXPECT_NEAR(iso["platen_stress_Pa"].get<double>(), p, 0.02 * p);
+  EXPECT_NEAR(iso["whole_sample_lateral_Pa"].get<double>(), p, 0.10 * p);
+  EXPECT_NEAR(iso["confinement_Pa"].get<double>(), p, 0.10 * p);
+  const auto& pm = r.summary["particle_membrane"];
+  EXPECT_EQ(pm["bonds"].get<long>(), pm["n_theta"].get<long>() * (2 * pm["n_z"].get<long>() - 1));
+  // No crack involves the membrane: its bonds never break and it is bonded to nothing else.
+  EXPECT_EQ(r.cracks_text.find("membrane"), std::string::npos);
+  const double q_pm = r.summary["peak_differential_stress_Pa"];
+  ASSERT_EQ(test::run_scenario(small_triaxial("membrane", p), faster, out, 1), RunStatus::Finished);
+  const auto fw = test::collect(out);
+  const double q_fw = fw.summary["peak_differential_stress_Pa"];
+  // The same sample; its figures leave the membrane's spheres and bonds out.
+  EXPECT_EQ(r.summary["sample"]["particles"], fw.summary["sample"]["particles"]);
+  EXPECT_EQ(r.series.column("intact_bonds")[0] + r.series.column("cracks_total")[0],
+            r.summary["sample"]["bonds"].get<double>());
+  EXPECT_NEAR(q_pm, q_fw, 0.10 * q_fw) << "particle membrane " << q_pm << " Pa, flexible membrane " << q_fw << " Pa";
+  std::filesystem::remove_all(out);
+}
+
+TEST(TriaxialValidation, ParticleMembraneRunResumesAndIgnoresTheThreadCount) {
+  // Everything the particle membrane needs is in the DEM state (spheres, bonds, inward loads) and
+  // the checkpointed layout. A run on 2 threads with every loop parallel (dem.parallel_min = 0),
+  // interrupted in the isotropic stage and resumed on 1 thread into the deviatoric stage, is
+  // bit-identical to an uninterrupted run on 1 thread: same files, same particle state.
+  const std::string text = small_triaxial("particle_membrane", 5e6);
+  const std::vector<std::string> sets = {"dem.parallel_min=0"};
+  const auto a = test::scratch("pm_whole"), b = test::scratch("pm_resumed");
+  const long stop = 7000;  // the isotropic stage ends after ~6400 steps
+  ASSERT_EQ(test::run_scenario(text, sets, a, 1, stop), RunStatus::Interrupted);
+  ASSERT_EQ(test::run_scenario(text, sets, b, 2, 3000), RunStatus::Interrupted);
+  ASSERT_EQ(test::run_scenario(text, sets, b, 1, stop, true), RunStatus::Interrupted);
+  const std::string series = test::slurp(a / "series.csv");
+  EXPECT_GT(std::count(series.begin(), series.end(), '\n'), 5) << "the deviatoric stage must have started";
+  EXPECT_TRUE(test::slurp(a / "isotropic.csv") == test::slurp(b / "isotropic.csv"));
+  EXPECT_TRUE(series == test::slurp(b / "series.csv"));
+  expect_same_state(a, b);
   std::filesystem::remove_all(a);
   std::filesystem::remove_all(b);
 }
