@@ -113,6 +113,29 @@ std::vector<TriaxialRunResult> collect(const fs::path& sweep_dir, const std::str
 
 int write_report(const ValidateArgs& a, const fs::path& out, std::chrono::steady_clock::time_point start);
 
+// The options as a command line (what the report says produced it).
+std::string command_line(const ValidateArgs& a) {
+  const ValidationSample d;
+  std::string c = "fracflow validate-triaxial";
+  if (a.out != "runs/validate_triaxial") c += " --out " + a.out;
+  if (a.report_only) c += " --report-only";
+  if (a.sample.diameter_m != d.diameter_m) c += fmt::format(" --diameter {}", a.sample.diameter_m);
+  if (a.sample.height_m != d.height_m) c += fmt::format(" --height {}", a.sample.height_m);
+  if (a.sample.radius_min_m != d.radius_min_m) c += fmt::format(" --radius-min {}", a.sample.radius_min_m);
+  if (a.sample.radius_max_m != d.radius_max_m) c += fmt::format(" --radius-max {}", a.sample.radius_max_m);
+  if (a.sample.voxel_size_m != d.voxel_size_m) c += fmt::format(" --voxel-size {}", a.sample.voxel_size_m);
+  if (a.sample.strain_rate != d.strain_rate) c += fmt::format(" --strain-rate {}", a.sample.strain_rate);
+  if (a.sample.seed != d.seed) c += fmt::format(" --seed {}", a.sample.seed);
+  std::string l;
+  for (auto& x : a.laterals) l += (l.empty() ? "" : ",") + x;
+  if (l != "particle_membrane,rigid_cylinder") c += " --laterals " + (l.empty() ? std::string("''") : l);
+  if (!a.calibration.empty()) c += " --calibration " + a.calibration;
+  if (a.inclusions != "scaled") c += " --inclusions " + a.inclusions;
+  if (a.max_calibration_runs != 6) c += fmt::format(" --max-calibration-runs {}", a.max_calibration_runs);
+  if (a.doc != "docs/validation/triaxial.md") c += " --doc " + a.doc;
+  return c;
+}
+
 int run_validate(const ValidateArgs& a) {
   const auto start = std::chrono::steady_clock::now();
   const fs::path exe = fs::read_symlink("/proc/self/exe");
@@ -148,7 +171,7 @@ int run_validate(const ValidateArgs& a) {
                             {"radius_min_m", s.radius_min_m}, {"radius_max_m", s.radius_max_m},
                             {"voxel_size_m", s.voxel_size_m}, {"strain_rate", s.strain_rate},
                             {"seed", s.seed},                 {"jobs", a.jobs},
-                            {"inclusions", a.inclusions}};
+                            {"inclusions", a.inclusions},     {"command", command_line(a)}};
     write_text(out / "validation_setup.json", setup.dump(2));
   }
   const fs::path sc = out / "scenarios";
@@ -223,6 +246,7 @@ int run_validate(const ValidateArgs& a) {
 int write_report(const ValidateArgs& a, const fs::path& out, std::chrono::steady_clock::time_point start) {
   ValidationReport rep;
   rep.sample = a.sample;
+  rep.calibration = read_json(a.calibration.empty() ? out / "calibration" / "calibration.json" : fs::path(a.calibration));
   if (a.report_only) {
     const nlohmann::json setup = read_json(out / "validation_setup.json");
     rep.sample.diameter_m = setup.at("diameter_m").get<double>();
@@ -238,7 +262,6 @@ int write_report(const ValidateArgs& a, const fs::path& out, std::chrono::steady
     rep.inclusions = a.inclusions;
   }
   rep.inclusion_sets = inclusion_sets(rep.calibration, rep.inclusions);
-  rep.calibration = read_json(a.calibration.empty() ? out / "calibration" / "calibration.json" : fs::path(a.calibration));
   for (auto& r : collect(out / "coal", "sample.voxels.folder")) {
     const bool c1 = r.label.find("c1") != std::string::npos;
     r.label = c1 ? "C1" : "C4";
@@ -254,8 +277,12 @@ int write_report(const ValidateArgs& a, const fs::path& out, std::chrono::steady
     setup["wall_time_s"] = rep.wall_time_s;
     write_text(out / "validation_setup.json", setup.dump(2));
   }
-  rep.command = "fracflow validate-triaxial";
-  if (!a.calibration.empty()) rep.command += " --calibration " + a.calibration;
+  if (a.report_only) {
+    const nlohmann::json setup = read_json(out / "validation_setup.json");
+    rep.command = fmt::format("{}` (runs), then `{}` (this report)", setup.value("command", std::string("?")), command_line(a));
+  } else {
+    rep.command = command_line(a);
+  }
   const std::time_t now = std::time(nullptr);
   rep.date = fmt::format("{:%Y-%m-%d}", fmt::gmtime(now));
   utsname u{};
