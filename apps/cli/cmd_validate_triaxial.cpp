@@ -279,7 +279,7 @@ int write_report(const ValidateArgs& a, const fs::path& out, std::chrono::steady
   }
   if (a.report_only) {
     const nlohmann::json setup = read_json(out / "validation_setup.json");
-    rep.command = fmt::format("{}` (runs), then `{}` (this report)", setup.value("command", std::string("?")), command_line(a));
+    rep.command = fmt::format("{}` (the runs), then `{}", setup.value("command", std::string("?")), command_line(a));
   } else {
     rep.command = command_line(a);
   }

@@ -232,8 +232,10 @@ std::vector<ValidationCheck> validation_checks(const ValidationReport& r) {
       if (std::abs(x.sigma3_Pa - l.sigma3_Pa) < 1) {
         out.push_back({fmt::format("sigma3 = {:g} MPa: flexible membrane stronger than the particle membrane (Fig. 15)",
                                    1e-6 * x.sigma3_Pa),
-                       fmt::format("{} vs {} MPa", mpa(x.peak_differential_Pa), mpa(l.peak_differential_Pa)),
-                       "flexible > particle", x.peak_differential_Pa > l.peak_differential_Pa});
+                       fmt::format("{} vs {} MPa ({:+.1f}%)", mpa(x.peak_differential_Pa), mpa(l.peak_differential_Pa),
+                                   100 * (x.peak_differential_Pa / l.peak_differential_Pa - 1)),
+                       "flexible at least 5% higher (seed 000: 'significantly lower' with the particle membrane)",
+                       x.peak_differential_Pa > 1.05 * l.peak_differential_Pa});
       }
   }
   if (!r.c1.empty()) {
@@ -487,7 +489,7 @@ void write_validation_report(const ValidationReport& r, const fs::path& doc) {
 
   auto run_table = [&](const std::vector<TriaxialRunResult>& runs, bool with_lab) {
     std::string t = "| sample | lateral | sigma3 [MPa] | peak q [MPa] | lab mean [MPa] | strain at peak [%] | confinement at peak "
-                    "[MPa] | E [GPa] | nu | cracks (tensile / shear) | spheres vs boundary | spheres | wall time [s] |\n"
+                    "[MPa] | E [GPa] | nu | cracks (tensile / shear) | isotropic stage: spheres vs boundary | particles | wall time [s] |\n"
                     "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (auto& x : runs) {
       const auto lab = with_lab ? lab_mean_peak_MPa(1e-6 * x.sigma3_Pa) : std::nullopt;
