@@ -519,9 +519,11 @@ void write_validation_report(const ValidationReport& r, const fs::path& doc) {
     std::vector<TriaxialRunResult> cmp = {r.c1.front()};
     cmp.insert(cmp.end(), r.laterals.begin(), r.laterals.end());
     md += "\n## Lateral boundary compared (seed 000 Fig. 15)\n\n" + run_table(cmp, true);
-    md += "\nThe particle membrane's forces are fixed at the start (pressure x initial tributary area), so as the sample "
-          "bulges the pressure it applies per unit of actual area falls (the 'confinement at peak' column); the flexible "
-          "membrane recomputes each triangle's force from its current area. The rigid cylinder cannot bulge unevenly.\n";
+    md += "\nThe particle membrane's forces have fixed magnitudes (pressure x initial tributary area), so the pressure it "
+          "applies per unit of actual area falls only as far as the sleeve's mean radius grows; the flexible membrane "
+          "recomputes each triangle's force from its current area, and the rigid cylinder cannot bulge unevenly. The "
+          "particle membrane's 'confinement at peak' (total force over the lateral area at the spheres' mean radius) and "
+          "its lateral strain (nu) read off because its spheres sink into the hollows of the sample surface (docs/dem.md).\n";
   }
   md += "\n## Figures\n\n"
         "![C1 and C4 stress-strain curves](images/triaxial_curves.png)\n\n"
