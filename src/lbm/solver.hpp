@@ -154,7 +154,6 @@ class Solver {
   std::array<AlignedVector<T>, 3> u_;  // N: sampled velocity
 
   std::vector<Span> spans_;
-  std::vector<Span> even_spans_;  // spans_ with the periodic-x seams joined (even steps need no neighbours)
   std::int64_t num_bulk_cells_ = 0;
   std::vector<BoundaryCell> bcells_;
   std::vector<Link> links_;

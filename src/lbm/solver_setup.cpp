@@ -78,12 +78,11 @@ void Solver<L, T>::finalize() {
                                          x, y, z));
         }
         const bool bulk = b.link_mask == 0 && b.open_mask == 0;
-        // Periodic x: the first and last cells of a row wrap, so they get spans of their own.
-        const bool split = g.periodic[0] && (x == 0 || x == g.nx - 1 || x == 1);
-        if (!bulk || split) close_run(x);
+        // Periodic x needs no split: the bulk kernel streams the first and last cells of a
+        // row through the ghost columns (bulk_sweep.cpp), so whole rows stay one span.
+        if (!bulk) close_run(x);
         if (bulk) {
           if (run_start < 0) run_start = x;
-          if (g.periodic[0] && (x == 0 || x == g.nx - 1)) close_run(x + 1);
           continue;
         }
         // Boundary cell: links to solids, then its open-face data.
@@ -126,17 +125,6 @@ void Solver<L, T>::finalize() {
       }
       close_run(g.nx);
     }
-  even_spans_.clear();
-  for (const Span& sp : spans_) {
-    if (!even_spans_.empty()) {
-      Span& b = even_spans_.back();
-      if (b.y == sp.y && b.z == sp.z && b.x0 + b.n == sp.x0) {
-        b.n += sp.n;
-        continue;
-      }
-    }
-    even_spans_.push_back(sp);
-  }
   num_bulk_cells_ = 0;
   for (auto& sp : spans_) num_bulk_cells_ += sp.n;
   link_saved_.assign(links_.size(), T(0));
