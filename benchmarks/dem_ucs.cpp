@@ -27,18 +27,23 @@ int main(int argc, char** argv) {
   int max_threads = 0;  // 0: every core
   double diameter = 25e-3, height = 50e-3;
   bool membrane = false;
+  int membrane_n_theta = 48;                  // units around the sleeve (scenario default: 24)
+  double radius_min = 0.4e-3, radius_max = 0.6e-3;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--steps") && i + 1 < argc) steps = std::atol(argv[++i]);
     if (!std::strcmp(argv[i], "--small")) { diameter = 12.5e-3; height = 25e-3; }
     if (!std::strcmp(argv[i], "--max-threads") && i + 1 < argc) max_threads = std::atoi(argv[++i]);
     if (!std::strcmp(argv[i], "--membrane")) membrane = true;
+    if (!std::strcmp(argv[i], "--membrane-n-theta") && i + 1 < argc) membrane_n_theta = std::atoi(argv[++i]);
+    if (!std::strcmp(argv[i], "--radius-min") && i + 1 < argc) radius_min = std::atof(argv[++i]);
+    if (!std::strcmp(argv[i], "--radius-max") && i + 1 < argc) radius_max = std::atof(argv[++i]);
   }
   const Driver& ucs = find_driver("ucs");
   ParamTable table = parameter_table(ucs);
   const std::string text = "driver = \"ucs\"\n" + std::string(dem::kCoalMatrixTable7Toml) +
-                           fmt::format("[sample]\ndiameter = {}\nheight = {}\nradius_min = 0.4e-3\nradius_max = 0.6e-3\n"
+                           fmt::format("[sample]\ndiameter = {}\nheight = {}\nradius_min = {}\nradius_max = {}\n"
                                        "porosity = 0.38\n",
-                                       diameter, height);
+                                       diameter, height, radius_min, radius_max);
   Config cfg = load_scenario(table, "<benchmark>", text, {});
   omp_set_num_threads(omp_get_num_procs());
   dem::DemSystem base;
@@ -86,13 +91,13 @@ int main(int argc, char** argv) {
                100 * t.integrate / tot);
   }
   if (membrane) {
-    // Membrane of 48 x N_z square units around the sample at 5 MPa; blocks with and without it
+    // Membrane of n_theta x N_z square units around the sample at 5 MPa; blocks with and without it
     // alternate so both see the same machine load. Overhead = best-block time ratio - 1.
     omp_set_num_threads(1);
     dem::DemSystem plain = base, wrapped = base;
     const Real R = 0.5 * diameter;
     // Clearance 0.1% of R: closes in ~200 steps at v_max.
-    dem::MembraneSettings m = dem::membrane_around_cylinder(R, base.walls[0].point.z(), base.walls[1].point.z(), 48, 0,
+    dem::MembraneSettings m = dem::membrane_around_cylinder(R, base.walls[0].point.z(), base.walls[1].point.z(), membrane_n_theta, 0,
                                                             1e-3, 1.2);
     m.pressure = 5e6;
     m.v_max = 1.0;
