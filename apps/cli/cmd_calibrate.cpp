@@ -202,12 +202,9 @@ int run_calibrate_command(const CalibrateArgs& a) {
         throw Error(fmt::format("calibration run {}: {} of the triaxial runs in {} failed; see their logs", it,
                                 triaxial->failed, dir.string()));
       // Least-squares slope of the peak differential stress sigma1 - sigma3 on sigma3 (seed 000 Eq. 1).
-      double mx = 0, my = 0, sxx = 0, sxy = 0;
-      for (auto& q : pts) mx += q.sigma3, my += q.sigma_p - q.sigma3;
-      mx /= static_cast<double>(pts.size());
-      my /= static_cast<double>(pts.size());
-      for (auto& q : pts) sxx += (q.sigma3 - mx) * (q.sigma3 - mx), sxy += (q.sigma3 - mx) * (q.sigma_p - q.sigma3 - my);
-      m.slope_b = sxy / sxx;
+      std::vector<double> s3, q;
+      for (auto& pt : pts) s3.push_back(pt.sigma3), q.push_back(pt.sigma_p - pt.sigma3);
+      m.slope_b = fit_line(s3, q).slope;
     }
     return m;
   };

@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
+#include "batch/mohr_coulomb.hpp"
 #include "core/error.hpp"
 #include "core/types.hpp"
 
@@ -85,22 +87,13 @@ MicroParameters next_parameters(std::span<const CalibrationStep> history, const 
   // of kratio and give a positive slope; else the guess.
   double slope = s.poisson_slope_guess;
   {
-    double mx = 0, my = 0;
-    for (auto& h : history) {
-      mx += std::log(h.params.bond_kratio);
-      my += h.measured.poisson_ratio;
-    }
-    mx /= static_cast<double>(history.size());
-    my /= static_cast<double>(history.size());
-    double sxx = 0, sxy = 0;
-    for (auto& h : history) {
-      const double dx = std::log(h.params.bond_kratio) - mx;
-      sxx += dx * dx;
-      sxy += dx * (h.measured.poisson_ratio - my);
-    }
+    std::vector<double> x, y;
+    for (auto& h : history) x.push_back(std::log(h.params.bond_kratio)), y.push_back(h.measured.poisson_ratio);
+    const LineFit line = fit_line(x, y);
     // A spread of at least 2% in kratio, and a slope no flatter than a tenth of the guess:
     // otherwise the measurement scatter would send kratio far away.
-    if (sxx > 1e-4 * static_cast<double>(history.size()) && sxy / sxx > 0.1 * s.poisson_slope_guess) slope = sxy / sxx;
+    if (line.sxx > 1e-4 * static_cast<double>(history.size()) && line.slope > 0.1 * s.poisson_slope_guess)
+      slope = line.slope;
   }
   const double f_kratio = limit(std::exp((s.target.poisson_ratio - m.poisson_ratio) / slope));
   p.bond_kratio *= f_kratio;
@@ -116,20 +109,11 @@ MicroParameters next_parameters(std::span<const CalibrationStep> history, const 
   if (s.calibrates_slope()) {
     auto tan_deg = [](double deg) { return std::tan(deg * kPi / 180); };
     double gradient = s.slope_gradient_guess;
-    double mx = 0, my = 0;
-    for (auto& h : history) {
-      mx += tan_deg(h.params.friction_angle_deg);
-      my += h.measured.slope_b;
-    }
-    mx /= static_cast<double>(history.size());
-    my /= static_cast<double>(history.size());
-    double sxx = 0, sxy = 0;
-    for (auto& h : history) {
-      const double dx = tan_deg(h.params.friction_angle_deg) - mx;
-      sxx += dx * dx;
-      sxy += dx * (h.measured.slope_b - my);
-    }
-    if (sxx > 1e-4 * static_cast<double>(history.size()) && sxy / sxx > 0.1 * s.slope_gradient_guess) gradient = sxy / sxx;
+    std::vector<double> x, y;
+    for (auto& h : history) x.push_back(tan_deg(h.params.friction_angle_deg)), y.push_back(h.measured.slope_b);
+    const LineFit line = fit_line(x, y);
+    if (line.sxx > 1e-4 * static_cast<double>(history.size()) && line.slope > 0.1 * s.slope_gradient_guess)
+      gradient = line.slope;
     const double t = tan_deg(p.friction_angle_deg) + (s.target.slope_b - m.slope_b) / gradient;
     p.friction_angle_deg = std::clamp(std::atan(std::max(t, 0.0)) * 180 / kPi, 0.0, s.max_friction_angle_deg);
   }

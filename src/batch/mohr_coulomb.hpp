@@ -30,6 +30,14 @@ struct MohrCoulombFit {
   int points = 0;
 };
 
+// Least-squares line y = intercept + slope x, from centred sums (no cancellation for MPa-sized
+// values). sxx = sum (x - mean x)^2 tells whether the x values spread at all (slope is NaN when
+// they do not); r_squared = 1 - SS_res / SS_tot (1 when every y is equal).
+struct LineFit {
+  double intercept = 0, slope = 0, r_squared = 0, sxx = 0;
+};
+LineFit fit_line(std::span<const double> x, std::span<const double> y);
+
 // Least-squares line sigma_p = a + b sigma3 and the phi, c it implies. Throws ff::InputError
 // when fewer than two distinct confining pressures are given, or when b < 1 (peak strength
 // falling faster than the confinement rises has no Coulomb friction angle).
