@@ -7,6 +7,7 @@
 #include <fstream>
 #include <map>
 
+#include "batch/mohr_coulomb.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "io/plot.hpp"
@@ -145,20 +146,12 @@ BulgeProfile bulge_profile(const TriaxialRunResult& r, double R0) {
 
 DifferentialFit fit_differential(const std::vector<TriaxialRunResult>& runs) {
   DifferentialFit f;
-  const double n = static_cast<double>(runs.size());
   if (runs.size() < 2) return f;
-  double mx = 0, my = 0;
-  for (auto& r : runs) mx += r.sigma3_Pa / n, my += r.peak_differential_Pa / n;
-  double sxx = 0, sxy = 0, syy = 0;
-  for (auto& r : runs) {
-    const double dx = r.sigma3_Pa - mx, dy = r.peak_differential_Pa - my;
-    sxx += dx * dx, sxy += dx * dy, syy += dy * dy;
-  }
-  if (!(sxx > 0)) return f;
-  f.slope = sxy / sxx;
-  f.intercept_Pa = my - f.slope * mx;
-  f.r_squared = syy > 0 ? sxy * sxy / (sxx * syy) : 1.0;
-  return f;
+  std::vector<double> s3, q;
+  for (auto& r : runs) s3.push_back(r.sigma3_Pa), q.push_back(r.peak_differential_Pa);
+  const LineFit line = fit_line(s3, q);
+  if (!(line.sxx > 0)) return f;
+  return {line.intercept, line.slope, line.r_squared};
 }
 
 namespace {
@@ -324,6 +317,21 @@ void write_curves_csv(const fs::path& csv, const std::vector<std::pair<std::stri
   }
 }
 
+// Differential stress against axial strain of several runs in one figure: img/NAME.csv + .png.
+PlotJob curves_figure(const fs::path& img, const std::string& name, const std::string& title,
+                      const std::vector<std::pair<std::string, const TriaxialRunResult*>>& runs) {
+  write_curves_csv(img / (name + ".csv"), runs);
+  PlotJob j{img / (name + ".csv"), img / (name + ".png"), {}};
+  j.spec.title = title;
+  j.spec.x = "axial_strain";
+  j.spec.x_scale = 100;
+  j.spec.xlabel = "axial strain [%]";
+  for (auto& p : runs) j.spec.y.push_back(p.first);
+  j.spec.y_scale = 1e-6;
+  j.spec.ylabel = "differential stress [MPa]";
+  return j;
+}
+
 }  // namespace
 
 void write_validation_report(const ValidationReport& r, const fs::path& doc) {
@@ -337,31 +345,15 @@ void write_validation_report(const ValidationReport& r, const fs::path& doc) {
     std::vector<std::pair<std::string, const TriaxialRunResult*>> runs;
     for (auto& x : r.c1) runs.emplace_back(fmt::format("C1 sigma3 = {:g} MPa", 1e-6 * x.sigma3_Pa), &x);
     for (auto& x : r.c4) runs.emplace_back(fmt::format("C4 sigma3 = {:g} MPa", 1e-6 * x.sigma3_Pa), &x);
-    write_curves_csv(img / "triaxial_curves.csv", runs);
-    PlotJob j{img / "triaxial_curves.csv", img / "triaxial_curves.png", {}};
-    j.spec.title = "Triaxial compression, flexible membrane: C1-like and C4-like samples";
-    j.spec.x = "axial_strain";
-    j.spec.x_scale = 100;
-    j.spec.xlabel = "axial strain [%]";
-    for (auto& p : runs) j.spec.y.push_back(p.first);
-    j.spec.y_scale = 1e-6;
-    j.spec.ylabel = "differential stress [MPa]";
-    jobs.push_back(j);
+    jobs.push_back(curves_figure(img, "triaxial_curves", "Triaxial compression, flexible membrane: C1-like and C4-like samples", runs));
   }
   // Figure: the lateral boundaries compared at the first pressure (seed 000 Fig. 15).
   if (!r.laterals.empty() && !r.c1.empty()) {
     std::vector<std::pair<std::string, const TriaxialRunResult*>> runs = {{"flexible membrane", &r.c1.front()}};
     for (auto& x : r.laterals) runs.emplace_back(x.lateral == "particle_membrane" ? "particle membrane" : x.lateral == "rigid_cylinder" ? "rigid cylinder" : x.lateral, &x);
-    write_curves_csv(img / "triaxial_laterals.csv", runs);
-    PlotJob j{img / "triaxial_laterals.csv", img / "triaxial_laterals.png", {}};
-    j.spec.title = fmt::format("C1, sigma3 = {:g} MPa: lateral boundary compared", 1e-6 * r.c1.front().sigma3_Pa);
-    j.spec.x = "axial_strain";
-    j.spec.x_scale = 100;
-    j.spec.xlabel = "axial strain [%]";
-    for (auto& p : runs) j.spec.y.push_back(p.first);
-    j.spec.y_scale = 1e-6;
-    j.spec.ylabel = "differential stress [MPa]";
-    jobs.push_back(j);
+    jobs.push_back(curves_figure(img, "triaxial_laterals",
+                                 fmt::format("C1, sigma3 = {:g} MPa: lateral boundary compared", 1e-6 * r.c1.front().sigma3_Pa),
+                                 runs));
   }
   // Figure: peaks against sigma3 with the laboratory tests (seed 000 Fig. 6).
   if (!r.c1.empty()) {
