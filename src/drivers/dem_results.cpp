@@ -51,4 +51,17 @@ nlohmann::json sample_json(const dem::DemSystem& sys, const dem::SampleInfo& inf
           {"floaters", info.floaters},        {"dimension", info.dim}};
 }
 
+PlotJob axial_strain_plot(const std::filesystem::path& out, const std::string& name, const std::string& title,
+                          std::vector<std::string> y, double y_scale, const std::string& ylabel) {
+  PlotJob j{out / "series.csv", out / "plots" / (name + ".png"), {}};
+  j.spec.title = title;
+  j.spec.x = "axial_strain";
+  j.spec.x_scale = 100;
+  j.spec.xlabel = "axial strain [%]";
+  j.spec.y = std::move(y);
+  j.spec.y_scale = y_scale;
+  j.spec.ylabel = ylabel;
+  return j;
+}
+
 }  // namespace ff::drivers

@@ -3,9 +3,14 @@
 #pragma once
 #include <nlohmann/json.hpp>
 
+#include <filesystem>
+#include <string>
+#include <vector>
+
 #include "dem/dem_system.hpp"
 #include "dem/sample_builder.hpp"
 #include "io/checkpoint.hpp"
+#include "io/plot.hpp"
 #include "io/params.hpp"
 
 namespace ff::drivers {
@@ -27,6 +32,11 @@ nlohmann::json cracks_json(const dem::DemSystem& sys, int groups = -1);
 // Particles (the first `particles` of the system; -1: all), bonds, porosity, size, locked-in
 // stress, floaters, dimension.
 nlohmann::json sample_json(const dem::DemSystem& sys, const dem::SampleInfo& info, long particles = -1);
+
+// A curve of series.csv against the axial strain in % (the x axis of every UCS and triaxial
+// plot): columns `y` scaled by `y_scale`, drawn into plots/NAME.png of `out`.
+PlotJob axial_strain_plot(const std::filesystem::path& out, const std::string& name, const std::string& title,
+                          std::vector<std::string> y, double y_scale, const std::string& ylabel);
 
 }  // namespace ff::drivers
 

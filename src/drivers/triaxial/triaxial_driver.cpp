@@ -217,35 +217,17 @@ std::vector<std::string> columns(const dem::Materials& mat, int groups) {
 void make_plots(const fs::path& out, const Config& cfg) {
   if (!cfg.boolean("output.plots")) return;
   fs::create_directories(out / "plots");
-  PlotSpec a;
-  a.title = fmt::format("Triaxial compression, sigma3 = {:g} MPa: stress and cracks", 1e-6 * cfg.real("triaxial.confining_pressure"));
-  a.x = "axial_strain";
-  a.x_scale = 100;
-  a.xlabel = "axial strain [%]";
-  a.y = {"differential_stress"};
-  a.y_scale = 1e-6;
-  a.ylabel = "differential stress [MPa]";
-  a.y2 = {"cracks_total", "cracks_tensile", "cracks_shear"};
-  a.y2label = "number of cracks";
-  plot_series(out / "series.csv", out / "plots" / "stress_strain_cracks.png", a);
-  PlotSpec b;
-  b.title = "Triaxial compression: strains";
-  b.x = "axial_strain";
-  b.x_scale = 100;
-  b.xlabel = "axial strain [%]";
-  b.y = {"lateral_strain", "volumetric_strain"};
-  b.y_scale = 100;
-  b.ylabel = "strain [%] (compression > 0)";
-  plot_series(out / "series.csv", out / "plots" / "strains.png", b);
-  PlotSpec c;
-  c.title = "Applied lateral confinement";
-  c.x = "axial_strain";
-  c.x_scale = 100;
-  c.xlabel = "axial strain [%]";
-  c.y = {"confinement"};
-  c.y_scale = 1e-6;
-  c.ylabel = "confinement [MPa]";
-  plot_series(out / "series.csv", out / "plots" / "confinement.png", c);
+  std::vector<PlotJob> jobs = {
+      axial_strain_plot(out, "stress_strain_cracks",
+                        fmt::format("Triaxial compression, sigma3 = {:g} MPa: stress and cracks",
+                                    1e-6 * cfg.real("triaxial.confining_pressure")),
+                        {"differential_stress"}, 1e-6, "differential stress [MPa]"),
+      axial_strain_plot(out, "strains", "Triaxial compression: strains", {"lateral_strain", "volumetric_strain"}, 100,
+                        "strain [%] (compression > 0)"),
+      axial_strain_plot(out, "confinement", "Applied lateral confinement", {"confinement"}, 1e-6, "confinement [MPa]")};
+  jobs[0].spec.y2 = {"cracks_total", "cracks_tensile", "cracks_shear"};
+  jobs[0].spec.y2label = "number of cracks";
+  plot_series(jobs);  // one python process for all three
 }
 
 RunStatus run(const Config& cfg, const RunOptions& opt) {

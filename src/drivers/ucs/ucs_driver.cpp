@@ -80,26 +80,14 @@ void read_checkpoint(const fs::path& dir, dem::DemSystem& sys, UcsState& st, dem
 void make_plots(const fs::path& out, const Config& cfg) {
   if (!cfg.boolean("output.plots")) return;
   fs::create_directories(out / "plots");
-  PlotSpec a;
-  a.title = "Uniaxial compression: stress and cracks";
-  a.x = "axial_strain";
-  a.x_scale = 100;
-  a.xlabel = "axial strain [%]";
-  a.y = {"axial_stress"};
-  a.y_scale = 1e-6;
-  a.ylabel = "axial stress [MPa]";
-  a.y2 = {"cracks_total", "cracks_tensile", "cracks_shear"};
-  a.y2label = "number of cracks";
-  plot_series(out / "series.csv", out / "plots" / "stress_strain_cracks.png", a);
-  PlotSpec b;
-  b.title = "Uniaxial compression: strains";
-  b.x = "axial_strain";
-  b.x_scale = 100;
-  b.xlabel = "axial strain [%]";
-  b.y = {"lateral_strain", "volumetric_strain"};
-  b.y_scale = 100;
-  b.ylabel = "strain [%] (compression > 0)";
-  plot_series(out / "series.csv", out / "plots" / "strains.png", b);
+  std::vector<PlotJob> jobs = {
+      axial_strain_plot(out, "stress_strain_cracks", "Uniaxial compression: stress and cracks", {"axial_stress"}, 1e-6,
+                        "axial stress [MPa]"),
+      axial_strain_plot(out, "strains", "Uniaxial compression: strains", {"lateral_strain", "volumetric_strain"}, 100,
+                        "strain [%] (compression > 0)")};
+  jobs[0].spec.y2 = {"cracks_total", "cracks_tensile", "cracks_shear"};
+  jobs[0].spec.y2label = "number of cracks";
+  plot_series(jobs);  // one python process for both
 }
 
 RunStatus run(const Config& cfg, const RunOptions& opt) {
