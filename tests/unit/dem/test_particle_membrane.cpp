@@ -55,6 +55,23 @@ ParticleMembraneSpec c1_like_spec() {
   return s;
 }
 
+// One undamped sphere of radius 0.5 mm (density 1390) at `pos` with velocity `vel` and inward
+// load `inward` [N], dt = 1 us, ready to step.
+DemSystem one_free_sphere(const Vec3& pos, const Vec3& vel, Real inward) {
+  DemSystem s = two_group_system();
+  s.settings.local_damping = 0;
+  s.settings.skin = 0.1e-3;
+  s.settings.dt = 1e-6;
+  s.particles.resize(1);
+  s.particles.radius[0] = 0.5e-3;
+  s.particles.pos[0] = pos;
+  s.particles.vel[0] = vel;
+  s.particles.set_mass_from_density(0, 1390, 3);
+  s.particles.inward_force[0] = inward;
+  s.initialise();
+  return s;
+}
+
 }  // namespace
 
 TEST(ParticleMembraneLayout, SpheresTouchTheirRingAndRowNeighboursAndThePlatens) {
@@ -245,16 +262,7 @@ TEST(DemInwardForce, PullsAFreeParticleTowardsTheAxisAsLeapfrog) {
   // A free sphere at rest at (x0, 0, z), no damping, inward load f: a constant force -f e_x
   // while x > 0, so v(n+1/2) = (n+1) a dt and x(n) = x0 - a dt^2 n(n+1)/2 with a = f/m
   // (leapfrog from rest). Tolerance 1e-12 relative.
-  DemSystem s = two_group_system();
-  s.settings.local_damping = 0;
-  s.settings.skin = 0.1e-3;
-  s.settings.dt = 1e-6;
-  s.particles.resize(1);
-  s.particles.radius[0] = 0.5e-3;
-  s.particles.pos[0] = Vec3(5e-3, 0, 2e-3);
-  s.particles.set_mass_from_density(0, 1390, 3);
-  s.particles.inward_force[0] = 0.3;
-  s.initialise();
+  DemSystem s = one_free_sphere(Vec3(5e-3, 0, 2e-3), Vec3::Zero(), 0.3);
   const int n = 100;
   s.run(n);
   const Real a = 0.3 * s.particles.inv_mass[0], dx = a * s.settings.dt * s.settings.dt * n * (n + 1) / 2.0;
@@ -270,17 +278,7 @@ TEST(DemInwardForce, ExertsNoMomentAboutTheAxis) {
   // to (x, y) of x(n), x(n) x v(n+1/2) = x(n) x v(n-1/2), and x(n+1) x v(n+1/2) = x(n) x v(n+1/2)
   // (leapfrog), exactly for L_z. A sphere on a circling path keeps L_z to 1e-12 relative over 2000
   // steps (round-off) while its distance from the axis changes by ~10%.
-  DemSystem s = two_group_system();
-  s.settings.local_damping = 0;
-  s.settings.skin = 0.1e-3;
-  s.settings.dt = 1e-6;
-  s.particles.resize(1);
-  s.particles.radius[0] = 0.5e-3;
-  s.particles.pos[0] = Vec3(5e-3, 1e-3, 0);
-  s.particles.vel[0] = Vec3(0.5, 2.0, 0.1);
-  s.particles.set_mass_from_density(0, 1390, 3);
-  s.particles.inward_force[0] = 1e-3;
-  s.initialise();
+  DemSystem s = one_free_sphere(Vec3(5e-3, 1e-3, 0), Vec3(0.5, 2.0, 0.1), 1e-3);
   // Each step stores the pair (x(n+1), v(n+1/2)), whose L_z is the invariant.
   auto lz = [&] { return s.particles.pos[0].x() * s.particles.vel[0].y() - s.particles.pos[0].y() * s.particles.vel[0].x(); };
   const Real l0 = lz(), r0 = std::hypot(s.particles.pos[0].x(), s.particles.pos[0].y());
