@@ -170,7 +170,7 @@ void load_dem(CheckpointReader& r, DemSystem& s) {
     r.get("dem.membrane.v", v);
     s.membrane->restore_vertices(x, v);
     s.membrane->set_pressure(r.get_value<Real>("dem.membrane.pressure"));
-    s.membrane->find_candidates(s.particles.pos, s.particles.radius, s.settings.skin);
+    s.rebuild_membrane_candidates();
   }
 }
 

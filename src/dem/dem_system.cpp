@@ -170,8 +170,21 @@ void DemSystem::rebuild_neighbors() {
     wc.load.assign(wc.particle.size(), PairLoad{});
   }
   wall_motion_since_build_ = 0;
-  if (membrane) membrane->find_candidates(particles.pos, particles.radius, settings.skin);
+  if (membrane) {
+    membrane->find_candidates(particles.pos, particles.radius, settings.skin);
+    membrane_built_at_travel_ = 0;
+    ++membrane_builds_;
+  }
   compact_bonds();
+}
+
+void DemSystem::rebuild_membrane_candidates() {
+  if (!membrane) return;
+  Real travel = 0;
+  nl_.needs_rebuild(particles.pos, 0, &travel);
+  membrane->find_candidates(particles.pos, particles.radius, settings.skin);
+  membrane_built_at_travel_ = travel;
+  ++membrane_builds_;
 }
 
 template <class Law>
@@ -423,11 +436,24 @@ void DemSystem::step() {
   Real wall_step = 0;
   for (auto& w : walls) wall_step = std::max(wall_step, w.step_motion(settings.dt));
   // Boundaries that moved since the last build use up the skin like particles do.
-  Real boundary_motion = wall_motion_since_build_ + wall_step;
-  if (membrane)
-    boundary_motion = std::max(boundary_motion, membrane->motion_since_build() + membrane->max_step_motion(settings.dt));
-  if (nl_.needs_rebuild(particles.pos, boundary_motion)) rebuild_neighbors();
+  Real travel = 0;
+  const bool rebuild = nl_.needs_rebuild(particles.pos, wall_motion_since_build_ + wall_step, &travel);
+  if (rebuild) rebuild_neighbors();
   lap(stage_times.neighbors);
+  if (!rebuild && membrane) {
+    // The membrane keeps its own candidates: a particle-element pair further apart than the
+    // particle's radius + skin at the build can touch only once the particle's travel plus the
+    // element's (each vertex's travel bounds that of every point of the triangle) reach the
+    // skin. The membrane moving does not make the particle pairs' list stale, so it no longer
+    // forces a rebuild of the whole neighbour list.
+    const Real particle_travel = travel + membrane_built_at_travel_;
+    if (particle_travel + membrane->motion_since_build() + membrane->max_step_motion(settings.dt) > settings.skin) {
+      membrane->find_candidates(particles.pos, particles.radius, settings.skin);
+      membrane_built_at_travel_ = travel;
+      ++membrane_builds_;
+    }
+    lap(stage_times.membrane);
+  }
   if (materials.contact_law == ContactLaw::Linear) contact_forces<LinearContact>(materials.linear);
   else contact_forces<HertzMindlinContact>(materials.hertz);
   lap(stage_times.contacts);
@@ -441,15 +467,18 @@ void DemSystem::step() {
   lap(stage_times.bonds);
   if (materials.contact_law == ContactLaw::Linear) wall_forces<LinearContact>(materials.linear);
   else wall_forces<HertzMindlinContact>(materials.hertz);
+  lap(stage_times.walls);
   if (membrane) {
     if (materials.contact_law == ContactLaw::Linear) membrane_forces<LinearContact>(materials.linear);
     else membrane_forces<HertzMindlinContact>(materials.hertz);
+    lap(stage_times.membrane);
   }
-  lap(stage_times.walls);
   gather_and_integrate();
   lap(stage_times.integrate);
-  if (membrane)
+  if (membrane) {
     membrane->move(settings.dt, walls[membrane_bottom_wall].point.z(), walls[membrane_top_wall].point.z());
+    lap(stage_times.membrane);
+  }
   for (auto& w : walls) w.move(settings.dt);
   wall_motion_since_build_ += wall_step;
   time += settings.dt;
@@ -583,8 +612,8 @@ Real DemSystem::strain_energy() const {
   return e;
 }
 
-Real DemSystem::max_unbalanced_force_ratio() const {
-  const std::size_t n = particles.size();
+Real DemSystem::max_unbalanced_force_ratio(std::size_t first) const {
+  const std::size_t n = std::min(first, particles.size());
   const Real unbalanced = deterministic_sum(n, settings.parallel_min, [&](std::size_t i) { return particles.force[i].norm(); });
   // Mean over the interactions that carry load (PFC's "average ratio").
   Real contact = 0;

@@ -5,6 +5,7 @@
 // pair order, so results are bit-identical on any number of OpenMP threads.
 #pragma once
 #include <optional>
+#include <limits>
 #include <vector>
 
 #include "dem/crack_log.hpp"
@@ -39,6 +40,7 @@ struct WallContacts {           // candidate particles of one wall, sorted by in
 // Wall-clock seconds spent in each stage of step() (the timing report of benchmarks).
 struct StageTimes {
   double neighbors = 0, contacts = 0, bonds = 0, walls = 0, integrate = 0;
+  double membrane = 0;  // flexible membrane: own candidate searches, contact forces, servo and vertex update
 };
 
 class DemSystem {
@@ -88,7 +90,9 @@ class DemSystem {
   long contacts_touching() const;
   Real kinetic_energy() const;       // translational + rotational [J] (half-step velocities)
   Real strain_energy() const;        // springs of contacts and intact bonds [J]
-  Real max_unbalanced_force_ratio() const;  // mean |F_unbalanced| / mean |F_contact|
+  // Mean |F_unbalanced| over the first `particles` particles (all by default) / mean |F_contact|
+  // over the loaded interactions.
+  Real max_unbalanced_force_ratio(std::size_t particles = std::numeric_limits<std::size_t>::max()) const;
   // Love-Weber average stress of the particles whose centres lie in `inside` (tension +),
   // divided by `volume` [Pa] (METHODS.md 1.7).
   template <class Pred> Mat3 average_stress(Pred inside, Real volume) const;
@@ -106,6 +110,11 @@ class DemSystem {
   const std::vector<WallContacts>& wall_contacts() const { return wall_contacts_; }
   const std::vector<PairLoad>& bond_loads() const { return bload_; }
   void rebuild_neighbors();  // forced rebuild (also used after a checkpoint restore)
+  // Rebuilds only the flexible membrane's candidates (also after a checkpoint restore).
+  void rebuild_membrane_candidates();
+  // How many times the particle neighbour list and the membrane candidates were rebuilt.
+  long neighbor_builds() const { return static_cast<long>(nl_.builds()); }
+  long membrane_builds() const { return membrane_builds_; }
   void build_bond_adjacency();
   void compact_bonds();      // drop broken bonds (keeps order of the intact ones)
   // Checkpoint support: per-pair load slots sized after a restored neighbour list, and the
@@ -123,6 +132,10 @@ class DemSystem {
   void gather_and_integrate();
 
   NeighborList nl_;
+  long membrane_builds_ = 0;
+  // Largest particle travel since the neighbour build at the membrane's last candidate build:
+  // with the travel since the neighbour build it bounds the travel since the membrane's build.
+  Real membrane_built_at_travel_ = 0;
   std::vector<ContactState> cstate_;
   std::vector<PairLoad> pload_, bload_;
   std::vector<std::uint8_t> bond_fail_flag_;

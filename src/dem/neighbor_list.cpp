@@ -139,13 +139,15 @@ void NeighborList::restore(Real skin, long builds) {
   build_adjacency(ref_pos_.size());
 }
 
-bool NeighborList::needs_rebuild(std::span<const Vec3> pos, Real extra_wall_motion) const {
+bool NeighborList::needs_rebuild(std::span<const Vec3> pos, Real extra_wall_motion, Real* max_displacement) const {
+  if (max_displacement) *max_displacement = 0;
   if (ref_pos_.size() != pos.size()) return true;
   const Real lim2 = 0.25 * skin_ * skin_;
   Real max2 = 0;
   const std::size_t n = pos.size();
 #pragma omp parallel for reduction(max : max2) schedule(static) if (n > parallel_min_)
   for (std::size_t i = 0; i < n; ++i) max2 = std::max(max2, (pos[i] - ref_pos_[i]).squaredNorm());
+  if (max_displacement) *max_displacement = std::sqrt(max2);
   // Two particles approaching each other can each move skin/2.
   return std::sqrt(max2) + extra_wall_motion > 0.5 * skin_ || max2 > lim2;
 }

@@ -24,7 +24,8 @@ class NeighborList {
   std::size_t build(std::span<const Vec3> pos, std::span<const Real> radius, Real skin);
   // True when a particle moved more than skin/2 since the last build (positions compared with
   // those stored at the build).
-  bool needs_rebuild(std::span<const Vec3> pos, Real extra_wall_motion = 0) const;
+  // `max_displacement`, when given, receives the largest particle travel since the build [m].
+  bool needs_rebuild(std::span<const Vec3> pos, Real extra_wall_motion = 0, Real* max_displacement = nullptr) const;
 
   std::span<const Index> first() const { return pair_i_; }
   std::span<const Index> second() const { return pair_j_; }

@@ -15,6 +15,7 @@
 #include "core/error.hpp"
 #include "core/rng.hpp"
 #include "dem/dem_system.hpp"
+#include "dem/sample_builder.hpp"
 #include "single_threaded.hpp"
 
 using namespace ff;
@@ -443,4 +444,49 @@ TEST(DemThreads, BitIdenticalOnOneAndThreeThreads) {
     EXPECT_EQ(o.cracks.events[k].time, a.cracks.events[k].time);
   }
   EXPECT_EQ(o.walls[0].force, a.walls[0].force);
+}
+
+// The flexible membrane keeps its own candidate list (DemSystem::step): it is searched again
+// when the particles' travel plus the vertices' travel since its last search could close the
+// skin, without rebuilding the particle pairs. A 6 x 6 x 6 bonded lattice is squeezed by the
+// platens inside a 16-unit sleeve that starts 5% of R outside it (more than the skin, so the
+// sleeve must move further than the skin before it touches): rebuilding the membrane's
+// candidates before every step changes no bit of the particles or the sleeve, and the sleeve
+// was searched again on its own at least once.
+TEST(DemMembrane, OwnCandidateSearchesMissNoContact) {
+  auto make = [] {
+    Rng g(11);
+    DemSystem s = bonded_lattice(3, 6, 0.0, 0.02 * kRadius, g);
+    s.settings.local_damping = 0.7;
+    SampleInfo info;
+    add_platens(s, info, 0.1);
+    s.settings.dt = 0.5 * s.critical_time_step();
+    s.walls[0].velocity.z() = 0.05;
+    s.walls[1].velocity.z() = -0.05;
+    Real R = 0;
+    for (std::size_t i = 0; i < s.particles.size(); ++i)
+      R = std::max(R, Vec3(s.particles.pos[i].x(), s.particles.pos[i].y(), 0).norm() + s.particles.radius[i]);
+    MembraneSettings m = membrane_around_cylinder(R, s.walls[0].point.z(), s.walls[1].point.z(), 16, 0, 0.05, 1.2);
+    m.pressure = 2e6;
+    m.v_max = 2.0;
+    m.r_min = 0.5 * R;
+    s.membrane.emplace(m);
+    s.rebuild_neighbors();
+    return s;
+  };
+  DemSystem a = make(), b = make();
+  const int steps = 3000;
+  a.run(steps);
+  for (int k = 0; k < steps; ++k) {
+    b.rebuild_membrane_candidates();
+    b.step();
+  }
+  int touching = 0;
+  for (std::size_t k = 0; k < a.membrane->element_count(); ++k) touching += a.membrane->contacts(k) > 0;
+  EXPECT_GT(touching, 16);  // the sleeve reached the lattice's edges
+  EXPECT_GT(a.membrane_builds(), a.neighbor_builds());  // searched again on its own
+  ASSERT_EQ(a.particles.size(), b.particles.size());
+  EXPECT_EQ(std::memcmp(a.particles.pos.data(), b.particles.pos.data(), a.particles.size() * sizeof(Vec3)), 0);
+  const auto va = a.membrane->vertices(), vb = b.membrane->vertices();
+  EXPECT_EQ(std::memcmp(va.data(), vb.data(), va.size() * sizeof(Vec3)), 0);
 }
