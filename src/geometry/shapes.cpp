@@ -1,5 +1,6 @@
 #include "geometry/shapes.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace ff::geom {
@@ -40,6 +41,14 @@ bool region_contains(const Region& region, const Vec3& p) {
 
 Aabb region_bounds(const Region& region) {
   return std::visit([](const auto& r) { return r.bounds(); }, region);
+}
+
+Real sphere_overlap_volume(Real R, Real r, Real d) {
+  if (d >= R + r) return 0;
+  const Real small = std::min(R, r), large = std::max(R, r);
+  if (d <= large - small) return 4.0 / 3.0 * kPi * small * small * small;
+  const Real t = R + r - d;
+  return kPi * t * t * (d * d + 2 * d * r - 3 * r * r + 2 * d * R + 6 * r * R - 3 * R * R) / (12 * d);
 }
 
 }  // namespace ff::geom

@@ -46,6 +46,10 @@ using Region = std::variant<Box, Sphere, Cylinder, Ellipsoid, MeshRegion>;
 bool region_contains(const Region& region, const Vec3& p);
 Aabb region_bounds(const Region& region);
 
+// Volume of the intersection of two spheres of radii R and r whose centres are d apart (a lens,
+// the sum of two spherical caps; the smaller sphere when one holds the other) [m^3].
+Real sphere_overlap_volume(Real R, Real r, Real d);
+
 }  // namespace ff::geom
 
 namespace ff {

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "geometry/shapes.hpp"
+
 namespace ff::drivers {
 
 void platen_forces(const dem::DemSystem& sys, std::size_t sample_particles, Real& bottom, Real& top) {
@@ -100,14 +102,19 @@ std::vector<SphereStress> measure_spheres(const dem::DemSystem& sys, const dem::
     auto inside = [&](Index i) {
       return static_cast<std::size_t>(i) < n && (P.pos[i] - m.centre).squaredNorm() <= rs * rs;
     };
-    Real vp = 0;
+    Real vp = 0, solid = 0;
     m.particles = 0;
     for (std::size_t i = 0; i < n; ++i) {
+      const Real r = P.radius[i];
+      solid += geom::sphere_overlap_volume(rs, r, (P.pos[i] - m.centre).norm());
       if (!inside(static_cast<Index>(i))) continue;
-      vp += 4.0 / 3.0 * kPi * P.radius[i] * P.radius[i] * P.radius[i];
+      vp += 4.0 / 3.0 * kPi * r * r * r;
       ++m.particles;
     }
-    const Real volume = vp > 0 ? vp / (1 - info.porosity) : 1;
+    const Real sphere_volume = 4.0 / 3.0 * kPi * rs * rs * rs;
+    m.porosity = 1 - solid / sphere_volume;
+    // (1 - n) / sum(V_p) = 1 / volume: the particles' volume spread at the region's own solid fraction.
+    const Real volume = vp > 0 && solid > 0 ? vp * sphere_volume / solid : 1;
     const Mat3 s = sys.average_stress_of(inside, volume);
     m.axial = -s(2, 2);
     m.lateral = -0.5 * (s(0, 0) + s(1, 1));

@@ -60,11 +60,14 @@ Real enclosed_volume(const dem::DemSystem& sys, const Lateral& lateral);
 // Measurement spheres on the sample axis ([S000] sec. 5.1 checks the isotropic state with
 // PFC measurement spheres). Average stress over the particles whose centres lie in a sphere,
 // with PFC's porosity correction sigma = -(1 - n)/sum(V_p) sum_p sum_c (x_c - x_p) f_c
-// (Itasca PFC 5 "measure" logic; METHODS.md 1.7), n = the sample's porosity.
+// (Itasca PFC 5 "measure" logic; METHODS.md 1.7), n = the porosity inside the sphere, from the
+// exact volume of every particle's part in it (the core of a walled sample is denser than the
+// sample's mean, so the sample porosity would understate the core's stress).
 struct SphereStress {
   Vec3 centre;
   Real radius;
   int particles;
+  Real porosity;
   Real axial, lateral;  // -sigma_zz and -(sigma_xx + sigma_yy)/2 [Pa]
 };
 // Only particles with index < sample_particles count (a particle membrane's do not).

@@ -47,6 +47,10 @@ void declare(ParamTable& t) {
   t.real("triaxial.isotropic_tolerance", 0.02, "-", "isotropic stage ends when platen stress and confinement are within this fraction of sigma3")
       .open_range(0, 1);
   t.integer("triaxial.isotropic_max_steps", 200000, "steps", "step cap of the isotropic stage").positive();
+  t.real("triaxial.isotropic_unbalanced_ratio", 0.01, "-",
+         "isotropic stage ends only once the mean unbalanced-force ratio is below this (quasi-static equilibrium, "
+         "METHODS.md 1.6: < 1e-2)")
+      .open_range(0, 1);
   t.real("triaxial.measurement_sphere_radius", 0.6, "-", "radius of the three measurement spheres on the axis, as a fraction of the sample radius")
       .open_range(0, 1);
   t.real("triaxial.stop_fraction", 0.6, "-", "stop when the differential stress has fallen below this fraction of its peak").open_range(0, 1);
@@ -93,6 +97,7 @@ struct TriaxialState {
   int sphere_particles[3] = {0, 0, 0};
   int iso_cracks = 0;
   Real whole_axial = 0, whole_lateral = 0;  // Love-Weber average of the whole sample over the enclosed volume
+  Real sphere_porosity[3] = {0, 0, 0};
 };
 
 }  // namespace
@@ -303,6 +308,7 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
   const long cp_every = cfg.integer("triaxial.checkpoint_interval");
   const long iso_max = cfg.integer("triaxial.isotropic_max_steps");
   const Real iso_tol = cfg.real("triaxial.isotropic_tolerance");
+  const Real iso_ubf = cfg.real("triaxial.isotropic_unbalanced_ratio");
   const Real stop_fraction = cfg.real("triaxial.stop_fraction"), max_strain = cfg.real("triaxial.max_strain");
   const Real vtk_every = cfg.real("triaxial.vtk_strain_interval"), v_platen = cfg.real("triaxial.platen_velocity");
   Progress progress("triaxial", opt.progress_interval_s);
@@ -342,15 +348,16 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
       const Real conf = applied_confinement(sys, lat);
       if (st.stage == 0) {
         st.iso_steps += every;
-        const Real ubf = sys.max_unbalanced_force_ratio();
+        const Real ubf = sys.max_unbalanced_force_ratio(n_sample);  // a particle membrane's spheres left out
         const double row[] = {static_cast<double>(sys.step_count), sys.time, axial, conf, ubf};
         iso.row(row);
         ++st.iso_rows;
         // Converged when both boundary stresses have stayed within the tolerance for 5 rows
-        // and the sample is near equilibrium. A particle membrane's forces are constant: there
-        // is no lateral servo to wait for (its reported confinement follows the sample's radius).
+        // and the sample is in equilibrium (its measurement spheres then agree with the
+        // boundary). A particle membrane's forces are constant: there is no lateral servo to
+        // wait for (its reported confinement follows the sample's radius).
         const bool lateral_ok = kind == LateralKind::ParticleMembrane || std::abs(conf - p) <= iso_tol * p;
-        const bool ok = std::abs(axial - p) <= iso_tol * p && lateral_ok && ubf < 0.05;
+        const bool ok = std::abs(axial - p) <= iso_tol * p && lateral_ok && ubf < iso_ubf;
         iso_ok_rows = ok ? iso_ok_rows + 1 : 0;
         progress.update(sys.step_count, sys.time, std::min(1.0, static_cast<double>(st.iso_steps) / iso_max),
                         fmt::format("isotropic: platens {:.3f} MPa, confinement {:.3f} MPa (target {:.3f})", 1e-6 * axial,
@@ -375,6 +382,7 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
             st.sphere_axial[s] = spheres[s].axial;
             st.sphere_lateral[s] = spheres[s].lateral;
             st.sphere_particles[s] = spheres[s].particles;
+            st.sphere_porosity[s] = spheres[s].porosity;
             st.iso_sphere_error = std::max({st.iso_sphere_error, std::abs(spheres[s].axial - axial) / axial,
                                             std::abs(spheres[s].lateral - conf) / conf});
           }
@@ -483,7 +491,8 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
                       {"points", fit.points}};
   nlohmann::json spheres = nlohmann::json::array();
   for (int s = 0; s < 3; ++s)
-    spheres.push_back({{"axial_Pa", st.sphere_axial[s]}, {"lateral_Pa", st.sphere_lateral[s]}, {"particles", st.sphere_particles[s]}});
+    spheres.push_back({{"axial_Pa", st.sphere_axial[s]}, {"lateral_Pa", st.sphere_lateral[s]}, {"particles", st.sphere_particles[s]},
+                       {"porosity", st.sphere_porosity[s]}});
   j["isotropic_stage"] = {{"steps", st.iso_steps},
                           {"converged", st.iso_converged != 0},
                           {"platen_stress_Pa", st.iso_axial},
