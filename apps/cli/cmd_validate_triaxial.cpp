@@ -37,7 +37,7 @@ struct ValidateArgs {
   std::string calibration;  // an existing calibration.json: skip the calibration
   int jobs = 2, max_calibration_runs = 6;
   std::string inclusions = "scaled";  // scaled: Table 7 contrasts kept; table7: Table 7 values as printed
-  bool overwrite = false, report_only = false;
+  bool overwrite = false, report_only = false, skip_fine_isotropic = false;
 };
 
 std::string quoted(const fs::path& p) { return "\"" + p.generic_string() + "\""; }
@@ -126,6 +126,10 @@ std::string command_line(const ValidateArgs& a) {
   if (a.sample.voxel_size_m != d.voxel_size_m) c += fmt::format(" --voxel-size {}", a.sample.voxel_size_m);
   if (a.sample.strain_rate != d.strain_rate) c += fmt::format(" --strain-rate {}", a.sample.strain_rate);
   if (a.sample.seed != d.seed) c += fmt::format(" --seed {}", a.sample.seed);
+  if (a.sample.packings != d.packings) c += fmt::format(" --packings {}", a.sample.packings);
+  if (a.sample.fine_radius_min_m != d.fine_radius_min_m) c += fmt::format(" --fine-radius-min {}", a.sample.fine_radius_min_m);
+  if (a.sample.fine_radius_max_m != d.fine_radius_max_m) c += fmt::format(" --fine-radius-max {}", a.sample.fine_radius_max_m);
+  if (a.skip_fine_isotropic) c += " --skip-fine-isotropic";
   std::string l;
   for (auto& x : a.laterals) l += (l.empty() ? "" : ",") + x;
   if (l != "particle_membrane,rigid_cylinder") c += " --laterals " + (l.empty() ? std::string("''") : l);
@@ -171,6 +175,8 @@ int run_validate(const ValidateArgs& a) {
                             {"radius_min_m", s.radius_min_m}, {"radius_max_m", s.radius_max_m},
                             {"voxel_size_m", s.voxel_size_m}, {"strain_rate", s.strain_rate},
                             {"seed", s.seed},                 {"jobs", a.jobs},
+                            {"fine_radius_min_m", s.fine_radius_min_m}, {"fine_radius_max_m", s.fine_radius_max_m},
+                            {"fine_isotropic", !a.skip_fine_isotropic}, {"packings", s.packings},
                             {"inclusions", a.inclusions},     {"command", command_line(a)}};
     write_text(out / "validation_setup.json", setup.dump(2));
   }
@@ -224,13 +230,29 @@ int run_validate(const ValidateArgs& a) {
   SweepAxis samples{"sample.voxels.folder", {quoted("../samples/c1/voxels"), quoted("../samples/c4/voxels")}};
   SweepAxis pressures{"triaxial.confining_pressure", {}};
   for (double p : a.pressures) pressures.values.push_back(fmt::format("{}", p));
-  so.axes = {samples, pressures};
+  SweepAxis packings{"sample.seed", {}};
+  for (int k = 0; k < s.packings; ++k) packings.values.push_back(std::to_string(s.seed + static_cast<unsigned>(k)));
+  so.axes = {samples, pressures, packings};
   so.out_dir = out / "coal";
-  log::info("validation: C1 and C4 at {} pressures in {}", a.pressures.size(), so.out_dir.string());
+  log::info("validation: C1 and C4 at {} pressures, {} packings each, in {}", a.pressures.size(), s.packings,
+            so.out_dir.string());
   check_sweep(run_sweep(so));
+  if (!a.skip_fine_isotropic) {  // the measurement spheres at seed resolution: isotropic stage only
+    SweepOptions io = so;
+    io.axes = {pressures};  // one packing: a sphere of ~2,000 particles scatters little
+    io.sets.push_back("sample.radius_min=" + fmt::format("{}", s.fine_radius_min_m));
+    io.sets.push_back("sample.radius_max=" + fmt::format("{}", s.fine_radius_max_m));
+    io.sets.push_back("triaxial.max_strain=2e-4");  // stop just after the isotropic stage
+    io.sets.push_back("output.vtk=false");
+    io.out_dir = out / "isotropic_fine";
+    io.plots = false;
+    log::info("validation: C1 isotropic stage at seed resolution (radii {:g}-{:g} mm) in {}", 1e3 * s.fine_radius_min_m,
+              1e3 * s.fine_radius_max_m, io.out_dir.string());
+    check_sweep(run_sweep(io));
+  }
   if (!a.laterals.empty()) {
     SweepOptions lo = so;
-    lo.axes = {SweepAxis{"triaxial.lateral", {}}};
+    lo.axes = {SweepAxis{"triaxial.lateral", {}}, packings};
     for (auto& l : a.laterals) lo.axes[0].values.push_back(quoted(fs::path(l)));
     lo.sets.push_back(fmt::format("triaxial.confining_pressure={}", a.pressures.front()));
     lo.out_dir = out / "laterals";
@@ -256,8 +278,11 @@ int write_report(const ValidateArgs& a, const fs::path& out, std::chrono::steady
     rep.sample.voxel_size_m = setup.at("voxel_size_m").get<double>();
     rep.sample.strain_rate = setup.at("strain_rate").get<double>();
     rep.sample.seed = setup.at("seed").get<unsigned>();
+    rep.sample.packings = setup.value("packings", 1);
     rep.wall_time_s = setup.value("wall_time_s", 0.0);
     rep.inclusions = setup.value("inclusions", std::string("scaled"));
+    rep.sample.fine_radius_min_m = setup.value("fine_radius_min_m", rep.sample.fine_radius_min_m);
+    rep.sample.fine_radius_max_m = setup.value("fine_radius_max_m", rep.sample.fine_radius_max_m);
   } else {
     rep.inclusions = a.inclusions;
   }
@@ -270,6 +295,13 @@ int write_report(const ValidateArgs& a, const fs::path& out, std::chrono::steady
   if (!a.laterals.empty()) {
     rep.laterals = collect(out / "laterals", "triaxial.lateral");
     for (auto& r : rep.laterals) r.label = "C1";
+  }
+  if (fs::is_directory(out / "isotropic_fine")) {
+    std::vector<fs::path> dirs;
+    for (auto& e : fs::directory_iterator(out / "isotropic_fine"))
+      if (e.is_directory() && e.path().filename().string().rfind("case_", 0) == 0) dirs.push_back(e.path());
+    std::sort(dirs.begin(), dirs.end());
+    for (auto& d : dirs) rep.isotropic_fine.push_back(read_isotropic_stage(d));
   }
   if (!a.report_only) {  // recorded for a later --report-only
     rep.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -313,7 +345,20 @@ const bool registered = ff::cli::register_command({"validate-triaxial", [](CLI::
   sub->add_option("--radius-max", a->sample.radius_max_m, "largest particle radius [m]")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--voxel-size", a->sample.voxel_size_m, "voxel edge of the synthetic samples [m]")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--strain-rate", a->sample.strain_rate, "axial strain rate of the loading [1/s]")->check(CLI::PositiveNumber)->capture_default_str();
-  sub->add_option("--seed", a->sample.seed, "packing and synthetic-sample seed")->capture_default_str();
+  sub->add_option("--seed", a->sample.seed, "synthetic-sample seed and first packing seed")->capture_default_str();
+  sub->add_option("--packings", a->sample.packings, "packings of each sample at each pressure (seeds --seed, --seed + 1, ...)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  sub->add_option("--fine-radius-min", a->sample.fine_radius_min_m,
+                  "smallest particle radius of the isotropic-stage check at seed resolution [m]")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  sub->add_option("--fine-radius-max", a->sample.fine_radius_max_m,
+                  "largest particle radius of the isotropic-stage check at seed resolution [m]")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  sub->add_flag("--skip-fine-isotropic", a->skip_fine_isotropic,
+                "leave out the isotropic-stage check at seed resolution (the spheres are then judged in the coarse runs)");
   sub->add_option("--pressures", a->pressures, "confining pressures [Pa]")->delimiter(',')->capture_default_str();
   sub->add_option("--laterals", a->laterals, "other lateral boundaries run on C1 at the first pressure")->delimiter(',')->capture_default_str();
   sub->add_option("--inclusions", a->inclusions,

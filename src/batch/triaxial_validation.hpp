@@ -31,7 +31,13 @@ struct ValidationSample {
   double radius_min_m = 0.75e-3, radius_max_m = 1.125e-3;
   double strain_rate = 10;                               // [1/s]: platens each move at rate * H / 2
   double voxel_size_m = 0.5e-3;
-  unsigned seed = 2;                                     // packing and synthetic-sample seed
+  unsigned seed = 2;                                     // synthetic-sample seed and first packing seed
+  // Packings per sample and pressure (seeds seed, seed + 1, ...): the peak of one ~4,000-sphere
+  // packing scatters by ~1 MPa, as much as the C1-C4 difference the report looks for.
+  int packings = 3;
+  // Particles of the isotropic-stage check at seed 000's resolution (r_p = 0.5 mm, ~35,000
+  // spheres): a measurement sphere then holds ~2,000 particles instead of ~300.
+  double fine_radius_min_m = 0.4e-3, fine_radius_max_m = 0.6e-3;
 };
 
 // Scenario text of the validation runs, seed 000 Table 7 micro-parameters (the matrix values are
@@ -45,6 +51,7 @@ struct TriaxialRunResult {
   std::string label;               // e.g. "C1", "C4"
   std::string lateral;             // membrane, rigid_cylinder, particle_membrane
   double sigma3_Pa = 0;
+  unsigned packing_seed = 0;       // sample.seed of the run
   double peak_differential_Pa = 0, strain_at_peak = 0, confinement_at_peak_Pa = 0;
   double youngs_modulus_Pa = 0, poisson_ratio = 0;
   double cracks_total = 0, cracks_tensile = 0, cracks_shear = 0;
@@ -57,6 +64,22 @@ struct TriaxialRunResult {
 // Reads a triaxial run's summary.json; throws ff::Error when something needed is missing.
 TriaxialRunResult read_triaxial_result(const std::filesystem::path& run_dir, const std::string& label);
 
+// The isotropic stage of a triaxial run: boundary stresses and the three measurement spheres.
+struct IsotropicStageResult {
+  double sigma3_Pa = 0, platen_Pa = 0, confinement_Pa = 0, largest_deviation = 0;
+  struct Sphere {
+    double axial_Pa = 0, lateral_Pa = 0, porosity = 0;
+    int particles = 0;
+  };
+  std::vector<Sphere> spheres;
+  int particles = 0;
+  double wall_time_s = 0;
+  std::filesystem::path dir;
+};
+// Reads the isotropic stage out of a triaxial run's summary.json; throws ff::Error when
+// something needed is missing.
+IsotropicStageResult read_isotropic_stage(const std::filesystem::path& run_dir);
+
 // How uneven the final bulge is: radial expansion of each membrane ring between the platens
 // relative to the sample radius R0 (rings outside [z_bottom, z_top] are left out).
 struct BulgeProfile {
@@ -65,11 +88,31 @@ struct BulgeProfile {
 };
 BulgeProfile bulge_profile(const TriaxialRunResult& r, double sample_radius_m);
 
-// Least-squares line of the peak differential stress on sigma3 (seed 000 Eq. 1's form).
+// Peak differential stress over the packings at each confining pressure, in rising sigma3.
+struct PeakStats {
+  double sigma3_Pa = 0, mean_Pa = 0, sd_Pa = 0;  // sd: sample standard deviation (0 for one run)
+  int runs = 0;
+};
+std::vector<PeakStats> peaks_by_pressure(const std::vector<TriaxialRunResult>& runs);
+// The runs of one packing seed, in their order.
+std::vector<const TriaxialRunResult*> runs_of_packing(const std::vector<TriaxialRunResult>& runs, unsigned seed);
+
+// Least-squares line of the peak differential stress on sigma3 (seed 000 Eq. 1's form), through
+// every run (with as many packings at each pressure, the slope of the line through the means).
 struct DifferentialFit {
   double intercept_Pa = 0, slope = 0, r_squared = 0;
 };
 DifferentialFit fit_differential(const std::vector<TriaxialRunResult>& runs);
+
+// The calibration's final figures out of `fracflow calibrate`'s calibration.json.
+struct CalibrationNumbers {
+  bool present = false, converged = false;
+  double E = 0, nu = 0, ucs = 0, b = 0;
+  int runs = 0;
+};
+CalibrationNumbers calibration_numbers(const nlohmann::json& calibration);
+// A stress in MPa with two decimals, as the report prints it.
+std::string mpa(double pa);
 
 struct ValidationCheck {
   std::string what, measured, required;
@@ -82,6 +125,7 @@ struct ValidationReport {
   nlohmann::json calibration;                 // calibration.json of `fracflow calibrate`
   std::vector<TriaxialRunResult> c1, c4;      // flexible membrane, one per confining pressure
   std::vector<TriaxialRunResult> laterals;    // C1 at the first pressure with other boundaries
+  std::vector<IsotropicStageResult> isotropic_fine;  // C1 isotropic stages at seed resolution
   std::string inclusions = "scaled";        // rule for inclusion/interface parameters (see the command)
   std::vector<std::string> inclusion_sets;    // the overrides it gave
   std::string command, date, machine;
@@ -91,7 +135,7 @@ struct ValidationReport {
 // The checks of issue 4 / seed 000 Sec. 6, in report order.
 std::vector<ValidationCheck> validation_checks(const ValidationReport& r);
 
-// Writes the markdown report to `doc`, with its figures (PNG + the CSV they are drawn from) in
+// Writes the markdown report to `doc` (triaxial_validation_report.cpp), with its figures (PNG + the CSV they are drawn from) in
 // `doc`'s folder / images. Plotting problems only warn (src/io/plot.hpp).
 void write_validation_report(const ValidationReport& r, const std::filesystem::path& doc);
 

@@ -118,3 +118,56 @@ TEST(TriaxialValidation, ChecksFollowTheIssueCriteria) {
   EXPECT_FALSE(find(checks, "particle membrane")->passed);
   EXPECT_FALSE(find(checks, "stronger than C4")->passed);  // 84 vs 99 MPa summed
 }
+
+// With several packings per pressure the checks use the means: peaks_by_pressure() averages per
+// sigma3 (sample standard deviation), and C1 - C4 is the mean of the differences of runs with
+// the same packing seed.
+TEST(TriaxialValidation, ChecksAverageOverPackings) {
+  auto packed = [](double s3, double q, unsigned seed, const char* label = "C1") {
+    TriaxialRunResult r = run(s3, q);
+    r.label = label;
+    r.packing_seed = seed;
+    return r;
+  };
+  ValidationReport rep;
+  rep.sample.seed = 2;
+  rep.c1 = {packed(2.5, 25, 2), packed(2.5, 27, 3), packed(5, 34, 2), packed(5, 36, 3)};
+  rep.c4 = {packed(2.5, 26, 2, "C4"), packed(2.5, 25, 3, "C4"), packed(5, 33, 2, "C4"), packed(5, 34, 3, "C4")};
+  const auto p = peaks_by_pressure(rep.c1);
+  ASSERT_EQ(p.size(), 2u);
+  EXPECT_DOUBLE_EQ(p[0].sigma3_Pa, 2.5e6);
+  EXPECT_NEAR(p[0].mean_Pa, 26e6, 1e-6);
+  EXPECT_NEAR(p[0].sd_Pa, std::sqrt(2.0) * 1e6, 1e-6);  // values 25, 27
+  EXPECT_EQ(p[0].runs, 2);
+  EXPECT_EQ(runs_of_packing(rep.c1, 3).size(), 2u);
+  auto checks = validation_checks(rep);
+  const auto* c = find(checks, "stronger than C4");
+  ASSERT_NE(c, nullptr);
+  // Paired differences -1, +2, +1, +2: mean +1.00 MPa, standard error sqrt(2)/2 = 0.71 MPa.
+  EXPECT_NE(c->measured.find("+1.00 +- 0.71"), std::string::npos) << c->measured;
+  EXPECT_TRUE(c->passed);
+  EXPECT_NE(find(checks, "rises")->what.find("mean of 2 packings"), std::string::npos);
+  // One weak C1 packing at 2.5 MPa turns the mean difference negative.
+  rep.c1[1].peak_differential_Pa = 20e6;
+  EXPECT_FALSE(find(validation_checks(rep), "stronger than C4")->passed);
+}
+
+// The isotropic-stage check uses the runs at seed resolution when there are any.
+TEST(TriaxialValidation, IsotropicCheckPrefersTheSeedResolutionRuns) {
+  ValidationReport rep;
+  rep.c1 = {run(2.5, 26), run(5, 36)};
+  rep.c1[0].largest_sphere_deviation = 0.08;  // a coarse sample's sphere of ~300 particles
+  EXPECT_FALSE(find(validation_checks(rep), "measurement spheres")->passed);
+  IsotropicStageResult fine;
+  fine.sigma3_Pa = 2.5e6;
+  fine.largest_deviation = 0.024;
+  fine.particles = 28000;
+  fine.spheres = {{2.5e6, 2.5e6, 0.37, 2000}, {2.5e6, 2.5e6, 0.37, 2040}, {2.5e6, 2.5e6, 0.37, 1990}};
+  rep.isotropic_fine = {fine};
+  const auto* c = find(validation_checks(rep), "measurement spheres");
+  ASSERT_NE(c, nullptr);
+  EXPECT_TRUE(c->passed);
+  EXPECT_NE(c->measured.find(">= 1990 particles"), std::string::npos) << c->measured;
+  rep.isotropic_fine[0].largest_deviation = 0.06;
+  EXPECT_FALSE(find(validation_checks(rep), "measurement spheres")->passed);
+}
