@@ -177,7 +177,7 @@ TEST(TriaxialValidation, ParticleMembraneRunResumesAndIgnoresTheThreadCount) {
   const std::string text = small_triaxial("particle_membrane", 5e6);
   const std::vector<std::string> sets = {"dem.parallel_min=0"};
   const auto a = test::scratch("pm_whole"), b = test::scratch("pm_resumed");
-  const long stop = 12000;  // the isotropic stage ends after ~8,700 steps
+  const long stop = 7000;  // the isotropic stage ends after ~6400 steps
   ASSERT_EQ(test::run_scenario(text, sets, a, 1, stop), RunStatus::Interrupted);
   ASSERT_EQ(test::run_scenario(text, sets, b, 2, 3000), RunStatus::Interrupted);
   ASSERT_EQ(test::run_scenario(text, sets, b, 1, stop, true), RunStatus::Interrupted);
