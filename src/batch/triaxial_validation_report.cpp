@@ -122,7 +122,7 @@ void write_validation_report(const ValidationReport& r, const fs::path& doc) {
   if (!r.c1.empty()) {
     {
       std::ofstream f(img / "triaxial_peaks.csv");
-      f << "sigma3_MPa,C1 simulated,C4 simulated,C1 fit\n";
+      f << "sigma3_MPa,C1 simulated (mean of packings),C4 simulated (mean of packings),C1 fit\n";
       const auto fit = fit_differential(r.c1);
       const auto p1 = peaks_by_pressure(r.c1), p4 = peaks_by_pressure(r.c4);
       for (std::size_t k = 0; k < p1.size(); ++k)
@@ -137,7 +137,7 @@ void write_validation_report(const ValidationReport& r, const fs::path& doc) {
     j.spec.title = "Peak differential stress against confinement";
     j.spec.x = "sigma3_MPa";
     j.spec.xlabel = "confining pressure sigma3 [MPa]";
-    j.spec.y = {"C1 simulated", "C4 simulated", "C1 fit"};
+    j.spec.y = {"C1 simulated (mean of packings)", "C4 simulated (mean of packings)", "C1 fit"};
     j.spec.ylabel = "peak differential stress [MPa]";
     j.spec.reference_csv = img / "triaxial_lab_table3.csv";
     j.spec.ref_x = "sigma3_MPa";
