@@ -67,7 +67,6 @@ void check_sweep(const SweepResult& r) {
                                                   c.exit_code, c.log.string(), c.error));
 }
 
-// The finished runs of a sweep folder (case_XXX in order), labelled by a parameter of each run.
 // Inclusion and interface parameters. "table7": as printed. "scaled": Table 7's values times the
 // factors the calibration applied to the matrix (emod, kratio, strengths), and the calibrated bond
 // friction angle: the contrasts between matrix, inclusions and interface stay those of Table 7
@@ -96,12 +95,19 @@ std::vector<std::string> inclusion_sets(const nlohmann::json& cal, const std::st
   return sets;
 }
 
-std::vector<TriaxialRunResult> collect(const fs::path& sweep_dir, const std::string& label_key) {
+// The case_XXX folders of a sweep folder, in order (none when it does not exist).
+std::vector<fs::path> case_dirs(const fs::path& sweep_dir) {
   std::vector<fs::path> dirs;
   if (fs::is_directory(sweep_dir))
     for (auto& e : fs::directory_iterator(sweep_dir))
       if (e.is_directory() && e.path().filename().string().rfind("case_", 0) == 0) dirs.push_back(e.path());
   std::sort(dirs.begin(), dirs.end());
+  return dirs;
+}
+
+// The finished runs of a sweep folder (case_XXX in order), labelled by a parameter of each run.
+std::vector<TriaxialRunResult> collect(const fs::path& sweep_dir, const std::string& label_key) {
+  const std::vector<fs::path> dirs = case_dirs(sweep_dir);
   if (dirs.empty()) throw Error(fmt::format("validation: no runs in '{}'", sweep_dir.string()));
   std::vector<TriaxialRunResult> out;
   for (auto& d : dirs) {
@@ -296,13 +302,7 @@ int write_report(const ValidateArgs& a, const fs::path& out, std::chrono::steady
     rep.laterals = collect(out / "laterals", "triaxial.lateral");
     for (auto& r : rep.laterals) r.label = "C1";
   }
-  if (fs::is_directory(out / "isotropic_fine")) {
-    std::vector<fs::path> dirs;
-    for (auto& e : fs::directory_iterator(out / "isotropic_fine"))
-      if (e.is_directory() && e.path().filename().string().rfind("case_", 0) == 0) dirs.push_back(e.path());
-    std::sort(dirs.begin(), dirs.end());
-    for (auto& d : dirs) rep.isotropic_fine.push_back(read_isotropic_stage(d));
-  }
+  for (auto& d : case_dirs(out / "isotropic_fine")) rep.isotropic_fine.push_back(read_isotropic_stage(d));
   if (!a.report_only) {  // recorded for a later --report-only
     rep.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     nlohmann::json setup = read_json(out / "validation_setup.json");

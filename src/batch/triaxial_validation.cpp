@@ -169,6 +169,23 @@ BulgeProfile bulge_profile(const TriaxialRunResult& r, double R0) {
   return b;
 }
 
+namespace {
+// Mean and sample standard deviation (0 for fewer than two values).
+struct MeanSd {
+  double mean = 0, sd = 0;
+};
+MeanSd mean_sd(const std::vector<double>& v) {
+  MeanSd m;
+  if (v.empty()) return m;
+  double sum = 0, ss = 0;
+  for (double x : v) sum += x;
+  m.mean = sum / static_cast<double>(v.size());
+  for (double x : v) ss += (x - m.mean) * (x - m.mean);
+  m.sd = v.size() > 1 ? std::sqrt(ss / static_cast<double>(v.size() - 1)) : 0;
+  return m;
+}
+}  // namespace
+
 std::vector<PeakStats> peaks_by_pressure(const std::vector<TriaxialRunResult>& runs) {
   std::vector<PeakStats> out;
   std::vector<std::vector<double>> peaks;
@@ -179,14 +196,10 @@ std::vector<PeakStats> peaks_by_pressure(const std::vector<TriaxialRunResult>& r
     peaks[k].push_back(r.peak_differential_Pa);
   }
   for (std::size_t k = 0; k < out.size(); ++k) {
-    const auto& v = peaks[k];
-    double sum = 0, ss = 0;
-    for (double x : v) sum += x;
-    const double mean = sum / static_cast<double>(v.size());
-    for (double x : v) ss += (x - mean) * (x - mean);
-    out[k].mean_Pa = mean;
-    out[k].sd_Pa = v.size() > 1 ? std::sqrt(ss / static_cast<double>(v.size() - 1)) : 0;
-    out[k].runs = static_cast<int>(v.size());
+    const MeanSd m = mean_sd(peaks[k]);
+    out[k].mean_Pa = m.mean;
+    out[k].sd_Pa = m.sd;
+    out[k].runs = static_cast<int>(peaks[k].size());
   }
   std::sort(out.begin(), out.end(), [](const PeakStats& a, const PeakStats& b) { return a.sigma3_Pa < b.sigma3_Pa; });
   return out;
@@ -319,10 +332,8 @@ std::vector<ValidationCheck> validation_checks(const ValidationReport& r) {
       for (auto& b : r.c4)
         if (a.packing_seed == b.packing_seed && std::abs(a.sigma3_Pa - b.sigma3_Pa) < 1)
           d.push_back(a.peak_differential_Pa - b.peak_differential_Pa);
-    double mean = 0, ss = 0;
-    for (double x : d) mean += x / static_cast<double>(d.size());
-    for (double x : d) ss += (x - mean) * (x - mean);
-    const double se = d.size() > 1 ? std::sqrt(ss / static_cast<double>(d.size() - 1) / static_cast<double>(d.size())) : 0;
+    const MeanSd m = mean_sd(d);
+    const double mean = m.mean, se = d.empty() ? 0 : m.sd / std::sqrt(static_cast<double>(d.size()));
     out.push_back({"C1 (inclusion-rich) stronger than C4 (inclusion-poor)" + over,
                    fmt::format("C1 - C4 = {} MPa; stronger at {} of {} pressures; over all {} pairs {:+.2f} +- {:.2f} MPa "
                                "(mean +- standard error)",

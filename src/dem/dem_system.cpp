@@ -170,21 +170,21 @@ void DemSystem::rebuild_neighbors() {
     wc.load.assign(wc.particle.size(), PairLoad{});
   }
   wall_motion_since_build_ = 0;
-  if (membrane) {
-    membrane->find_candidates(particles.pos, particles.radius, settings.skin);
-    membrane_built_at_travel_ = 0;
-    ++membrane_builds_;
-  }
+  if (membrane) search_membrane_candidates(0);
   compact_bonds();
+}
+
+void DemSystem::search_membrane_candidates(Real travel) {
+  membrane->find_candidates(particles.pos, particles.radius, settings.skin);
+  membrane_built_at_travel_ = travel;
+  ++membrane_builds_;
 }
 
 void DemSystem::rebuild_membrane_candidates() {
   if (!membrane) return;
   Real travel = 0;
   nl_.needs_rebuild(particles.pos, 0, &travel);
-  membrane->find_candidates(particles.pos, particles.radius, settings.skin);
-  membrane_built_at_travel_ = travel;
-  ++membrane_builds_;
+  search_membrane_candidates(travel);
 }
 
 template <class Law>
@@ -447,11 +447,8 @@ void DemSystem::step() {
     // skin. The membrane moving does not make the particle pairs' list stale, so it no longer
     // forces a rebuild of the whole neighbour list.
     const Real particle_travel = travel + membrane_built_at_travel_;
-    if (particle_travel + membrane->motion_since_build() + membrane->max_step_motion(settings.dt) > settings.skin) {
-      membrane->find_candidates(particles.pos, particles.radius, settings.skin);
-      membrane_built_at_travel_ = travel;
-      ++membrane_builds_;
-    }
+    if (particle_travel + membrane->motion_since_build() + membrane->max_step_motion(settings.dt) > settings.skin)
+      search_membrane_candidates(travel);
     lap(stage_times.membrane);
   }
   if (materials.contact_law == ContactLaw::Linear) contact_forces<LinearContact>(materials.linear);

@@ -4,8 +4,8 @@
 // Every per-pair result is written to its own slot and gathered per particle in increasing
 // pair order, so results are bit-identical on any number of OpenMP threads.
 #pragma once
-#include <optional>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "dem/crack_log.hpp"
@@ -130,6 +130,9 @@ class DemSystem {
   template <class Law> void membrane_forces(const std::vector<typename Law::Params>& params);
   void record_bond_failures();
   void gather_and_integrate();
+  // Searches the membrane's candidates; `travel`: the particles' largest travel since the
+  // neighbour build at this moment.
+  void search_membrane_candidates(Real travel);
 
   NeighborList nl_;
   long membrane_builds_ = 0;
