@@ -45,14 +45,15 @@ std::vector<std::pair<std::string, double>> parameter_keys(const std::string& pa
           {"dem.bond." + pair + ".friction_angle", p.friction_angle_deg}};
 }
 
-std::string step_line(const CalibrationStep& s) {
+std::string step_line(const CalibrationStep& s, bool calibrates_slope) {
   const auto& p = s.params;
   const auto& m = s.measured;
-  const bool with_b = m.slope_b > 0;
+  const bool with_b = s.slope_measured;
   return fmt::format("iter {:2d}: emod {:.4g} GPa, kratio {:.4g}, tensile {:.4g} MPa, cohesion {:.4g} MPa{} -> "
                      "E {:.4g} GPa ({:+.1f}%), nu {:.3f} ({:+.3f}), UCS {:.4g} MPa ({:+.1f}%){}{}",
                      s.iteration, 1e-9 * p.bond_emod_Pa, p.bond_kratio, 1e-6 * p.tensile_strength_Pa,
-                     1e-6 * p.cohesion_Pa, with_b ? fmt::format(", friction angle {:.4g} deg", p.friction_angle_deg) : "",
+                     1e-6 * p.cohesion_Pa,
+                     calibrates_slope ? fmt::format(", friction angle {:.4g} deg", p.friction_angle_deg) : "",
                      1e-9 * m.youngs_modulus_Pa, 100 * s.youngs_modulus_error, m.poisson_ratio, s.poisson_error,
                      1e-6 * m.ucs_Pa, 100 * s.ucs_error,
                      with_b ? fmt::format(", b {:.3f} ({:+.1f}%)", m.slope_b, 100 * s.slope_error) : "",
@@ -63,13 +64,13 @@ void write_csv(const fs::path& file, const std::vector<CalibrationStep>& steps) 
   std::ofstream f(file);
   f << "iteration,bond_emod_Pa,contact_emod_Pa,bond_kratio,contact_kratio,tensile_strength_Pa,cohesion_Pa,"
        "bond_friction_angle_deg,youngs_modulus_Pa,poisson_ratio,ucs_Pa,slope_b,youngs_modulus_error,poisson_error,"
-       "ucs_error,slope_error,converged\n";
+       "ucs_error,slope_measured,slope_error,converged\n";
   for (auto& s : steps)
-    f << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", s.iteration, s.params.bond_emod_Pa,
+    f << fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", s.iteration, s.params.bond_emod_Pa,
                      s.params.contact_emod_Pa, s.params.bond_kratio, s.params.contact_kratio, s.params.tensile_strength_Pa,
                      s.params.cohesion_Pa, s.params.friction_angle_deg, s.measured.youngs_modulus_Pa,
                      s.measured.poisson_ratio, s.measured.ucs_Pa, s.measured.slope_b, s.youngs_modulus_error,
-                     s.poisson_error, s.ucs_error, s.slope_error, s.converged ? 1 : 0);
+                     s.poisson_error, s.ucs_error, s.slope_measured ? 1 : 0, s.slope_error, s.converged ? 1 : 0);
   if (!f) throw Error(fmt::format("cannot write '{}'", file.string()));
 }
 
@@ -145,11 +146,12 @@ int run_calibrate_command(const CalibrateArgs& a) {
     std::string ps;
     for (double p : a.b_confinement) ps += fmt::format(" {:.4g}", 1e-6 * p);
     log::info("and the triaxial slope to b = {:.3f} (tolerance {:.0f}%) by the bond friction angle, from runs of {} at "
-              "sigma3 ={} MPa alongside each UCS run",
-              a.settings.target.slope_b, 100 * a.settings.slope_tolerance, a.triaxial, ps);
+              "sigma3 ={} MPa beside the UCS runs that come within {:g} tolerances of E, nu and UCS",
+              a.settings.target.slope_b, 100 * a.settings.slope_tolerance, a.triaxial, ps,
+              a.settings.slope_measure_window);
   }
 
-  auto model = [&](const MicroParameters& p, int it) {
+  auto model = [&](const MicroParameters& p, int it, bool measure_slope) {
     std::vector<std::string> overrides = base;
     for (auto& [k, v] : parameter_keys(a.pair, p)) overrides.push_back(fmt::format("{}={}", k, v));
     InProcessRun run;
@@ -160,7 +162,7 @@ int run_calibrate_command(const CalibrateArgs& a) {
     std::optional<SweepResult> triaxial;
     std::string triaxial_error;
     std::thread sweep_thread;
-    if (with_b) {
+    if (measure_slope) {
       SweepOptions so;
       so.scenario = a.triaxial;
       so.sets = overrides;
@@ -194,7 +196,7 @@ int run_calibrate_command(const CalibrateArgs& a) {
                               run.out_dir.string()));
     const RunSummary s = read_run_summary(run.out_dir);
     MacroProperties m{s.youngs_modulus_Pa, s.poisson_ratio, s.ucs_Pa, 0.0};
-    if (with_b) {
+    if (measure_slope) {
       const fs::path dir = out / fmt::format("iter_{:02d}_triaxial", it);
       if (!triaxial_error.empty()) throw Error(fmt::format("calibration run {}: triaxial runs: {}", it, triaxial_error));
       const auto& pts = triaxial->strength_points;
@@ -211,7 +213,7 @@ int run_calibrate_command(const CalibrateArgs& a) {
   std::vector<CalibrationStep> steps;
   auto on_step = [&](const CalibrationStep& s) {
     steps.push_back(s);
-    fmt::print("{}\n", step_line(s));  // the iteration lines are the result: printed even with -q
+    fmt::print("{}\n", step_line(s, with_b));  // the iteration lines are the result: printed even with -q
     std::fflush(stdout);
     write_csv(out / "calibration.csv", steps);
   };
@@ -269,6 +271,7 @@ int run_calibrate_command(const CalibrateArgs& a) {
                                {"poisson_ratio", s.measured.poisson_ratio},
                                {"ucs_Pa", s.measured.ucs_Pa},
                                {"slope_b", s.measured.slope_b},
+                               {"slope_measured", s.slope_measured},
                                {"slope_error", s.slope_error},
                                {"youngs_modulus_error", s.youngs_modulus_error},
                                {"poisson_error", s.poisson_error},
@@ -279,8 +282,8 @@ int run_calibrate_command(const CalibrateArgs& a) {
     fmt::print("converged after {} UCS runs; parameters in {}\n", r.steps.size(), (out / "calibrated.toml").string());
     return 0;
   }
-  log::error("not converged within {} UCS runs; the closest run (iteration {}) is in {}", r.steps.size(),
-             chosen.iteration, (out / "calibrated.toml").string());
+  log::error("not converged ({}); the closest run (iteration {}) is in {}", r.stop_reason, chosen.iteration,
+             (out / "calibrated.toml").string());
   return 1;
 }
 

@@ -35,7 +35,7 @@ struct ValidateArgs {
   std::vector<double> pressures = {2.5e6, 5e6, 7.5e6};
   std::vector<std::string> laterals = {"particle_membrane", "rigid_cylinder"};
   std::string calibration;  // an existing calibration.json: skip the calibration
-  int jobs = 2, max_calibration_runs = 6;
+  int jobs = 2, max_calibration_runs = 14;
   std::string inclusions = "scaled";  // scaled: Table 7 contrasts kept; table7: Table 7 values as printed
   bool overwrite = false, report_only = false, skip_fine_isotropic = false;
 };
@@ -141,7 +141,7 @@ std::string command_line(const ValidateArgs& a) {
   if (l != "particle_membrane,rigid_cylinder") c += " --laterals " + (l.empty() ? std::string("''") : l);
   if (!a.calibration.empty()) c += " --calibration " + a.calibration;
   if (a.inclusions != "scaled") c += " --inclusions " + a.inclusions;
-  if (a.max_calibration_runs != 6) c += fmt::format(" --max-calibration-runs {}", a.max_calibration_runs);
+  if (a.max_calibration_runs != 14) c += fmt::format(" --max-calibration-runs {}", a.max_calibration_runs);
   if (a.doc != "docs/validation/triaxial.md") c += " --doc " + a.doc;
   return c;
 }

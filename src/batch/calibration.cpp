@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "batch/mohr_coulomb.hpp"
@@ -50,18 +51,70 @@ void score_step(CalibrationStep& st, const CalibrationSettings& s) {
   st.youngs_modulus_error = (st.measured.youngs_modulus_Pa - s.target.youngs_modulus_Pa) / s.target.youngs_modulus_Pa;
   st.poisson_error = st.measured.poisson_ratio - s.target.poisson_ratio;
   st.ucs_error = (st.measured.ucs_Pa - s.target.ucs_Pa) / s.target.ucs_Pa;
-  st.slope_error = s.calibrates_slope() ? (st.measured.slope_b - s.target.slope_b) / s.target.slope_b : 0.0;
+  const bool with_b = s.calibrates_slope() && st.slope_measured;
+  st.slope_error = with_b ? (st.measured.slope_b - s.target.slope_b) / s.target.slope_b : 0.0;
   st.converged = std::abs(st.youngs_modulus_error) < s.youngs_modulus_tolerance &&
                  std::abs(st.poisson_error) < s.poisson_tolerance && std::abs(st.ucs_error) < s.ucs_tolerance &&
-                 std::abs(st.slope_error) < s.slope_tolerance;
+                 (!s.calibrates_slope() || (st.slope_measured && std::abs(st.slope_error) < s.slope_tolerance));
+}
+
+double worst_scaled_error_without_slope(const CalibrationStep& st, const CalibrationSettings& s) {
+  const double w = std::max({std::abs(st.youngs_modulus_error) / s.youngs_modulus_tolerance,
+                             std::abs(st.poisson_error) / s.poisson_tolerance, std::abs(st.ucs_error) / s.ucs_tolerance});
+  return std::isfinite(w) ? w : HUGE_VAL;
 }
 
 double worst_scaled_error(const CalibrationStep& st, const CalibrationSettings& s) {
-  const double w = std::max({std::abs(st.youngs_modulus_error) / s.youngs_modulus_tolerance,
-                             std::abs(st.poisson_error) / s.poisson_tolerance, std::abs(st.ucs_error) / s.ucs_tolerance,
-                             std::abs(st.slope_error) / s.slope_tolerance});
+  if (s.calibrates_slope() && !st.slope_measured) return HUGE_VAL;
+  const double w = std::max(worst_scaled_error_without_slope(st, s), std::abs(st.slope_error) / s.slope_tolerance);
   return std::isfinite(w) ? w : HUGE_VAL;
 }
+
+namespace {
+
+double tan_deg(double deg) { return std::tan(deg * kPi / 180); }
+
+// Two parameter sets share a friction angle (they are rounded to 6 digits, so equal means equal).
+bool same_angle(double a, double b) { return std::abs(a - b) <= 1e-9 * std::max(1.0, std::abs(a)); }
+
+// d nu / d ln(kratio): least squares over the runs at one friction angle, the current one first,
+// else the latest earlier angle with a usable fit, else the guess. Usable: a spread of at least
+// 2% in kratio and a slope no flatter than a tenth of the guess (otherwise the measurement scatter
+// would send kratio far away).
+double poisson_slope(std::span<const CalibrationStep> history, const CalibrationSettings& s) {
+  std::vector<double> angles;  // distinct angles, latest first
+  for (auto it = history.rbegin(); it != history.rend(); ++it)
+    if (std::none_of(angles.begin(), angles.end(), [&](double a) { return same_angle(a, it->params.friction_angle_deg); }))
+      angles.push_back(it->params.friction_angle_deg);
+  for (double angle : angles) {
+    std::vector<double> x, y;
+    for (auto& h : history)
+      if (same_angle(h.params.friction_angle_deg, angle))
+        x.push_back(std::log(h.params.bond_kratio)), y.push_back(h.measured.poisson_ratio);
+    if (x.size() < 2) continue;
+    const LineFit line = fit_line(x, y);
+    if (line.sxx > 1e-4 * static_cast<double>(x.size()) && line.slope > 0.1 * s.poisson_slope_guess) return line.slope;
+  }
+  return s.poisson_slope_guess;
+}
+
+// d b / d tan(phi_b): least squares over the runs that measured b when they span a range of
+// phi_b and give a positive gradient; else the guess.
+double slope_gradient(std::span<const CalibrationStep> history, const CalibrationSettings& s) {
+  std::vector<double> x, y;
+  for (auto& h : history)
+    if (h.slope_measured) x.push_back(tan_deg(h.params.friction_angle_deg)), y.push_back(h.measured.slope_b);
+  if (x.size() < 2) return s.slope_gradient_guess;
+  const LineFit line = fit_line(x, y);
+  if (line.sxx > 1e-4 * static_cast<double>(x.size()) && line.slope > 0.1 * s.slope_gradient_guess) return line.slope;
+  return s.slope_gradient_guess;
+}
+
+bool within_tolerances_without_slope(const CalibrationStep& st, const CalibrationSettings& s) {
+  return worst_scaled_error_without_slope(st, s) < 1;
+}
+
+}  // namespace
 
 MicroParameters next_parameters(std::span<const CalibrationStep> history, const CalibrationSettings& s) {
   if (history.empty()) throw Error("next_parameters: no run to update from");
@@ -72,30 +125,26 @@ MicroParameters next_parameters(std::span<const CalibrationStep> history, const 
     throw Error(fmt::format("calibration iteration {}: the run measured E = {}, nu = {}, UCS = {}; cannot update from "
                             "that (see the run's folder)",
                             last.iteration, m.youngs_modulus_Pa, m.poisson_ratio, m.ucs_Pa));
-  if (s.calibrates_slope() && !(std::isfinite(m.slope_b) && m.slope_b > 0))
+  if (s.calibrates_slope() && last.slope_measured && !(std::isfinite(m.slope_b) && m.slope_b > 0))
     throw Error(fmt::format("calibration iteration {}: the triaxial runs measured b = {}; cannot update from that (see "
                             "the run's folder)", last.iteration, m.slope_b));
   auto limit = [&](double f) { return std::clamp(f, 1 / s.max_factor, s.max_factor); };
   MicroParameters p = last.params;
+
+  // E, nu and UCS in tolerance and b measured: move the friction angle only (see the header).
+  if (s.calibrates_slope() && last.slope_measured && within_tolerances_without_slope(last, s)) {
+    const double t = tan_deg(p.friction_angle_deg) + (s.target.slope_b - m.slope_b) / slope_gradient(history, s);
+    p.friction_angle_deg = std::clamp(std::atan(std::max(t, 0.0)) * 180 / kPi, 0.0, s.max_friction_angle_deg);
+    return p;
+  }
 
   // E linear in the moduli (through the origin).
   const double f_emod = limit(s.target.youngs_modulus_Pa / m.youngs_modulus_Pa);
   p.bond_emod_Pa *= f_emod;
   p.contact_emod_Pa *= f_emod;
 
-  // nu linear in ln(kratio): slope by least squares over the runs so far, when they span a range
-  // of kratio and give a positive slope; else the guess.
-  double slope = s.poisson_slope_guess;
-  {
-    std::vector<double> x, y;
-    for (auto& h : history) x.push_back(std::log(h.params.bond_kratio)), y.push_back(h.measured.poisson_ratio);
-    const LineFit line = fit_line(x, y);
-    // A spread of at least 2% in kratio, and a slope no flatter than a tenth of the guess:
-    // otherwise the measurement scatter would send kratio far away.
-    if (line.sxx > 1e-4 * static_cast<double>(history.size()) && line.slope > 0.1 * s.poisson_slope_guess)
-      slope = line.slope;
-  }
-  const double f_kratio = limit(std::exp((s.target.poisson_ratio - m.poisson_ratio) / slope));
+  // nu linear in ln(kratio).
+  const double f_kratio = limit(std::exp((s.target.poisson_ratio - m.poisson_ratio) / poisson_slope(history, s)));
   p.bond_kratio *= f_kratio;
   p.contact_kratio *= f_kratio;
 
@@ -103,21 +152,26 @@ MicroParameters next_parameters(std::span<const CalibrationStep> history, const 
   const double f_strength = limit(s.target.ucs_Pa / m.ucs_Pa);
   p.tensile_strength_Pa *= f_strength;
   p.cohesion_Pa *= f_strength;
-
-  // b linear in tan(phi_b): gradient by least squares when the runs span a range of phi_b and
-  // give a positive gradient; else the guess.
-  if (s.calibrates_slope()) {
-    auto tan_deg = [](double deg) { return std::tan(deg * kPi / 180); };
-    double gradient = s.slope_gradient_guess;
-    std::vector<double> x, y;
-    for (auto& h : history) x.push_back(tan_deg(h.params.friction_angle_deg)), y.push_back(h.measured.slope_b);
-    const LineFit line = fit_line(x, y);
-    if (line.sxx > 1e-4 * static_cast<double>(history.size()) && line.slope > 0.1 * s.slope_gradient_guess)
-      gradient = line.slope;
-    const double t = tan_deg(p.friction_angle_deg) + (s.target.slope_b - m.slope_b) / gradient;
-    p.friction_angle_deg = std::clamp(std::atan(std::max(t, 0.0)) * 180 / kPi, 0.0, s.max_friction_angle_deg);
-  }
   return p;
+}
+
+bool next_run_measures_slope(std::span<const CalibrationStep> history, const CalibrationSettings& s) {
+  return s.calibrates_slope() && !history.empty() &&
+         worst_scaled_error_without_slope(history.back(), s) < s.slope_measure_window;
+}
+
+std::string slope_out_of_reach(std::span<const CalibrationStep> history, const CalibrationSettings& s) {
+  if (history.empty() || !s.calibrates_slope()) return {};
+  const CalibrationStep& last = history.back();
+  if (!last.slope_measured || last.converged || !within_tolerances_without_slope(last, s)) return {};
+  const double phi = last.params.friction_angle_deg, b = last.measured.slope_b;
+  if (b < s.target.slope_b && phi >= s.max_friction_angle_deg)
+    return fmt::format("b* = {:.3g} is out of reach: b = {:.3g} with E, nu and UCS in tolerance at the largest bond "
+                       "friction angle allowed ({:g} deg)", s.target.slope_b, b, s.max_friction_angle_deg);
+  if (b > s.target.slope_b && phi <= 0)
+    return fmt::format("b* = {:.3g} is out of reach: b = {:.3g} with E, nu and UCS in tolerance at a bond friction "
+                       "angle of 0", s.target.slope_b, b);
+  return {};
 }
 
 MicroParameters rounded(const MicroParameters& p, int digits) {
@@ -131,26 +185,43 @@ CalibrationResult calibrate(const MicroParameters& start, const CalibrationSetti
   check_calibration_input(start, s);
   CalibrationResult r;
   MicroParameters p = start;
+  bool measure_slope = false;
   for (int it = 1; it <= s.max_iterations; ++it) {
     CalibrationStep st;
     st.iteration = it;
     st.params = p;
-    st.measured = model(p, it);
+    st.slope_measured = measure_slope;
+    st.measured = model(p, it, measure_slope);
+    if (!measure_slope) st.measured.slope_b = 0;
     score_step(st, s);
     r.steps.push_back(st);
     if (on_step) on_step(st);
     if (st.converged) {
       r.converged = true;
+      r.stop_reason = fmt::format("converged after {} runs", it);
       break;
     }
-    if (it < s.max_iterations) p = rounded(next_parameters(r.steps, s));
+    if (r.stop_reason = slope_out_of_reach(r.steps, s); !r.stop_reason.empty()) break;
+    if (it < s.max_iterations) {
+      p = rounded(next_parameters(r.steps, s));
+      measure_slope = next_run_measures_slope(r.steps, s);
+    }
   }
+  if (r.stop_reason.empty()) r.stop_reason = fmt::format("not converged within {} runs", s.max_iterations);
   if (r.converged) {
     r.chosen = static_cast<int>(r.steps.size()) - 1;
   } else {
+    // The closest run. With b calibrated, E, nu and UCS come first (b is the optional target): the
+    // run with those in tolerance and the smallest b error when there is one; else the closest
+    // among the runs that measured b (when any did).
+    auto rank = [&](const CalibrationStep& x) -> std::pair<int, double> {
+      if (!s.calibrates_slope()) return {0, worst_scaled_error_without_slope(x, s)};
+      if (x.slope_measured && within_tolerances_without_slope(x, s)) return {0, std::abs(x.slope_error)};
+      return {x.slope_measured ? 1 : 2, x.slope_measured ? worst_scaled_error(x, s) : worst_scaled_error_without_slope(x, s)};
+    };
     r.chosen = 0;
     for (std::size_t i = 1; i < r.steps.size(); ++i)
-      if (worst_scaled_error(r.steps[i], s) < worst_scaled_error(r.steps[r.chosen], s)) r.chosen = static_cast<int>(i);
+      if (rank(r.steps[i]) < rank(r.steps[r.chosen])) r.chosen = static_cast<int>(i);
   }
   r.final_params = r.steps[r.chosen].params;
   return r;
