@@ -25,7 +25,8 @@
 //   - the nu slope is fitted over the runs at the current phi_b only (the latest angle with two
 //     usable runs when the current one has fewer; the guess when none has),
 //   - b is measured (the triaxial runs) only when the previous run was within twice the E, nu and
-//     UCS tolerances, i.e. close to where phi_b may move next,
+//     UCS tolerances, i.e. close to where phi_b may move next; a run with the three in tolerance
+//     that did not measure b is repeated with b (same parameters),
 //   - at phi_b = 0 or at its cap with b still off in the direction the angle cannot go, the
 //     calibration stops: b* is out of reach of the bond friction angle (stop_reason says so).
 #pragma once

@@ -324,3 +324,21 @@ TEST(Calibration, NotConvergedPrefersTheRunWithEnuAndUcsInTolerance) {
   EXPECT_LT(worst_scaled_error(r.steps[1], s), worst_scaled_error(r.steps[2], s));  // 1.12 against 1.18
   EXPECT_EQ(r.chosen, 2);
 }
+
+// A run with E, nu and UCS in tolerance that did not measure b is repeated as it was, with b.
+TEST(Calibration, RunInToleranceWithoutSlopeIsRepeatedWithIt) {
+  const auto s = table5_and_slope(3.54);
+  CalibrationStep st;
+  st.iteration = 10;
+  st.params = kValidationStart;
+  st.measured = {2.37e9 * 1.002, 0.334, 14.97e6 * 0.973};
+  score_step(st, s);
+  ASSERT_FALSE(st.slope_measured);
+  const std::span<const CalibrationStep> h(&st, 1);
+  const auto p = next_parameters(h, s);
+  EXPECT_EQ(p.bond_emod_Pa, st.params.bond_emod_Pa);
+  EXPECT_EQ(p.bond_kratio, st.params.bond_kratio);
+  EXPECT_EQ(p.tensile_strength_Pa, st.params.tensile_strength_Pa);
+  EXPECT_EQ(p.friction_angle_deg, st.params.friction_angle_deg);
+  EXPECT_TRUE(next_run_measures_slope(h, s));
+}
