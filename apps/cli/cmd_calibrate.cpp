@@ -253,8 +253,10 @@ int run_calibrate_command(const CalibrateArgs& a) {
     j["b_confinement_Pa"] = a.b_confinement;
   }
   j["rules"] = "seed 000 Sec. 5.2: E linear in emod, nu linear in ln(kratio), UCS linear in the strengths at fixed "
-               "tensile_strength/cohesion; b (with --target-b) linear in tan(bond friction_angle)";
+               "tensile_strength/cohesion; b (with --target-b) linear in tan(bond friction_angle), moved only after "
+               "a run with E, nu and UCS in tolerance (docs/batch.md)";
   j["converged"] = r.converged;
+  j["stop_reason"] = r.stop_reason;
   j["chosen_iteration"] = chosen.iteration;
   j["initial_parameters"] = params_json(a.pair, start);
   j["final_parameters"] = params_json(a.pair, r.final_params);

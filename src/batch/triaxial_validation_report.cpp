@@ -216,12 +216,13 @@ void write_validation_report(const ValidationReport& r, const fs::path& doc) {
   const auto cal = calibration_numbers(r.calibration);
   if (cal.present) {
     const std::string why = r.calibration.value("stop_reason", std::string());
-    md += fmt::format("\n## Calibration of the coal matrix (seed 000 Table 5 averages; Eq. 1 slope)\n\n"
-                      "{} after {} iterations{}. Each iteration is one UCS run; b (triaxial runs at the two outer "
-                      "pressures) is measured beside the runs that come near E, nu and UCS, and the bond friction "
-                      "angle moves only after a run with all three in tolerance (docs/batch.md).\n\n",
-                      cal.converged ? "Converged" : "**Not converged**; the closest iteration is used,", cal.runs,
-                      why.empty() ? "" : " (" + why + ")");
+    md += "\n## Calibration of the coal matrix (seed 000 Table 5 averages; Eq. 1 slope)\n\n";
+    md += cal.converged ? fmt::format("Converged after {} iterations.", cal.runs)
+                        : fmt::format("**Not converged** after {} iterations; iteration {} is used.{}", cal.runs,
+                                      r.calibration.value("chosen_iteration", 0), why.empty() ? "" : " Stop: " + why + ".");
+    md += " Each iteration is one UCS run; b (triaxial runs at the two outer pressures) is measured beside the runs "
+          "that come near E, nu and UCS, and the bond friction angle moves only after a run with all three in "
+          "tolerance (docs/batch.md).\n\n";
     md += "| iteration | emod [GPa] | kratio | tensile / cohesion [MPa] | bond friction angle [deg] | E [GPa] | nu | UCS [MPa] | b |\n"
           "|---|---|---|---|---|---|---|---|---|\n";
     for (auto& it : r.calibration.value("iterations", nlohmann::json::array())) {
