@@ -117,7 +117,7 @@ void remap_pair_indices(std::span<std::int32_t> pair, int n_old, int n_new) {
 ParticleMembraneLayout add_particle_membrane(DemSystem& sys, const ParticleMembraneSpec& spec,
                                              const ParticleMembraneMaterial& pm) {
   if (sys.settings.dim != 3) throw InputError("particle membrane: 3D samples only (dem.dim = 3)");
-  if (sys.materials.bond_law == BondLaw::None)
+  if (pm.bonded && sys.materials.bond_law == BondLaw::None)
     throw InputError("particle membrane: its particles are bonded, so it needs dem.bond_law = \"parallel\" or \"rotational\"");
   ParticleMembraneLayout l = particle_membrane_layout(spec);
   const int n_old = sys.materials.groups();
@@ -136,7 +136,7 @@ ParticleMembraneLayout add_particle_membrane(DemSystem& sys, const ParticleMembr
       P.inward_force[k] = l.force;
     }
   // Ring neighbours, then row neighbours, sphere by sphere (a fixed order).
-  for (std::int64_t j = 0; j < l.n_z; ++j)
+  for (std::int64_t j = 0; j < (pm.bonded ? l.n_z : 0); ++j)
     for (std::int64_t i = 0; i < l.n_theta; ++i) {
       sys.add_bond(sphere_index(l, i, j), sphere_index(l, i + 1, j));
       if (j + 1 < l.n_z) sys.add_bond(sphere_index(l, i, j), sphere_index(l, i, j + 1));

@@ -75,6 +75,7 @@ struct ParticleMembraneMaterial {
   Real emod = 1e7;       // bond and membrane-membrane contact modulus [Pa]
   Real density = 1000;   // [kg/m^3]
   Real friction = 0;     // membrane-sample contact friction [-]
+  bool bonded = true;    // ring and row neighbours bonded (false: loose spheres, only their contacts)
 };
 
 inline constexpr const char* kParticleMembraneGroup = "membrane";
@@ -96,7 +97,7 @@ int add_particle_membrane_group(Materials& m, const ParticleMembraneMaterial& pm
 void remap_pair_indices(std::span<std::int32_t> pair, int n_old, int n_new);
 
 // Builds the membrane in `sys` (3D, materials and skin set): group, spheres (at rest, constant
-// external forces), ring and row bonds; initialises the system. Returns the layout.
+// external forces), ring and row bonds (unless !pm.bonded); initialises the system. Returns the layout.
 ParticleMembraneLayout add_particle_membrane(DemSystem& sys, const ParticleMembraneSpec& spec,
                                              const ParticleMembraneMaterial& pm);
 

@@ -79,6 +79,9 @@ void declare(ParamTable& t) {
          "particle membrane: modulus of its bonds and of its spheres' mutual contacts (latex-like; its hoop stress "
          "~ emod pi r_m e_theta / (2 R) stays small beside sigma3 for e_theta of a few %)")
       .positive();
+  t.boolean("particle_membrane.bonded", true,
+            "particle membrane: bond ring and row neighbours (false: loose spheres that touch, each still pushed by its "
+            "constant force; the sample can push between them where the ring opens)");
   t.real("particle_membrane.density", 1000, "kg/m^3",
          "particle membrane: sphere density (latex ~ 950); inertial masses are scaled up where the sample's time step needs "
          "it")
@@ -144,6 +147,7 @@ dem::ParticleMembraneMaterial particle_membrane_material(const Config& cfg) {
   dem::ParticleMembraneMaterial m;
   m.emod = cfg.real("particle_membrane.emod");
   m.density = cfg.real("particle_membrane.density");
+  m.bonded = cfg.boolean("particle_membrane.bonded");
   m.friction = cfg.real("membrane.friction");
   return m;
 }

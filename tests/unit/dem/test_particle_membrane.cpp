@@ -227,6 +227,48 @@ TEST(ParticleMembrane, PressesOnARigidCoreWithItsConstantForces) {
   for (std::size_t i = k0; i < s.particles.size(); ++i) EXPECT_LT(s.particles.force[i].norm(), 1e-9 * l.force);
 }
 
+TEST(ParticleMembrane, UnbondedSpheresPressOnARigidCoreThroughTheirContactsOnly) {
+  // particle_membrane.bonded = false: no bonds at all (so no bond law is needed), and the same
+  // statics as above with the hoop link reduced to the sphere-sphere contact, k_link = E pi r / 2:
+  // u = f / (k_c + 4 sin^2(pi/N) E pi r / 2). The ring is closed in compression, so its contacts
+  // carry the hoop load as the bonds did. Tolerance 1e-4 u.
+  DemSystem s = two_group_system();
+  s.materials.bond_law = BondLaw::None;
+  s.settings.skin = 0.1e-3;
+  ParticleMembraneSpec spec = c1_like_spec();
+  spec.z_top = spec.z_bottom + 4e-3;
+  const auto plan = particle_membrane_layout(spec);
+  const Real rk = 0.4e-3, r = plan.particle_radius;
+  for (int j = 0; j < plan.n_z; ++j)
+    for (int i = 0; i < plan.n_theta; ++i) {
+      const Vec3 x = particle_membrane_position(plan, i, j);
+      const std::size_t k = s.particles.size();
+      s.particles.resize(k + 1);
+      s.particles.pos[k] = Vec3(x.x(), x.y(), 0).normalized() * (plan.centre_radius - r - rk) + Vec3(0, 0, x.z());
+      s.particles.radius[k] = rk;
+      s.particles.set_mass_from_density(k, 1390, 3);
+      s.particles.inv_mass[k] = s.particles.inv_inertia[k] = 0;  // fixed
+    }
+  const Real E = 1e7;
+  ParticleMembraneMaterial pm{E, 1000, 0.3};
+  pm.bonded = false;
+  const auto l = add_particle_membrane(s, spec, pm);
+  EXPECT_EQ(s.bond_i.size(), 0u);
+  EXPECT_EQ(particle_membrane_bonds(s, l), 0u);
+  const Real kc = LinearContact::normal_stiffness(s.materials.linear[0], r, rk, 3);
+  const Real sn = std::sin(kPi / static_cast<Real>(l.n_theta));
+  const Real u = l.force / (kc + 4 * sn * sn * E * kPi * r / 2);
+  const std::size_t k0 = static_cast<std::size_t>(l.first);
+  s.settings.dt = 0.2 * std::sqrt(s.particles.mass[k0] / kc);
+  s.run(4000);
+  EXPECT_NEAR(particle_membrane_mean_radius(s.particles, l), l.centre_radius - u, 1e-4 * u);
+  // A bonded membrane without a bond law is still refused.
+  DemSystem t = two_group_system();
+  t.materials.bond_law = BondLaw::None;
+  t.settings.skin = 0.1e-3;
+  EXPECT_THROW(add_particle_membrane(t, spec, ParticleMembraneMaterial{E, 1000, 0.3}), InputError);
+}
+
 TEST(ParticleMembrane, StabilisedMassesKeepTheSampleTimeStep) {
   // Density scaling (METHODS.md 1.6) of the membrane spheres only: with half-size spheres their
   // own critical step is shorter; after scaling, a sphere pressing on 4 sample spheres (the
