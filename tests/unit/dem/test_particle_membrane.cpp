@@ -55,6 +55,30 @@ ParticleMembraneSpec c1_like_spec() {
   return s;
 }
 
+// A 4 mm high membrane of c1_like_spec().
+ParticleMembraneSpec short_membrane_spec() {
+  ParticleMembraneSpec s = c1_like_spec();
+  s.z_top = s.z_bottom + 4e-3;
+  return s;
+}
+
+// Under each sphere of the membrane `plan`, a fixed sphere of radius rk on its radial line,
+// touching it when the membrane is built; sets the skin.
+void add_fixed_core(DemSystem& s, const ParticleMembraneLayout& plan, Real rk) {
+  s.settings.skin = 0.1e-3;
+  const Real r = plan.particle_radius;
+  for (int j = 0; j < plan.n_z; ++j)
+    for (int i = 0; i < plan.n_theta; ++i) {
+      const Vec3 x = particle_membrane_position(plan, i, j);
+      const std::size_t k = s.particles.size();
+      s.particles.resize(k + 1);
+      s.particles.pos[k] = Vec3(x.x(), x.y(), 0).normalized() * (plan.centre_radius - r - rk) + Vec3(0, 0, x.z());
+      s.particles.radius[k] = rk;
+      s.particles.set_mass_from_density(k, 1390, 3);
+      s.particles.inv_mass[k] = s.particles.inv_inertia[k] = 0;  // fixed
+    }
+}
+
 // One undamped sphere of radius 0.5 mm (density 1390) at `pos` with velocity `vel` and inward
 // load `inward` [N], dt = 1 us, ready to step.
 DemSystem one_free_sphere(const Vec3& pos, const Vec3& vel, Real inward) {
@@ -199,21 +223,10 @@ TEST(ParticleMembrane, PressesOnARigidCoreWithItsConstantForces) {
   // rest; tolerance 1e-4 u (measured 3e-12 u: the incremental bond and contact laws are exact for
   // this radial motion).
   DemSystem s = two_group_system();
-  s.settings.skin = 0.1e-3;
-  ParticleMembraneSpec spec = c1_like_spec();
-  spec.z_top = spec.z_bottom + 4e-3;
+  const ParticleMembraneSpec spec = short_membrane_spec();
   const auto plan = particle_membrane_layout(spec);
   const Real rk = 0.4e-3, r = plan.particle_radius;
-  for (int j = 0; j < plan.n_z; ++j)
-    for (int i = 0; i < plan.n_theta; ++i) {
-      const Vec3 x = particle_membrane_position(plan, i, j);
-      const std::size_t k = s.particles.size();
-      s.particles.resize(k + 1);
-      s.particles.pos[k] = Vec3(x.x(), x.y(), 0).normalized() * (plan.centre_radius - r - rk) + Vec3(0, 0, x.z());
-      s.particles.radius[k] = rk;
-      s.particles.set_mass_from_density(k, 1390, 3);
-      s.particles.inv_mass[k] = s.particles.inv_inertia[k] = 0;  // fixed
-    }
+  add_fixed_core(s, plan, rk);
   const Real E = 1e7;
   const auto l = add_particle_membrane(s, spec, ParticleMembraneMaterial{E, 1000, 0.3});
   ASSERT_EQ(l.n_theta, plan.n_theta);
@@ -234,21 +247,10 @@ TEST(ParticleMembrane, UnbondedSpheresPressOnARigidCoreThroughTheirContactsOnly)
   // carry the hoop load as the bonds did. Tolerance 1e-4 u.
   DemSystem s = two_group_system();
   s.materials.bond_law = BondLaw::None;
-  s.settings.skin = 0.1e-3;
-  ParticleMembraneSpec spec = c1_like_spec();
-  spec.z_top = spec.z_bottom + 4e-3;
+  const ParticleMembraneSpec spec = short_membrane_spec();
   const auto plan = particle_membrane_layout(spec);
   const Real rk = 0.4e-3, r = plan.particle_radius;
-  for (int j = 0; j < plan.n_z; ++j)
-    for (int i = 0; i < plan.n_theta; ++i) {
-      const Vec3 x = particle_membrane_position(plan, i, j);
-      const std::size_t k = s.particles.size();
-      s.particles.resize(k + 1);
-      s.particles.pos[k] = Vec3(x.x(), x.y(), 0).normalized() * (plan.centre_radius - r - rk) + Vec3(0, 0, x.z());
-      s.particles.radius[k] = rk;
-      s.particles.set_mass_from_density(k, 1390, 3);
-      s.particles.inv_mass[k] = s.particles.inv_inertia[k] = 0;  // fixed
-    }
+  add_fixed_core(s, plan, rk);
   const Real E = 1e7;
   ParticleMembraneMaterial pm{E, 1000, 0.3};
   pm.bonded = false;
@@ -265,7 +267,6 @@ TEST(ParticleMembrane, UnbondedSpheresPressOnARigidCoreThroughTheirContactsOnly)
   // A bonded membrane without a bond law is still refused.
   DemSystem t = two_group_system();
   t.materials.bond_law = BondLaw::None;
-  t.settings.skin = 0.1e-3;
   EXPECT_THROW(add_particle_membrane(t, spec, ParticleMembraneMaterial{E, 1000, 0.3}), InputError);
 }
 
