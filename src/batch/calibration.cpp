@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -77,10 +78,18 @@ double tan_deg(double deg) { return std::tan(deg * kPi / 180); }
 // Two parameter sets share a friction angle (they are rounded to 6 digits, so equal means equal).
 bool same_angle(double a, double b) { return std::abs(a - b) <= 1e-9 * std::max(1.0, std::abs(a)); }
 
-// d nu / d ln(kratio): least squares over the runs at one friction angle, the current one first,
-// else the latest earlier angle with a usable fit, else the guess. Usable: a spread of at least
-// 2% in kratio and a slope no flatter than a tenth of the guess (otherwise the measurement scatter
-// would send kratio far away).
+// The least-squares slope of y on x when it is usable: a spread of at least 2% in x (per point)
+// and a slope no flatter than a tenth of the guess (otherwise the measurement scatter would send
+// the parameter far away); else nothing.
+std::optional<double> usable_slope(std::span<const double> x, std::span<const double> y, double guess) {
+  if (x.size() < 2) return std::nullopt;
+  const LineFit line = fit_line(x, y);
+  if (line.sxx > 1e-4 * static_cast<double>(x.size()) && line.slope > 0.1 * guess) return line.slope;
+  return std::nullopt;
+}
+
+// d nu / d ln(kratio): from the runs at one friction angle, the current one first, else the
+// latest earlier angle with a usable fit, else the guess.
 double poisson_slope(std::span<const CalibrationStep> history, const CalibrationSettings& s) {
   std::vector<double> angles;  // distinct angles, latest first
   for (auto it = history.rbegin(); it != history.rend(); ++it)
@@ -91,23 +100,17 @@ double poisson_slope(std::span<const CalibrationStep> history, const Calibration
     for (auto& h : history)
       if (same_angle(h.params.friction_angle_deg, angle))
         x.push_back(std::log(h.params.bond_kratio)), y.push_back(h.measured.poisson_ratio);
-    if (x.size() < 2) continue;
-    const LineFit line = fit_line(x, y);
-    if (line.sxx > 1e-4 * static_cast<double>(x.size()) && line.slope > 0.1 * s.poisson_slope_guess) return line.slope;
+    if (const auto slope = usable_slope(x, y, s.poisson_slope_guess)) return *slope;
   }
   return s.poisson_slope_guess;
 }
 
-// d b / d tan(phi_b): least squares over the runs that measured b when they span a range of
-// phi_b and give a positive gradient; else the guess.
+// d b / d tan(phi_b): from the runs that measured b, else the guess.
 double slope_gradient(std::span<const CalibrationStep> history, const CalibrationSettings& s) {
   std::vector<double> x, y;
   for (auto& h : history)
     if (h.slope_measured) x.push_back(tan_deg(h.params.friction_angle_deg)), y.push_back(h.measured.slope_b);
-  if (x.size() < 2) return s.slope_gradient_guess;
-  const LineFit line = fit_line(x, y);
-  if (line.sxx > 1e-4 * static_cast<double>(x.size()) && line.slope > 0.1 * s.slope_gradient_guess) return line.slope;
-  return s.slope_gradient_guess;
+  return usable_slope(x, y, s.slope_gradient_guess).value_or(s.slope_gradient_guess);
 }
 
 bool within_tolerances_without_slope(const CalibrationStep& st, const CalibrationSettings& s) {
@@ -131,12 +134,12 @@ MicroParameters next_parameters(std::span<const CalibrationStep> history, const 
   auto limit = [&](double f) { return std::clamp(f, 1 / s.max_factor, s.max_factor); };
   MicroParameters p = last.params;
 
-  // E, nu and UCS in tolerance but b not measured: the same parameters again, now with b (the
-  // runs are deterministic). Moving on would trade a run in tolerance for one that may not be: on
-  // validate-triaxial's sample a kratio step of 6% after such a run moved E from +0.2% to -5.5%.
-  if (s.calibrates_slope() && !last.slope_measured && within_tolerances_without_slope(last, s)) return p;
-  // E, nu and UCS in tolerance and b measured: move the friction angle only (see the header).
-  if (s.calibrates_slope() && last.slope_measured && within_tolerances_without_slope(last, s)) {
+  if (s.calibrates_slope() && within_tolerances_without_slope(last, s)) {
+    // E, nu and UCS in tolerance but b not measured: the same parameters again, now with b (the
+    // runs are deterministic). Moving on would trade a run in tolerance for one that may not be: on
+    // validate-triaxial's sample a kratio step of 6% after such a run moved E from +0.2% to -5.5%.
+    if (!last.slope_measured) return p;
+    // b measured: move the friction angle only (see the header).
     const double t = tan_deg(p.friction_angle_deg) + (s.target.slope_b - m.slope_b) / slope_gradient(history, s);
     p.friction_angle_deg = std::clamp(std::atan(std::max(t, 0.0)) * 180 / kPi, 0.0, s.max_friction_angle_deg);
     return p;

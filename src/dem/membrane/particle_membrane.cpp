@@ -136,11 +136,12 @@ ParticleMembraneLayout add_particle_membrane(DemSystem& sys, const ParticleMembr
       P.inward_force[k] = l.force;
     }
   // Ring neighbours, then row neighbours, sphere by sphere (a fixed order).
-  for (std::int64_t j = 0; j < (pm.bonded ? l.n_z : 0); ++j)
-    for (std::int64_t i = 0; i < l.n_theta; ++i) {
-      sys.add_bond(sphere_index(l, i, j), sphere_index(l, i + 1, j));
-      if (j + 1 < l.n_z) sys.add_bond(sphere_index(l, i, j), sphere_index(l, i, j + 1));
-    }
+  if (pm.bonded)
+    for (std::int64_t j = 0; j < l.n_z; ++j)
+      for (std::int64_t i = 0; i < l.n_theta; ++i) {
+        sys.add_bond(sphere_index(l, i, j), sphere_index(l, i + 1, j));
+        if (j + 1 < l.n_z) sys.add_bond(sphere_index(l, i, j), sphere_index(l, i, j + 1));
+      }
   sys.initialise();
   return l;
 }

@@ -32,7 +32,9 @@
 // sample's groups: ring and row neighbours are joined by bonds of the active bond law with a soft,
 // latex-like modulus and strengths so high that they never break; membrane-membrane contacts use
 // the same modulus, no friction; membrane-sample contacts use the sample group's own contact
-// properties with the membrane friction. No bond joins the membrane to the sample.
+// properties with the membrane friction. No bond joins the membrane to the sample. Unbonded
+// (ParticleMembraneMaterial::bonded = false) the spheres are loose and hold together only where
+// they touch.
 //
 // Units: SI. 3D only.
 #pragma once
