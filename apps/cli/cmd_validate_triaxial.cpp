@@ -37,7 +37,7 @@ struct ValidateArgs {
   std::string calibration;  // an existing calibration.json: skip the calibration
   int jobs = 2, max_calibration_runs = 14;
   std::string inclusions = "scaled";  // scaled: Table 7 contrasts kept; table7: Table 7 values as printed
-  bool overwrite = false, report_only = false, skip_fine_isotropic = false;
+  bool overwrite = false, report_only = false, skip_fine_isotropic = false, skip_friction = false;
 };
 
 std::string quoted(const fs::path& p) { return "\"" + p.generic_string() + "\""; }
@@ -136,6 +136,7 @@ std::string command_line(const ValidateArgs& a) {
   if (a.sample.fine_radius_min_m != d.fine_radius_min_m) c += fmt::format(" --fine-radius-min {}", a.sample.fine_radius_min_m);
   if (a.sample.fine_radius_max_m != d.fine_radius_max_m) c += fmt::format(" --fine-radius-max {}", a.sample.fine_radius_max_m);
   if (a.skip_fine_isotropic) c += " --skip-fine-isotropic";
+  if (a.skip_friction) c += " --skip-friction";
   std::string l;
   for (auto& x : a.laterals) l += (l.empty() ? "" : ",") + x;
   if (l != "particle_membrane,rigid_cylinder") c += " --laterals " + (l.empty() ? std::string("''") : l);
@@ -267,6 +268,17 @@ int run_validate(const ValidateArgs& a) {
               a.laterals.size(), lo.out_dir.string());
     check_sweep(run_sweep(lo));
   }
+  if (!a.skip_friction) {  // what seed 000's Fig. 15 difference takes: frictional boundary contacts
+    SweepOptions fo = so;
+    fo.axes = {SweepAxis{"triaxial.lateral", {quoted("membrane"), quoted("particle_membrane")}}, packings};
+    fo.sets.push_back(fmt::format("triaxial.confining_pressure={}", a.pressures.front()));
+    fo.sets.push_back("membrane.friction=-1");
+    fo.out_dir = out / "friction";
+    fo.plots = false;
+    log::info("validation: C1 at {:g} MPa with frictional lateral boundaries in {}", 1e-6 * a.pressures.front(),
+              fo.out_dir.string());
+    check_sweep(run_sweep(fo));
+  }
   return write_report(a, out, start);
 }
 
@@ -303,6 +315,10 @@ int write_report(const ValidateArgs& a, const fs::path& out, std::chrono::steady
     for (auto& r : rep.laterals) r.label = "C1";
   }
   for (auto& d : case_dirs(out / "isotropic_fine")) rep.isotropic_fine.push_back(read_isotropic_stage(d));
+  if (!case_dirs(out / "friction").empty()) {
+    rep.friction = collect(out / "friction", "triaxial.lateral");
+    for (auto& r : rep.friction) r.label = "C1";
+  }
   if (!a.report_only) {  // recorded for a later --report-only
     rep.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     nlohmann::json setup = read_json(out / "validation_setup.json");
@@ -359,6 +375,8 @@ const bool registered = ff::cli::register_command({"validate-triaxial", [](CLI::
       ->capture_default_str();
   sub->add_flag("--skip-fine-isotropic", a->skip_fine_isotropic,
                 "leave out the isotropic-stage check at seed resolution (the spheres are then judged in the coarse runs)");
+  sub->add_flag("--skip-friction", a->skip_friction,
+                "leave out the C1 runs with frictional lateral boundaries (what seed 000's Fig. 15 difference takes)");
   sub->add_option("--pressures", a->pressures, "confining pressures [Pa]")->delimiter(',')->capture_default_str();
   sub->add_option("--laterals", a->laterals, "other lateral boundaries run on C1 at the first pressure")->delimiter(',')->capture_default_str();
   sub->add_option("--inclusions", a->inclusions,

@@ -50,6 +50,7 @@ std::string validation_scenario(const ValidationSample& s, const std::string& dr
 struct TriaxialRunResult {
   std::string label;               // e.g. "C1", "C4"
   std::string lateral;             // membrane, rigid_cylinder, particle_membrane
+  double boundary_friction = 0;    // membrane.friction of the run (-1: each particle's own contact friction)
   double sigma3_Pa = 0;
   unsigned packing_seed = 0;       // sample.seed of the run
   double peak_differential_Pa = 0, strain_at_peak = 0, confinement_at_peak_Pa = 0;
@@ -61,6 +62,8 @@ struct TriaxialRunResult {
   std::vector<double> ring_radius_m, ring_z_m;  // final membrane profile (flexible membrane)
   std::filesystem::path dir;
 };
+// The lateral boundary of a run as the report names it, with its friction when it has one.
+std::string lateral_label(const TriaxialRunResult& r);
 // Reads a triaxial run's summary.json; throws ff::Error when something needed is missing.
 TriaxialRunResult read_triaxial_result(const std::filesystem::path& run_dir, const std::string& label);
 
@@ -125,6 +128,9 @@ struct ValidationReport {
   nlohmann::json calibration;                 // calibration.json of `fracflow calibrate`
   std::vector<TriaxialRunResult> c1, c4;      // flexible membrane, one per confining pressure
   std::vector<TriaxialRunResult> laterals;    // C1 at the first pressure with other boundaries
+  // C1 at the first pressure, flexible and particle membrane, with frictional boundary contacts
+  // (membrane.friction = -1): what seed 000's Fig. 15 difference takes in this model.
+  std::vector<TriaxialRunResult> friction;
   std::vector<IsotropicStageResult> isotropic_fine;  // C1 isotropic stages at seed resolution
   std::string inclusions = "scaled";        // rule for inclusion/interface parameters (see the command)
   std::vector<std::string> inclusion_sets;    // the overrides it gave

@@ -259,7 +259,7 @@ void write_validation_report(const ValidationReport& r, const fs::path& doc) {
     for (auto& x : runs) {
       const auto lab = with_lab ? lab_mean_peak_MPa(1e-6 * x.sigma3_Pa) : std::nullopt;
       t += fmt::format("| {} | {} | {} | {:g} | {} | {} | {:.2f} | {} | {:.2f} | {:.2f} | {:.0f} ({:.0f} / {:.0f}) | {:.1f}% | {} | {:.0f} |\n",
-                       x.label, x.packing_seed, x.lateral, 1e-6 * x.sigma3_Pa, mpa(x.peak_differential_Pa),
+                       x.label, x.packing_seed, lateral_label(x), 1e-6 * x.sigma3_Pa, mpa(x.peak_differential_Pa),
                        lab ? fmt::format("{:.2f}", *lab) : "-", 100 * x.strain_at_peak, mpa(x.confinement_at_peak_Pa),
                        1e-9 * x.youngs_modulus_Pa, x.poisson_ratio, x.cracks_total, x.cracks_tensile, x.cracks_shear,
                        100 * x.largest_sphere_deviation, x.particles, x.wall_time_s);
@@ -308,6 +308,25 @@ void write_validation_report(const ValidationReport& r, const fs::path& doc) {
           "recomputes each triangle's force from its current area, and the rigid cylinder cannot bulge unevenly. The "
           "particle membrane's 'confinement at peak' (total force over the lateral area at the spheres' mean radius) and "
           "its lateral strain (nu) read off because its spheres sink into the hollows of the sample surface (docs/dem.md).\n";
+  }
+  if (!r.friction.empty()) {
+    md += "\n## Friction of the lateral boundary\n\n"
+          "The runs above have frictionless lateral boundaries (membrane.friction = 0: pure pressure, as a rubber sleeve "
+          "that moves with the sample). Below, the same C1 packings with every boundary contact taking the particle's own "
+          "contact friction (membrane.friction = -1, mu = 0.4 as in Table 7), as PFC wall elements would:\n\n" +
+          run_table(r.friction, true);
+    std::vector<TriaxialRunResult> fw, pm;
+    for (auto& x : r.friction) (x.lateral == "membrane" ? fw : pm).push_back(x);
+    const auto a = peaks_by_pressure(fw), b = peaks_by_pressure(pm);
+    if (a.size() == 1 && b.size() == 1)
+      md += fmt::format(
+          "\nMeans: flexible membrane {} MPa, particle membrane {} MPa ({:+.1f}%). The flexible membrane's elements move only "
+          "along their normals, so friction holds the sample's surface where the sample shortens and bulges: the sleeve "
+          "carries axial load, which raises the peak as seed 000's Fig. 15 shows, while the particle membrane's spheres "
+          "move with the surface and add almost nothing. The same friction spoils the isotropic stage (measurement "
+          "spheres against the applied stresses, column above), which seed 000 reports consistent, and a latex sleeve "
+          "cannot carry axial load; so the validation runs keep the frictionless boundary (docs/dem.md).\n",
+          mpa(a[0].mean_Pa), mpa(b[0].mean_Pa), 100 * (a[0].mean_Pa / b[0].mean_Pa - 1));
   }
   if (!r.isotropic_fine.empty()) {
     const auto& x0 = r.isotropic_fine.front();

@@ -319,7 +319,7 @@ void DemSystem::wall_forces(const std::vector<typename Law::Params>& params) {
       contact_kinematics(g, particles.pos[i], particles.vel[i], particles.omega[i], g.xc, wall.velocity_at(g),
                          Vec3::Zero(), dt);
       auto prm = params[particles.group[i] * ng + particles.group[i]];
-      prm.fric = wall.friction;
+      prm.fric = boundary_friction(wall.friction, prm.fric);
       Real fn;
       const Vec3 f = Law::force(prm, g, wc.state[k], dt, dim, fn);  // force on the wall
       out.f = f;

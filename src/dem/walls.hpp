@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "dem/contact/boundary_friction.hpp"
 #include "dem/contact/contact_geometry.hpp"
 
 namespace ff::dem {
@@ -18,7 +19,8 @@ struct Wall {
   Real radius = 0;             // cylinder radius [m]
   Vec3 velocity = Vec3::Zero();  // plane translation velocity [m/s]
   Real radial_velocity = 0;    // cylinder: dR/dt [m/s]
-  Real friction = 0.5;         // Coulomb friction of wall contacts [-]
+  Real friction = 0.5;         // Coulomb friction of wall contacts [-]; kGroupFriction: the particle's own
+                               // group contact friction, as between two of its particles
   bool active = true;
   // Output of the last step: total force exerted BY the particles ON the wall [N],
   // and the summed normal stiffness of its contacts (for servos) [N/m].

@@ -84,7 +84,8 @@ FlexibleMembrane::FlexibleMembrane(const MembraneSettings& s) : s_(s) {
   if (!(s.relaxation > 0 && s.relaxation <= 1)) bad("relaxation (alpha_s) must be in (0, 1] (PFC default 0.8)");
   if (!(s.r_min > 0 && s.r_min < s.radius))
     bad("r_min must be in (0, radius): set it a little below the platen radius (free rows stop there)");
-  if (!(s.friction >= 0)) bad("friction must be >= 0");
+  if (!(s.friction >= 0 || s.friction == kGroupFriction))
+    bad("friction must be >= 0, or kGroupFriction (each particle's own group contact friction)");
   tol_ = 1e-9 * s.radius;
   const int nt = s.n_theta, nz = s.n_z;
   x_.resize(static_cast<std::size_t>(nt) * (nz + 1));
@@ -325,7 +326,7 @@ void FlexibleMembrane::compute_forces(const MembraneParticles& p, std::span<cons
       contact_kinematics(g, x, p.vel[i], p.omega[i], g.xc, v_surface, Vec3::Zero(), dt);
       const int grp = p.group[i];
       auto prm = pair_params[static_cast<std::size_t>(grp) * n_groups + grp];
-      prm.fric = s_.friction;
+      prm.fric = boundary_friction(s_.friction, prm.fric);
       Real fn;
       const Vec3 f = Law::force(prm, g, state_[c], dt, 3, fn);  // force on the element
       out.f = f;

@@ -44,6 +44,7 @@
 #include <span>
 #include <vector>
 
+#include "dem/contact/boundary_friction.hpp"
 #include "dem/contact/contact_geometry.hpp"
 #include "dem/membrane/triangle_contact.hpp"
 
@@ -86,7 +87,8 @@ struct MembraneSettings {
   // it a little below the platen radius (the smallest expected sample radius), so the membrane
   // still follows a sample that contracts but free rows do not fold through the platens.
   Real r_min = 0;
-  Real friction = 0;             // particle-membrane Coulomb friction (0: pure pressure) [-]
+  Real friction = 0;             // particle-membrane Coulomb friction (0: pure pressure; kGroupFriction:
+                                 // each particle's own group contact friction) [-]
   MembraneVertexRule rule = MembraneVertexRule::Nodal;
   std::size_t parallel_min = 2048;  // contact loops with fewer candidates run on one thread
 };

@@ -89,11 +89,11 @@ int add_particle_membrane_group(Materials& m, const ParticleMembraneMaterial& pm
   const int n = m.groups();
   const Real E = pm.emod, nu = kMembranePoisson;
   grow_table(m.linear, n, LinearContact::Params{E, 1.0, 0.0}, [&](LinearContact::Params p) {
-    p.fric = pm.friction;
+    p.fric = boundary_friction(pm.friction, p.fric);
     return p;
   });
   grow_table(m.hertz, n, HertzMindlinContact::Params{E / (2 * (1 + nu)), nu, 0.0}, [&](HertzMindlinContact::Params p) {
-    p.fric = pm.friction;
+    p.fric = boundary_friction(pm.friction, p.fric);
     return p;
   });
   ParallelBond::Material pb;  // soft, unbreakable; (sample, membrane) pairs are never bonded

@@ -76,7 +76,7 @@ struct ParticleMembraneLayout {
 struct ParticleMembraneMaterial {
   Real emod = 1e7;       // bond and membrane-membrane contact modulus [Pa]
   Real density = 1000;   // [kg/m^3]
-  Real friction = 0;     // membrane-sample contact friction [-]
+  Real friction = 0;     // membrane-sample contact friction [-] (kGroupFriction: the sample group's own)
   bool bonded = true;    // ring and row neighbours bonded (false: loose spheres, only their contacts)
 };
 

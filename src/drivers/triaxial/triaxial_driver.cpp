@@ -68,9 +68,11 @@ void declare(ParamTable& t) {
   t.real("membrane.min_radius_fraction", 0.9, "-", "vertices never come closer to the axis than this fraction of the sample radius")
       .open_range(0, 1);
   t.real("membrane.friction", 0.0, "-",
-         "friction between sample particles and the membrane (flexible or particle) or rigid cylinder (0: pure pressure, as "
-         "a rubber sleeve with a lubricated contact)")
-      .non_negative();
+         "friction between sample particles and the lateral boundary (flexible or particle membrane, rigid cylinder); 0: "
+         "pure pressure, as a rubber sleeve that moves with the sample; -1: each particle's own contact friction "
+         "(dem.contact.G-G.friction), as between particles (then the sleeve's elements, which move only along their "
+         "normals, carry axial load: docs/dem.md)")
+      .at_least(-1);
   t.real("particle_membrane.radius_fraction", 1.0, "-",
          "particle membrane: sphere radius as a fraction of the sample's mean particle radius (adjusted by up to 15% so "
          "that the rows fill the platen gap and the ring clears the sample by membrane.clearance)")
@@ -115,6 +117,15 @@ template <> struct is_checkpoint_pod<dem::ParticleMembraneLayout> : std::true_ty
 namespace ff::drivers {
 namespace {
 
+// membrane.friction as the contacts take it: -1 is kGroupFriction, otherwise >= 0.
+Real membrane_friction(const Config& cfg) {
+  const Real mu = cfg.real("membrane.friction");
+  if (mu < 0 && mu != dem::kGroupFriction)
+    cfg.fail("membrane.friction", fmt::format("{} is neither a friction coefficient (>= 0) nor -1 (each particle's own "
+                                              "contact friction)", mu));
+  return mu;
+}
+
 // The membrane around a sample of radius R between the platens: a sleeve `length_factor`
 // times the sample height, centred on it, its facets `clearance` R outside the sample.
 dem::MembraneSettings membrane_settings(const Config& cfg, const dem::DemSystem& sys, const dem::SampleInfo& info) {
@@ -126,7 +137,7 @@ dem::MembraneSettings membrane_settings(const Config& cfg, const dem::DemSystem&
   m.v_max = cfg.real("triaxial.servo_velocity");
   m.relaxation = cfg.real("triaxial.servo_relaxation");
   m.r_min = cfg.real("membrane.min_radius_fraction") * R;
-  m.friction = cfg.real("membrane.friction");
+  m.friction = membrane_friction(cfg);
   m.parallel_min = sys.settings.parallel_min;
   return m;
 }
@@ -148,7 +159,7 @@ dem::ParticleMembraneMaterial particle_membrane_material(const Config& cfg) {
   m.emod = cfg.real("particle_membrane.emod");
   m.density = cfg.real("particle_membrane.density");
   m.bonded = cfg.boolean("particle_membrane.bonded");
-  m.friction = cfg.real("membrane.friction");
+  m.friction = membrane_friction(cfg);
   return m;
 }
 
@@ -254,6 +265,7 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
   sys.materials = dem::build_materials(cfg);
   if (sys.settings.dim != 3) cfg.fail("dem.dim", "a triaxial test needs a 3D cylinder sample (dim = 3)");
   if (cfg.string("sample.shape") != "cylinder") cfg.fail("sample.shape", "a triaxial test needs shape = \"cylinder\"");
+  membrane_friction(cfg);  // checked before anything is built
   dem::SampleInfo info;
   TriaxialState st;
   const std::size_t cyl = lat.cylinder_wall;  // the rigid cylinder is wall 2 (after the platens)
@@ -274,7 +286,7 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
       log::info("flexible membrane: {} x {} units, {} triangles, sleeve radius {:.4g} m", sys.membrane->settings().n_theta,
                 sys.membrane->settings().n_z, sys.membrane->element_count(), sys.membrane->settings().radius);
     } else if (kind == LateralKind::RigidCylinder) {
-      add_rigid_cylinder(sys, info, cfg.real("membrane.friction"));
+      add_rigid_cylinder(sys, info, membrane_friction(cfg));
     }
     dem::choose_time_step(cfg, sys);
     if (kind == LateralKind::ParticleMembrane) lat.particles = add_particle_membrane(cfg, sys, info);

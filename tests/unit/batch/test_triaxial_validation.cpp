@@ -119,6 +119,27 @@ TEST(TriaxialValidation, ChecksFollowTheIssueCriteria) {
   EXPECT_FALSE(find(checks, "stronger than C4")->passed);  // 84 vs 99 MPa summed
 }
 
+// The runs with frictional boundary contacts are quoted beside the Fig. 15 check but do not
+// decide it: the frictionless flexible and particle membranes do.
+TEST(TriaxialValidation, FrictionRunsAreQuotedNotJudged) {
+  ValidationReport rep;
+  rep.c1 = {run(2.5, 26), run(5, 36), run(7.5, 44)};
+  rep.laterals = {run(2.5, 26, "particle_membrane")};
+  TriaxialRunResult fw = run(2.5, 29), pm = run(2.5, 26.5, "particle_membrane");
+  fw.boundary_friction = pm.boundary_friction = -1;
+  fw.largest_sphere_deviation = 0.36;
+  rep.friction = {fw, pm};
+  const auto* c = find(validation_checks(rep), "particle membrane");
+  ASSERT_NE(c, nullptr);
+  EXPECT_FALSE(c->passed);  // 26 vs 26 MPa without friction
+  EXPECT_NE(c->measured.find("29.00 vs 26.50 MPa (+9.4%)"), std::string::npos) << c->measured;
+  EXPECT_NE(c->measured.find("up to 36% off"), std::string::npos) << c->measured;
+  EXPECT_EQ(lateral_label(fw), "membrane, friction of the particles");
+  fw.boundary_friction = 0.3;
+  EXPECT_EQ(lateral_label(fw), "membrane, friction 0.3");
+  EXPECT_EQ(lateral_label(rep.laterals[0]), "particle_membrane");
+}
+
 // With several packings per pressure the checks use the means: peaks_by_pressure() averages per
 // sigma3 (sample standard deviation), and C1 - C4 is the mean of the differences of runs with
 // the same packing seed.

@@ -369,6 +369,30 @@ TEST(DemWalls, SphereOnPlaneWall) {
   }
 }
 
+TEST(DemWalls, GroupFrictionWallTakesTheParticlesContactFriction) {
+  // A wall with friction kGroupFriction treats each body as its own group's contacts do: the
+  // sliding body of SphereOnPlaneWall feels mu Fn with mu = dem.contact.G-G.friction (0.25 here).
+  // Tolerance 1e-9 relative.
+  const Real delta = 1e-6;
+  DemSystem s = empty_system(3);
+  s.materials.bond_law = BondLaw::None;
+  s.materials.linear[0].fric = 0.25;
+  Wall w;
+  w.kind = Wall::Kind::Plane;
+  w.point = Vec3(0, 0.01, 0);
+  w.normal = Vec3::UnitY();
+  w.friction = kGroupFriction;
+  s.walls.push_back(w);
+  add_particle(s, Vec3(0.004, 0.01 + kRadius - delta, 0), kRadius);
+  s.settings.dt = 1e-6;
+  s.particles.vel[0] = Vec3(2.0, 0, 0);
+  s.initialise();
+  s.step();
+  const Real kn = LinearContact::normal_stiffness(s.materials.linear[0], kRadius, 0, 3);
+  EXPECT_NEAR(s.particles.force[0].y(), kn * delta, 1e-9 * kn * delta);
+  EXPECT_NEAR(s.particles.force[0].x(), -0.25 * kn * delta, 1e-9 * kn * delta);
+}
+
 TEST(DemWalls, SphereInsideCylinderWall) {
   // Sphere pressed against the inside of a cylinder (axis z, radius Rc) by delta: the wall
   // pushes it back towards the axis with kn delta, kn by the wall rule (METHODS.md 1.3), and the

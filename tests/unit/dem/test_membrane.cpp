@@ -354,6 +354,34 @@ struct Probe {
 };
 }  // namespace
 
+// Friction of the element contacts (issue 4: "the same contact law and friction as everything
+// else"). A sphere pressed by delta on the middle of a face slides along the axis, faster than
+// its shear spring can hold in one step (ks v dt = 6.7 mu Fn at mu = 0.5), so the shear force on
+// it is mu Fn against the motion: mu = the particle's own contact friction (0.5 here) with
+// kGroupFriction, the membrane's friction otherwise (0.2, and 0 for a lubricated sleeve).
+// Tolerance: round-off, 1e-9 relative.
+TEST(MembraneContact, SlidingSphereFeelsTheMembraneOrItsOwnFriction) {
+  const Real R = 0.01, H = 0.02, r = 1e-3, delta = 1e-6, v = 5.0, dt = 1e-6;
+  const Real kn = kPi * r * kE;  // linear contact, rB = 0 (METHODS.md 1.3)
+  for (Real mu : {kGroupFriction, 0.2, 0.0}) {
+    MembraneSettings s = sleeve(16, 4, R, H);
+    s.friction = mu;
+    FlexibleMembrane m(s);
+    const std::size_t k = 2 * (16 + 3);  // lower triangle of unit (3, 1), away from every edge
+    Balls b;
+    b.add(m.centroid(k) + (r - delta) * m.normal(k), r);
+    b.vel[0] = Vec3(0, 0, v);
+    m.find_candidates(b.pos, b.radius, 0.2 * r);
+    m.compute_forces<LinearContact>(b.view(), linear_params(), 1, dt);
+    int active = 0;
+    const Vec3 f = force_on_particles(m, active);
+    ASSERT_EQ(active, 1);
+    const Real want_mu = mu == kGroupFriction ? linear_params()[0].fric : mu;
+    EXPECT_NEAR(f.dot(m.normal(k)), kn * delta, 1e-9 * kn * delta) << "mu " << mu;  // pushed towards the axis
+    EXPECT_NEAR(f.z(), -want_mu * kn * delta, 1e-9 * kn * delta) << "mu " << mu;
+  }
+}
+
 // No double counting (file comment of flexible_membrane.hpp): a sphere pressed by delta on a
 // face, on the shared diagonal of a (flat) unit, on the shared edge between two rows, and on an
 // inward-pushed vertex (a ridge: one vertex contact over six elements) gets exactly one contact

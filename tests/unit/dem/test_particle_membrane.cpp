@@ -206,6 +206,30 @@ TEST(ParticleMembrane, AddedAsItsOwnBondedGroupWithInwardConstantForces) {
   EXPECT_NEAR(particle_membrane_volume(s.particles, l, spec.z_bottom, spec.z_top), v, 1e-12 * v);
 }
 
+TEST(ParticleMembrane, GroupFrictionKeepsEachSampleGroupsOwnFriction) {
+  // Membrane friction kGroupFriction (membrane.friction = -1): a membrane sphere touches each
+  // sample group with that group's own contact friction, as the group's particles touch each
+  // other; the membrane's mutual contacts stay frictionless.
+  Materials m;
+  m.group_names = {"matrix", "vein"};
+  m.density = {1390, 1810};
+  m.linear.resize(4);
+  m.hertz.resize(4);
+  m.linear[0].fric = m.hertz[0].fric = 0.4;
+  m.linear[3].fric = m.hertz[3].fric = 0.3;
+  m.linear[1].fric = m.linear[2].fric = m.hertz[1].fric = m.hertz[2].fric = 0.35;
+  ParticleMembraneMaterial pm;
+  pm.friction = kGroupFriction;
+  ASSERT_EQ(add_particle_membrane_group(m, pm), 2);
+  for (int g = 0; g < 2; ++g) {
+    const Real own = g == 0 ? 0.4 : 0.3;
+    EXPECT_EQ(m.linear[m.pair(g, 2)].fric, own);
+    EXPECT_EQ(m.linear[m.pair(2, g)].fric, own);
+    EXPECT_EQ(m.hertz[m.pair(g, 2)].fric, own);
+  }
+  EXPECT_EQ(m.linear[m.pair(2, 2)].fric, 0);
+}
+
 TEST(ParticleMembrane, GroupNameIsReserved) {
   DemSystem s = two_group_system();
   s.materials.group_names[1] = "membrane";
