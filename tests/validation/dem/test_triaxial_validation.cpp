@@ -174,7 +174,7 @@ TEST(TriaxialValidation, FrictionalFlexibleMembraneCarriesAxialLoad) {
   // triaxial.md): with frictional element contacts (membrane.friction = -1: each particle's own
   // contact friction, 0.4) the flexible membrane's elements, which move only along their normals,
   // hold the sample's surface where it slides along them. The sleeve then carries axial load: the
-  // peak rises (measured +32% on this small sample, +8% on validate-triaxial's C1 at 2.5 MPa;
+  // peak rises (measured +32% on this small sample, +7% on validate-triaxial's C1 at 2.5 MPa;
   // asserted > +10%), and in the isotropic stage the whole sample's axial stress (Love-Weber, over
   // the enclosed volume) no longer equals the platens' (measured +21%; frictionless within 3%, see
   // MembraneIsotropicStageAndEquilibrium; asserted > +5%).
