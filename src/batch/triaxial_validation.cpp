@@ -194,6 +194,20 @@ MeanSd mean_sd(const std::vector<double>& v) {
 }
 }  // namespace
 
+std::optional<FrictionComparison> compare_friction_runs(const std::vector<TriaxialRunResult>& runs) {
+  std::vector<TriaxialRunResult> fw, pm;
+  FrictionComparison c;
+  for (auto& x : runs) {
+    (x.lateral == "membrane" ? fw : pm).push_back(x);
+    c.largest_sphere_deviation = std::max(c.largest_sphere_deviation, x.largest_sphere_deviation);
+  }
+  const auto a = peaks_by_pressure(fw), b = peaks_by_pressure(pm);
+  if (a.size() != 1 || b.size() != 1) return std::nullopt;
+  c.flexible = a[0];
+  c.particle = b[0];
+  return c;
+}
+
 std::vector<PeakStats> peaks_by_pressure(const std::vector<TriaxialRunResult>& runs) {
   std::vector<PeakStats> out;
   std::vector<std::vector<double>> peaks;
@@ -306,19 +320,11 @@ std::vector<ValidationCheck> validation_checks(const ValidationReport& r) {
   const auto pp = peaks_by_pressure(particle);
   // The same comparison with frictional boundary contacts, quoted beside the check (not judged).
   std::string with_friction;
-  {
-    std::vector<TriaxialRunResult> fw, pm;
-    double worst = 0;
-    for (auto& x : r.friction) {
-      (x.lateral == "membrane" ? fw : pm).push_back(x);
-      worst = std::max(worst, x.largest_sphere_deviation);
-    }
-    const auto a = peaks_by_pressure(fw), b = peaks_by_pressure(pm);
-    if (a.size() == 1 && b.size() == 1)
-      with_friction = fmt::format("; with frictional contacts (membrane.friction = -1): {} vs {} MPa ({:+.1f}%), but the "
-                                  "isotropic stage then reads up to {:.0f}% off (below)",
-                                  mpa(a[0].mean_Pa), mpa(b[0].mean_Pa), 100 * (a[0].mean_Pa / b[0].mean_Pa - 1), 100 * worst);
-  }
+  if (const auto f = compare_friction_runs(r.friction))
+    with_friction = fmt::format("; with frictional contacts (membrane.friction = -1): {} vs {} MPa ({:+.1f}%), but the "
+                                "isotropic stage then reads up to {:.0f}% off (below)",
+                                mpa(f->flexible.mean_Pa), mpa(f->particle.mean_Pa),
+                                100 * (f->flexible.mean_Pa / f->particle.mean_Pa - 1), 100 * f->largest_sphere_deviation);
   for (auto& l : pp)
     for (auto& x : p1)
       if (std::abs(x.sigma3_Pa - l.sigma3_Pa) < 1) {

@@ -97,6 +97,14 @@ struct PeakStats {
   int runs = 0;
 };
 std::vector<PeakStats> peaks_by_pressure(const std::vector<TriaxialRunResult>& runs);
+// The frictional-boundary runs (ValidationReport::friction) summed up: mean peaks of the flexible
+// and the particle membrane and the largest isotropic-stage sphere deviation; nullopt unless both
+// boundaries were run at one pressure.
+struct FrictionComparison {
+  PeakStats flexible, particle;
+  double largest_sphere_deviation = 0;
+};
+std::optional<FrictionComparison> compare_friction_runs(const std::vector<TriaxialRunResult>& runs);
 // The runs of one packing seed, in their order.
 std::vector<const TriaxialRunResult*> runs_of_packing(const std::vector<TriaxialRunResult>& runs, unsigned seed);
 

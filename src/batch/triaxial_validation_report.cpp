@@ -315,10 +315,7 @@ void write_validation_report(const ValidationReport& r, const fs::path& doc) {
           "that moves with the sample). Below, the same C1 packings with every boundary contact taking the particle's own "
           "contact friction (membrane.friction = -1, mu = 0.4 as in Table 7), as PFC wall elements would:\n\n" +
           run_table(r.friction, true);
-    std::vector<TriaxialRunResult> fw, pm;
-    for (auto& x : r.friction) (x.lateral == "membrane" ? fw : pm).push_back(x);
-    const auto a = peaks_by_pressure(fw), b = peaks_by_pressure(pm);
-    if (a.size() == 1 && b.size() == 1)
+    if (const auto f = compare_friction_runs(r.friction))
       md += fmt::format(
           "\nMeans: flexible membrane {} MPa, particle membrane {} MPa ({:+.1f}%). The flexible membrane's elements move only "
           "along their normals, so friction holds the sample's surface where the sample shortens and bulges: the sleeve "
@@ -326,7 +323,7 @@ void write_validation_report(const ValidationReport& r, const fs::path& doc) {
           "move with the surface and add almost nothing. The same friction spoils the isotropic stage (measurement "
           "spheres against the applied stresses, column above), which seed 000 reports consistent, and a latex sleeve "
           "cannot carry axial load; so the validation runs keep the frictionless boundary (docs/dem.md).\n",
-          mpa(a[0].mean_Pa), mpa(b[0].mean_Pa), 100 * (a[0].mean_Pa / b[0].mean_Pa - 1));
+          mpa(f->flexible.mean_Pa), mpa(f->particle.mean_Pa), 100 * (f->flexible.mean_Pa / f->particle.mean_Pa - 1));
   }
   if (!r.isotropic_fine.empty()) {
     const auto& x0 = r.isotropic_fine.front();

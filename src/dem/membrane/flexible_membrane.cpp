@@ -84,7 +84,7 @@ FlexibleMembrane::FlexibleMembrane(const MembraneSettings& s) : s_(s) {
   if (!(s.relaxation > 0 && s.relaxation <= 1)) bad("relaxation (alpha_s) must be in (0, 1] (PFC default 0.8)");
   if (!(s.r_min > 0 && s.r_min < s.radius))
     bad("r_min must be in (0, radius): set it a little below the platen radius (free rows stop there)");
-  if (!(s.friction >= 0 || s.friction == kGroupFriction))
+  if (!valid_boundary_friction(s.friction))
     bad("friction must be >= 0, or kGroupFriction (each particle's own group contact friction)");
   tol_ = 1e-9 * s.radius;
   const int nt = s.n_theta, nz = s.n_z;

@@ -120,7 +120,7 @@ namespace {
 // membrane.friction as the contacts take it: -1 is kGroupFriction, otherwise >= 0.
 Real membrane_friction(const Config& cfg) {
   const Real mu = cfg.real("membrane.friction");
-  if (mu < 0 && mu != dem::kGroupFriction)
+  if (!dem::valid_boundary_friction(mu))
     cfg.fail("membrane.friction", fmt::format("{} is neither a friction coefficient (>= 0) nor -1 (each particle's own "
                                               "contact friction)", mu));
   return mu;
