@@ -2,9 +2,11 @@
 // its scenario keys and runs. Drivers are listed once, in registry.cpp.
 #pragma once
 #include <filesystem>
+#include <functional>
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "io/params.hpp"
 
@@ -18,7 +20,19 @@ struct RunOptions {
   bool resume = false;               // continue from out_dir/checkpoint/
   std::filesystem::path abort_file;  // when this file appears: checkpoint and stop
   double progress_interval_s = 5;    // status line period (0: silent)
+  // Called by the driver once its set-up has passed every check and the sample/lattice is
+  // built, before it writes any file into out_dir (not called on resume). The CLI uses it to
+  // replace an old run only when the new one is known to start (--overwrite). May be empty.
+  std::function<void()> begin_output;
+  // Keys of scenario.toml edited since the run started that the user accepted at resume
+  // (fracflow resume --accept-edited-scenario); recorded in summary.json by every driver.
+  std::vector<std::string> accepted_scenario_changes;
 };
+
+// Calls opt.begin_output when set (every driver calls this once, after set-up, on a fresh run).
+inline void begin_output(const RunOptions& opt) {
+  if (opt.begin_output && !opt.resume) opt.begin_output();
+}
 
 // What run() reports back to the CLI.
 enum class RunStatus { Finished, Interrupted };
