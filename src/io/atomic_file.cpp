@@ -1,6 +1,7 @@
 #include "io/atomic_file.hpp"
 
 #include <fmt/format.h>
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -59,11 +60,36 @@ void AtomicFileWriter::commit() {
     fail("close failed (disk full?)");
   }
   f_ = nullptr;
+  if (!previous_.empty() && ::access(path_.c_str(), F_OK) == 0) {
+    // A hard link keeps `path_` in place until the new file replaces it; without hard links
+    // (some network file systems) a rename leaves the older copy alone for an instant.
+    auto prev_tmp = previous_;
+    prev_tmp += fmt::format(".tmp.{}", static_cast<long>(::getpid()));
+    ::unlink(prev_tmp.c_str());
+    const bool kept = ::link(path_.c_str(), prev_tmp.c_str()) == 0 ? std::rename(prev_tmp.c_str(), previous_.c_str()) == 0
+                                                                   : std::rename(path_.c_str(), previous_.c_str()) == 0;
+    if (!kept) {
+      const int err = errno;
+      ::unlink(prev_tmp.c_str());
+      std::error_code ec;
+      std::filesystem::remove(tmp_, ec);
+      throw Error(fmt::format("cannot write '{}': keeping the previous copy as '{}' failed ({})", path_.string(),
+                              previous_.string(), std::strerror(err)));
+    }
+  }
   if (std::rename(tmp_.c_str(), path_.c_str()) != 0) {
     const int err = errno;
     std::error_code ec;
     std::filesystem::remove(tmp_, ec);
     throw Error(fmt::format("cannot write '{}': renaming the temporary file failed ({})", path_.string(), std::strerror(err)));
+  }
+  if (durable_) {  // the renames themselves survive a power loss only once the folder is synced
+    const auto dir = path_.has_parent_path() ? path_.parent_path() : std::filesystem::path(".");
+    const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY);
+    if (fd >= 0) {
+      ::fsync(fd);
+      ::close(fd);
+    }
   }
 }
 

@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "core/error.hpp"
+#include "core/log.hpp"
 #include "io/atomic_file.hpp"
 
 namespace ff {
@@ -15,6 +16,8 @@ constexpr char kMagic[8] = {'F', 'F', 'C', 'H', 'K', 'P', 'T', '\0'};
 constexpr std::uint32_t kEndMarker = 0xFFFFFFFFu;
 constexpr std::size_t kHeaderBytes = 16, kTrailerBytes = 4 + 8 + 8, kMaxTag = 4096;
 constexpr std::uint64_t kPrime = 0x100000001b3ull;
+// Advice when a checkpoint cannot be used: the commands that exist (there is no --resume flag).
+constexpr const char* kStartOver = "to start the run again from the beginning: fracflow run SCENARIO --out DIR --overwrite";
 }  // namespace
 
 // ---------------------------------------------------------------- checksum
@@ -51,8 +54,9 @@ std::uint64_t detail::Checksum::value() const {
 
 // ---------------------------------------------------------------- writer
 
-CheckpointWriter::CheckpointWriter(std::filesystem::path path)
-    : out_(std::make_unique<AtomicFileWriter>(std::move(path), /*durable=*/true)) {
+CheckpointWriter::CheckpointWriter(std::filesystem::path path, bool keep_previous)
+    : out_(std::make_unique<AtomicFileWriter>(path, /*durable=*/true)) {
+  if (keep_previous) out_->keep_previous_as(previous_checkpoint_path(path));
   const std::uint32_t version = kCheckpointFormatVersion, zero = 0;
   hashed_write(kMagic, sizeof kMagic);
   hashed_write(&version, 4);
@@ -105,8 +109,7 @@ CheckpointReader::CheckpointReader(std::filesystem::path path) : path_(std::move
   const auto size = static_cast<std::uint64_t>(in_.tellg());
   in_.seekg(0);
   auto truncated = [&](const std::string& why) {
-    return InputError(fmt::format("checkpoint '{}' is truncated or corrupted ({}); restart from an older checkpoint or "
-                                  "without --resume", name, why));
+    return InputError(fmt::format("checkpoint '{}' is truncated or corrupted ({}); {}", name, why, kStartOver));
   };
   char head[12] = {};
   in_.read(head, 12);
@@ -118,8 +121,8 @@ CheckpointReader::CheckpointReader(std::filesystem::path path) : path_(std::move
   std::uint32_t version = 0;
   std::memcpy(&version, head + 8, 4);
   if (version != kCheckpointFormatVersion)
-    throw InputError(fmt::format("checkpoint '{}' has format version {}, this build reads version {}; restart without "
-                                 "--resume or use the fracflow version that wrote it", name, version, kCheckpointFormatVersion));
+    throw InputError(fmt::format("checkpoint '{}' has format version {}, this build reads version {}; resume it with the "
+                                 "fracflow version that wrote it, or {}", name, version, kCheckpointFormatVersion, kStartOver));
   if (size < kHeaderBytes + kTrailerBytes) throw truncated(fmt::format("only {} bytes", size));
 
   // Verify the checksum over the whole file before trusting any section header.
@@ -210,6 +213,33 @@ std::vector<std::string> CheckpointReader::tags() const {
   std::vector<std::string> t;
   for (auto& [k, s] : sections_) t.push_back(k);
   return t;
+}
+
+// ---------------------------------------------------------------- rotation
+
+std::filesystem::path previous_checkpoint_path(const std::filesystem::path& newest) {
+  auto p = newest;
+  p.replace_filename(newest.stem().string() + ".prev" + newest.extension().string());
+  return p;
+}
+
+CheckpointReader open_checkpoint(const std::filesystem::path& newest) {
+  const auto prev = previous_checkpoint_path(newest);
+  try {
+    return CheckpointReader(newest);
+  } catch (const InputError& e) {
+    if (!std::filesystem::exists(prev)) throw;
+    const std::string why = e.what();
+    try {
+      CheckpointReader r(prev);
+      log::warn("the newest checkpoint '{}' cannot be used ({}); resuming from the previous one, '{}'", newest.string(), why,
+                prev.string());
+      return r;
+    } catch (const InputError& e2) {
+      throw InputError(fmt::format("neither checkpoint can be used: '{}': {}; '{}': {}", newest.string(), why, prev.string(),
+                                   e2.what()));
+    }
+  }
 }
 
 }  // namespace ff

@@ -47,7 +47,9 @@ template <class S, int O> struct is_checkpoint_pod<Eigen::Quaternion<S, O>> : st
 class CheckpointWriter {
  public:
   // Starts writing `path` (via a temporary file; nothing replaces `path` before commit()).
-  explicit CheckpointWriter(std::filesystem::path path);
+  // With keep_previous, commit() first keeps the file it replaces as
+  // previous_checkpoint_path(path), so a complete checkpoint exists at every instant.
+  explicit CheckpointWriter(std::filesystem::path path, bool keep_previous = false);
   ~CheckpointWriter();  // without commit(): the temporary file is removed, `path` untouched
 
   // Stores a vector as one section; T must satisfy is_checkpoint_pod.
@@ -110,5 +112,12 @@ class CheckpointReader {
   std::ifstream in_;
   std::map<std::string, Section, std::less<>> sections_;
 };
+
+// The older checkpoint kept beside `newest` ("state.ffcp" -> "state.prev.ffcp").
+std::filesystem::path previous_checkpoint_path(const std::filesystem::path& newest);
+// Opens `newest`; when it is missing, truncated or fails its checksum, opens the previous one
+// kept beside it instead, with a warning naming both. Throws InputError naming both (and why)
+// when neither can be read.
+CheckpointReader open_checkpoint(const std::filesystem::path& newest);
 
 }  // namespace ff

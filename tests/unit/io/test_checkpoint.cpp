@@ -130,3 +130,73 @@ TEST(io_checkpoint, UncommittedWriterKeepsThePreviousCheckpoint) {
   EXPECT_THROW(w.put_value("b", 2), Error);
   EXPECT_EQ(CheckpointReader(d / "x.ffck").get_value<int>("a"), 1);
 }
+
+namespace {
+void write_time(const std::filesystem::path& p, double t) {
+  CheckpointWriter w(p, /*keep_previous=*/true);
+  w.put_value("time", t);
+  w.commit();
+}
+}  // namespace
+
+TEST(io_checkpoint, RotationKeepsThePreviousCheckpointBesideTheNewest) {
+  test::ScratchDir d;
+  const auto p = d / "state.ffcp", prev = d / "state.prev.ffcp";
+  EXPECT_EQ(previous_checkpoint_path(p), prev);
+  write_time(p, 1.0);
+  EXPECT_FALSE(std::filesystem::exists(prev));  // nothing to keep yet
+  write_time(p, 2.0);
+  write_time(p, 3.0);
+  EXPECT_EQ(CheckpointReader(p).get_value<double>("time"), 3.0);
+  EXPECT_EQ(CheckpointReader(prev).get_value<double>("time"), 2.0);
+  {  // a writer that never commits (killed while writing) leaves both untouched
+    CheckpointWriter w(p, true);
+    w.put_value("time", 4.0);
+  }
+  EXPECT_EQ(open_checkpoint(p).get_value<double>("time"), 3.0);
+  EXPECT_EQ(CheckpointReader(prev).get_value<double>("time"), 2.0);
+  for (auto& e : std::filesystem::directory_iterator(d.path()))  // no temporary file left over
+    EXPECT_TRUE(e.path() == p || e.path() == prev) << e.path();
+}
+
+TEST(io_checkpoint, ResumeFallsBackToThePreviousCheckpointWhenTheNewestIsDamaged) {
+  test::ScratchDir d;
+  const auto p = d / "state.ffcp", prev = d / "state.prev.ffcp";
+  write_time(p, 1.0);
+  write_time(p, 2.0);
+  const std::string good = test::slurp(p);
+  // Truncated, one flipped bit, missing: the previous one is used.
+  test::spit(p, good.substr(0, good.size() / 2));
+  EXPECT_EQ(open_checkpoint(p).get_value<double>("time"), 1.0);
+  std::string bad = good;
+  bad[good.size() / 2] ^= 0x10;
+  test::spit(p, bad);
+  EXPECT_EQ(open_checkpoint(p).get_value<double>("time"), 1.0);
+  std::filesystem::remove(p);
+  EXPECT_EQ(open_checkpoint(p).get_value<double>("time"), 1.0);
+  // Both damaged: one error naming both files.
+  test::spit(p, bad);
+  test::spit(prev, good.substr(0, 10));
+  const auto e = error_of([&] { open_checkpoint(p); });
+  EXPECT_NE(e.find(p.string()), std::string::npos) << e;
+  EXPECT_NE(e.find(prev.string()), std::string::npos) << e;
+  // No previous checkpoint: the newest's own error.
+  std::filesystem::remove(prev);
+  EXPECT_NE(error_of([&] { open_checkpoint(p); }).find("checksum"), std::string::npos);
+}
+
+TEST(io_checkpoint, AdviceNamesOnlyCommandsThatExist) {
+  // Was: "restart ... without --resume" (there is no --resume flag).
+  test::ScratchDir d;
+  const auto p = d / "c.ffck";
+  write_sample(p);
+  const std::string good = test::slurp(p);
+  std::string future = good;
+  future[8] = 99;
+  for (const std::string& bytes : {good.substr(0, good.size() / 2), future}) {
+    test::spit(p, bytes);
+    const auto e = error_of([&] { CheckpointReader r(p); });
+    EXPECT_EQ(e.find("--resume"), std::string::npos) << e;
+    EXPECT_NE(e.find("fracflow run SCENARIO --out DIR --overwrite"), std::string::npos) << e;
+  }
+}
