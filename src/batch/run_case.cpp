@@ -15,6 +15,7 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "io/run_folder.hpp"
 #include "io/scenario.hpp"
 
 extern char** environ;
@@ -43,15 +44,11 @@ std::unique_ptr<LoadedScenario> load_scenario_for_run(const std::string& path, c
 RunStatus run_in_process(const std::string& scenario_path, const std::vector<std::string>& overrides,
                          const InProcessRun& run) {
   auto l = load_scenario_for_run(scenario_path, overrides);  // every key validated before anything is written
-  if (fs::exists(run.out_dir) && !fs::is_empty(run.out_dir))
-    throw InputError(fmt::format("results folder '{}' already holds files; choose an empty or new folder",
-                                 run.out_dir.string()));
-  fs::create_directories(run.out_dir);
-  {
-    std::ofstream f(run.out_dir / "scenario.toml");
-    f << l->config.resolved_toml();
-    if (!f) throw Error(fmt::format("cannot write '{}'", (run.out_dir / "scenario.toml").string()));
-  }
+  // The same folder rules as `fracflow run` (never --overwrite here): created, with its marker,
+  // lock and scenario.toml, only when the driver's set-up has passed (opt.begin_output).
+  NewRunFolder folder(run.out_dir, false, scenario_path);
+  std::string command = "run " + (scenario_path.empty() ? std::string("(built-in default)") : scenario_path);
+  for (auto& o : overrides) command += " --set " + o;
   RunOptions opt;
   opt.out_dir = run.out_dir;
   opt.threads = std::max(1, run.threads);
@@ -59,6 +56,7 @@ RunStatus run_in_process(const std::string& scenario_path, const std::vector<std
   opt.max_wall_s = run.max_wall_s;
   opt.abort_file = run.out_dir / "ABORT";
   opt.progress_interval_s = run.quiet ? 0 : l->config.real("output.progress_interval");
+  opt.begin_output = [&folder, resolved = l->config.resolved_toml(), command] { folder.begin(resolved, command); };
   // The driver reads the thread count from the OpenMP runtime; quiet is a process-wide flag,
   // so both are restored afterwards.
   const int threads_before = omp_get_max_threads();
@@ -73,7 +71,12 @@ RunStatus run_in_process(const std::string& scenario_path, const std::vector<std
       log::quiet() = quiet;
     }
   } restore{threads_before, quiet_before};
-  return l->driver->run(l->config, opt);
+  try {
+    return l->driver->run(l->config, opt);
+  } catch (const InputError&) {
+    folder.discard_if_empty();  // a refused run leaves nothing behind, as with `fracflow run`
+    throw;
+  }
 }
 
 namespace {

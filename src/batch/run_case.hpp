@@ -34,9 +34,10 @@ struct InProcessRun {
   double max_wall_s = 0;
 };
 
-// Runs a scenario in this process: validate, create out_dir, write scenario.toml (the
-// resolved parameters), call the driver. Input errors are thrown before out_dir is created;
-// driver errors (ff::InputError from cross-parameter checks, ff::NumericalError) propagate.
+// Runs a scenario in this process: validate, check out_dir as `fracflow run` does
+// (io/run_folder.hpp), call the driver, which creates out_dir with its marker, lock and
+// scenario.toml once its set-up has passed. Input errors leave no out_dir behind; driver errors
+// (ff::InputError from cross-parameter checks, ff::NumericalError) propagate.
 RunStatus run_in_process(const std::string& scenario_path, const std::vector<std::string>& overrides,
                          const InProcessRun& run);
 

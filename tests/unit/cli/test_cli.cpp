@@ -163,3 +163,35 @@ TEST(Cli, DefaultScenarioIsTheExampleFile) {
   };
   EXPECT_EQ(values(a.output.substr(a.output.find("\n\n"))), values(b.output.substr(b.output.find("\n\n"))));
 }
+
+TEST(Cli, MistypedCommandGetsADidYouMean) {
+  auto r = run("runn x.toml");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("unknown command 'runn', did you mean 'run'?"), std::string::npos) << r.output;
+  r = run("sweeep");  // registered commands are suggested too
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("did you mean 'sweep'?"), std::string::npos) << r.output;
+  r = run("examples/ucs_2d.toml");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("fracflow run examples/ucs_2d.toml"), std::string::npos) << r.output;
+}
+
+TEST(Cli, BadThreadsValueSaysTheAllowedRangeInWords) {
+  for (const char* v : {"-1", "0.5", "abc", "100000"}) {
+    for (const char* cmd : {"run", "resume /nonexistent"}) {
+      const auto r = run(std::string(cmd) + " --threads " + v);
+      EXPECT_EQ(r.code, 2) << cmd << " " << v << "\n" << r.output;
+      EXPECT_NE(r.output.find("--threads: must be a whole number from 1 to 1024 (0 or absent: all cores)"),
+                std::string::npos)
+          << r.output;
+    }
+  }
+}
+
+TEST(Cli, CommandLineErrorsExitWithCode2) {
+  // CLI11's own codes (105, 106, 109...) meant nothing to scripts; every input error is 2.
+  EXPECT_EQ(run("").code, 2);
+  EXPECT_EQ(run("run --no-such-flag").code, 2);
+  EXPECT_EQ(run("resume").code, 2);
+  EXPECT_EQ(run("run --help").code, 0);
+}

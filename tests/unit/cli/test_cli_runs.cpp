@@ -1,0 +1,274 @@
+// Results are never lost, through the fracflow program itself: --overwrite replaces only a run
+// of ours and only once the new run has started, protected and unwritable folders are refused,
+// one process writes a folder at a time, an edited scenario.toml is refused at resume, and
+// SIGINT/SIGTERM leave a checkpoint that `fracflow resume` finishes. Tiny UCS samples (~150
+// spheres, well under a second each).
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include "io/run_folder.hpp"
+
+namespace fs = std::filesystem;
+
+extern char** environ;
+
+namespace {
+
+const std::string kTiny =
+    " --set sample.diameter=5e-3 --set sample.height=8e-3 --set sample.porosity=0.45 --set ucs.max_strain=0.004"
+    " --set output.vtk=false --set output.plots=false --set output.progress_interval=0 -j1";
+
+struct Result {
+  int code;
+  std::string output;
+};
+Result run(const std::string& args) {
+  const std::string cmd = std::string(FRACFLOW_BIN) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf;
+  while (std::fgets(buf.data(), buf.size(), p)) out += buf.data();
+  const int status = pclose(p);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+// Same, after `prefix` (e.g. "cd DIR && " or "HOME=DIR ").
+Result run_in(const std::string& prefix, const std::string& args) {
+  const std::string cmd = prefix + std::string(FRACFLOW_BIN) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf;
+  while (std::fgets(buf.data(), buf.size(), p)) out += buf.data();
+  const int status = pclose(p);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+// Starts fracflow in the background, stdout and stderr into `log`.
+pid_t start(const std::vector<std::string>& args, const fs::path& log) {
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&fa, STDOUT_FILENO, STDERR_FILENO);
+  std::vector<std::string> store = {FRACFLOW_BIN};
+  store.insert(store.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& a : store) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = -1;
+  if (posix_spawn(&pid, FRACFLOW_BIN, &fa, nullptr, argv.data(), environ) != 0) pid = -1;
+  posix_spawn_file_actions_destroy(&fa);
+  return pid;
+}
+
+struct Scratch {
+  fs::path path;
+  Scratch() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    path = fs::temp_directory_path() / ("fracflow-cliruns-" + std::string(info->name()) + "-" + std::to_string(::getpid()));
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~Scratch() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+  fs::path operator/(const std::string& n) const { return path / n; }
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// A tiny run stopped by --max-steps: a folder with a checkpoint to resume.
+void interrupted_run(const fs::path& dir) {
+  const auto r = run("run --out " + dir.string() + kTiny + " --max-steps 300");
+  ASSERT_EQ(r.code, 0) << r.output;
+  ASSERT_TRUE(fs::exists(dir / "checkpoint")) << r.output;
+  ASSERT_FALSE(fs::exists(dir / "summary.json"));
+}
+
+}  // namespace
+
+TEST(CliRuns, OverwriteRefusesAFolderThatHoldsNoRun) {
+  Scratch s;
+  const fs::path dir = s / "thesis";
+  fs::create_directories(dir);
+  std::ofstream(dir / "chapter1.tex") << "precious";
+  const auto r = run("run --out " + dir.string() + " --overwrite" + kTiny);
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("holds no fracflow run"), std::string::npos) << r.output;
+  EXPECT_EQ(slurp(dir / "chapter1.tex"), "precious");
+}
+
+TEST(CliRuns, OverwriteKeepsTheOldRunWhenTheNewOneFailsItsRunTimeChecks) {
+  // The time-step check needs the built sample: before, --overwrite had deleted the old run by then.
+  Scratch s;
+  const fs::path dir = s / "run";
+  ASSERT_EQ(run("run --out " + dir.string() + kTiny).code, 0);
+  const std::string summary = slurp(dir / "summary.json");
+  const auto r = run("run --out " + dir.string() + " --overwrite" + kTiny + " --set dem.time_step=1e-3");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("dem.time_step"), std::string::npos) << r.output;
+  EXPECT_EQ(slurp(dir / "summary.json"), summary) << "the old run is untouched";
+  EXPECT_TRUE(ff::is_fracflow_run(dir));
+}
+
+TEST(CliRuns, OverwriteReplacesARunOfOursWithoutLeftovers) {
+  Scratch s;
+  const fs::path dir = s / "run";
+  ASSERT_EQ(run("run --out " + dir.string() + kTiny).code, 0);
+  std::ofstream(dir / "old_note.txt") << "from the old run";
+  const auto r = run("run --out " + dir.string() + " --overwrite" + kTiny + " --set ucs.platen_velocity=0.3");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "old_note.txt"));
+  EXPECT_TRUE(fs::exists(dir / "summary.json"));
+  EXPECT_NE(slurp(dir / "scenario.toml").find("0.3"), std::string::npos);
+  EXPECT_EQ(std::distance(fs::directory_iterator(s.path), fs::directory_iterator()), 1) << "no moved-aside copy left";
+}
+
+TEST(CliRuns, CurrentDirectoryHomeAndScenarioFolderAreRefusedWhateverTheyHold) {
+  Scratch s;
+  std::ofstream(s / "notes.txt") << "mine";
+  const fs::path scenario = s / "case.toml";
+  std::ofstream(scenario) << "driver = \"ucs\"\n";
+  const std::string cd = "cd " + s.path.string() + " && ";
+  auto r = run_in(cd, "run --out . --overwrite" + kTiny);
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("the current directory"), std::string::npos) << r.output;
+  r = run_in(cd, "run case.toml --out " + s.path.string() + " --overwrite" + kTiny);
+  EXPECT_EQ(r.code, 2) << r.output;
+  r = run_in("HOME=" + s.path.string() + " ", "run --out " + s.path.string() + "/ --overwrite" + kTiny);
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("home folder"), std::string::npos) << r.output;
+  r = run("run --out / --overwrite" + kTiny);
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_TRUE(fs::exists(s / "notes.txt"));
+  EXPECT_TRUE(fs::exists(scenario));
+}
+
+TEST(CliRuns, UnwritableOutIsOneLineAndExitCode2) {
+  const auto r = run("run --out /proc/fracflow-test/out" + kTiny);
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("cannot be written"), std::string::npos) << r.output;
+  EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+}
+
+TEST(CliRuns, AFolderInUseIsRefusedToASecondRunOrResume) {
+  Scratch s;
+  const fs::path dir = s / "run";
+  interrupted_run(dir);
+  {
+    const ff::FolderLock held = ff::FolderLock::acquire(dir);  // as a running fracflow would
+    const std::string pid = "process " + std::to_string(::getpid());
+    auto r = run("resume " + dir.string() + " -q");
+    EXPECT_EQ(r.code, 2) << r.output;
+    EXPECT_NE(r.output.find("in use by " + pid), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(dir.string()), std::string::npos) << r.output;
+    r = run("run --out " + dir.string() + " --overwrite" + kTiny);
+    EXPECT_EQ(r.code, 2) << r.output;
+    EXPECT_NE(r.output.find("in use by " + pid), std::string::npos) << r.output;
+    EXPECT_TRUE(fs::exists(dir / "checkpoint"));
+  }
+  // The lock file stays behind, naming a process that no longer holds it: no obstacle.
+  const auto r = run("resume " + dir.string() + " -q");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(dir / "summary.json"));
+}
+
+TEST(CliRuns, EditedScenarioIsRefusedAtResumeUnlessAccepted) {
+  Scratch s;
+  const fs::path dir = s / "run";
+  interrupted_run(dir);
+  std::string text = slurp(dir / "scenario.toml");
+  const auto at = text.find("platen_velocity = ");
+  ASSERT_NE(at, std::string::npos) << text;
+  const auto eol = text.find('\n', at);
+  const std::string old_line = text.substr(at, eol - at);
+  text.replace(at, eol - at, "platen_velocity = 0.25");
+  std::ofstream(dir / "scenario.toml") << text;
+  auto r = run("resume " + dir.string() + " -q");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("ucs.platen_velocity: " + old_line.substr(18) + " -> 0.25"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--accept-edited-scenario"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "summary.json"));
+  r = run("resume " + dir.string() + " -q --accept-edited-scenario");
+  EXPECT_EQ(r.code, 0) << r.output;
+  const auto summary = nlohmann::json::parse(slurp(dir / "summary.json"));
+  ASSERT_TRUE(summary.contains("resumed_with_edited_scenario")) << summary.dump(1);
+  EXPECT_EQ(summary["resumed_with_edited_scenario"][0], "ucs.platen_velocity: " + old_line.substr(18) + " -> 0.25");
+}
+
+TEST(CliRuns, ResumeOfARunWithoutMarkerStillWorks) {
+  // Runs made before results folders carried .fracflow/ resume as before, and lose nothing.
+  Scratch s;
+  const fs::path dir = s / "run";
+  interrupted_run(dir);
+  fs::remove_all(dir / ".fracflow");
+  const auto r = run("resume " + dir.string() + " -q");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(dir / "summary.json"));
+  EXPECT_TRUE(fs::exists(dir / "scenario.toml"));
+}
+
+namespace {
+
+// Starts a tiny run that lasts a few seconds, sends `sig` once the sample is built, and checks
+// that the run stops at once with a checkpoint, exit code 0 and a message naming the signal
+// and `fracflow resume DIR`.
+void stop_with_signal(const fs::path& dir, int sig, const std::string& name) {
+  std::vector<std::string> args = {"run", "--out", dir.string()};
+  std::istringstream tiny(kTiny);
+  for (std::string w; tiny >> w;) args.push_back(w);
+  for (const char* a : {"--set", "ucs.platen_velocity=0.004"}) args.push_back(a);  // ~3 s
+  const fs::path log = dir.string() + ".log";
+  const pid_t pid = start(args, log);
+  ASSERT_GT(pid, 0);
+  const auto t0 = std::chrono::steady_clock::now();
+  while (!fs::exists(ff::run_marker_file(dir)) && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(20))
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  ::kill(pid, sig);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  const std::string out = slurp(log);
+  ASSERT_TRUE(WIFEXITED(status)) << "killed by the signal instead of stopping cleanly\n" << out;
+  EXPECT_EQ(WEXITSTATUS(status), 0) << out;
+  EXPECT_NE(out.find("stopped by " + name), std::string::npos) << out;
+  EXPECT_NE(out.find("fracflow resume " + dir.string()), std::string::npos) << out;
+  EXPECT_TRUE(fs::exists(dir / "checkpoint")) << out;
+  EXPECT_FALSE(fs::exists(dir / "summary.json")) << "the run should have been stopped before its end\n" << out;
+}
+
+}  // namespace
+
+TEST(CliRuns, SigintWritesACheckpointAndResumeFinishesTheRun) {
+  Scratch s;
+  const fs::path dir = s / "run";
+  stop_with_signal(dir, SIGINT, "SIGINT");
+  const auto r = run("resume " + dir.string() + " -q");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(dir / "summary.json"));
+}
+
+TEST(CliRuns, SigtermWritesACheckpoint) {
+  Scratch s;
+  stop_with_signal(s / "run", SIGTERM, "SIGTERM");
+}
