@@ -24,10 +24,12 @@ namespace fs = std::filesystem;
 
 namespace ff::batch {
 
-std::unique_ptr<LoadedScenario> load_scenario_for_run(const std::string& path, const std::vector<std::string>& overrides) {
+std::unique_ptr<LoadedScenario> load_scenario_for_run(const std::string& path, const std::vector<std::string>& overrides,
+                                                      bool resume) {
   const std::string text = path.empty() ? std::string(default_scenario_text()) : read_text_file(path);
   const std::string source = path.empty() ? "<built-in default scenario>" : path;
-  std::string driver_name = peek_driver(text, source);
+  const auto entries = parse_toml_flat(text, source);  // parsed once: a large file costs one pass
+  std::string driver_name = peek_driver(entries, source);
   for (auto& o : overrides)
     if (o.rfind("driver=", 0) == 0) driver_name = o.substr(7);
   if (driver_name.empty()) {
@@ -37,7 +39,8 @@ std::unique_ptr<LoadedScenario> load_scenario_for_run(const std::string& path, c
   auto l = std::make_unique<LoadedScenario>();
   l->driver = &find_driver(driver_name);
   l->table = parameter_table(*l->driver);
-  l->config = load_scenario(l->table, path, text, overrides);
+  l->config = load_scenario(l->table, path, entries, overrides);
+  if (!resume && l->driver->validate) l->driver->validate(l->config);
   return l;
 }
 

@@ -23,8 +23,13 @@ struct LoadedScenario {
 };
 
 // Reads the scenario file (or the built-in default when `path` is empty), applies the
-// "key=value" overrides (later ones win) and validates every key; throws ff::InputError.
-std::unique_ptr<LoadedScenario> load_scenario_for_run(const std::string& path, const std::vector<std::string>& overrides);
+// "key=value" overrides (later ones win), validates every key and runs the driver's validate()
+// (every check run() makes before building its sample or lattice); throws ff::InputError.
+// `resume`: the scenario.toml of a results folder, whose sample or lattice is in its checkpoint;
+// validate() is left out (the files it names are relative to the original scenario's folder,
+// and the run checked them when it started).
+std::unique_ptr<LoadedScenario> load_scenario_for_run(const std::string& path, const std::vector<std::string>& overrides,
+                                                      bool resume = false);
 
 struct InProcessRun {
   std::filesystem::path out_dir;  // must be absent or empty

@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <string_view>
+
 #include "core/error.hpp"
 #include "core/log.hpp"
 
@@ -46,21 +49,62 @@ void declare_dem_params(ParamTable& t) {
 }
 
 namespace {
-// Pair tables may be written a-b or b-a; both orders name the same pair.
-std::string find_pair_table(const Config& cfg, const std::string& section, const std::string& a, const std::string& b) {
-  const auto names = cfg.names(section);
-  for (auto& n : names)
-    if (n == a + "-" + b || n == b + "-" + a) return section + "." + n;
+
+// The law a key of a pair table belongs to ("" when every law of its section reads it).
+const char* law_of_key(std::string_view section, std::string_view leaf) {
+  if (section == "dem.contact") {
+    if (leaf == "emod" || leaf == "kratio") return "linear";
+    if (leaf == "shear_modulus" || leaf == "poisson") return "hertz_mindlin";
+    return "";
+  }
+  if (leaf == "emod" || leaf == "kratio" || leaf == "tensile_strength" || leaf == "radius_multiplier" ||
+      leaf == "moment_factor")
+    return "parallel";
+  if (leaf == "youngs_modulus" || leaf == "poisson_ratio" || leaf == "beta1" || leaf == "beta2" || leaf == "truncation")
+    return "rotational";
   return "";
 }
+
+// A pair-table key of a law that is not the active one would be silently ignored: refused,
+// unless it holds its default (a resolved scenario.toml writes every key of every law).
+void check_law_keys(const Config& cfg) {
+  for (const char* section : {"dem.contact", "dem.bond"}) {
+    const std::string law_key = std::string(section) == "dem.contact" ? "dem.contact_law" : "dem.bond_law";
+    const std::string& active = cfg.string(law_key);
+    const std::string p = std::string(section) + ".";
+    const auto& values = cfg.values();
+    for (auto it = values.lower_bound(p); it != values.end() && it->first.compare(0, p.size(), p) == 0; ++it) {
+      const std::string& key = it->first;
+      const std::string leaf = key.substr(key.rfind('.') + 1);
+      const char* law = law_of_key(section, leaf);
+      const bool unused = active == "none" || (*law != '\0' && active != law);
+      if (!unused) continue;
+      const ParamSpec* spec = cfg.table().find(key);
+      if (spec && spec->default_value && *spec->default_value == it->second.first) continue;
+      if (active == "none")
+        cfg.fail(key, fmt::format("dem.bond_law = \"none\" installs no bonds, so this bond key would be ignored; remove "
+                                  "the [{}] table or choose a bond law (dem.bond_law = \"parallel\" or \"rotational\")",
+                                  key.substr(0, key.rfind('.'))));
+      cfg.fail(key, fmt::format("'{}' belongs to the {} law, but {} = \"{}\", which does not read it (it would be "
+                                "ignored); remove it, or set {} = \"{}\"",
+                                leaf, law, law_key, active, law_key, law));
+    }
+  }
+}
+
 }  // namespace
 
 Materials build_materials(const Config& cfg) {
+  check_law_keys(cfg);
   Materials m;
   m.group_names = cfg.names("dem.group");
   if (m.group_names.empty())
     throw InputError(fmt::format("{}: no particle group defined; add e.g. [dem.group.rock] with density = 2600",
                                  cfg.scenario_name()));
+  if (m.groups() > kMaxGroups)
+    throw InputError(fmt::format("{}: the scenario declares {} particle groups ([dem.group.NAME]); the limit is {} (every "
+                                 "pair of groups needs its own contact and bond table)",
+                                 cfg.scenario_name(), m.group_names.size(), kMaxGroups));
   for (auto& g : m.group_names) {
     if (g.find('-') != std::string::npos)
       cfg.fail("dem.group." + g + ".density", "group names may not contain '-' (it separates the two groups of a pair)");
@@ -76,23 +120,36 @@ Materials build_materials(const Config& cfg) {
   m.hertz.resize(ng * ng);
   m.parallel.resize(ng * ng);
   m.rotational.resize(ng * ng);
-  // Pair tables must name declared groups.
+  // Pair tables must name declared groups, each pair once (a-b or b-a: both name the same pair).
+  std::vector<std::string> contact_table(ng * ng), bond_table(ng * ng);
   for (const char* section : {"dem.contact", "dem.bond"}) {
+    auto& table = std::string(section) == "dem.contact" ? contact_table : bond_table;
     for (auto& n : cfg.names(section)) {
       const auto dash = n.find('-');
       const std::string a = n.substr(0, dash), b = dash == std::string::npos ? "" : n.substr(dash + 1);
-      if (dash == std::string::npos || m.group_index(a) < 0 || m.group_index(b) < 0) {
+      const int ia = m.group_index(a), ib = dash == std::string::npos ? -1 : m.group_index(b);
+      const std::string key = std::string(section) + "." + n;
+      if (ia < 0 || ib < 0) {
         std::string known;
         for (auto& g : m.group_names) known += (known.empty() ? "" : ", ") + g;
-        throw InputError(fmt::format("{}: table [{}.{}] does not name a pair of declared groups 'a-b' (groups: {})",
-                                     cfg.scenario_name(), section, n, known));
+        const std::string what = fmt::format("table [{}] does not name a pair of declared groups 'a-b' (groups: {}; "
+                                             "declare a group with [dem.group.NAME])",
+                                             key, known);
+        const auto first = cfg.values().lower_bound(key + ".");  // one of its keys, for file and line
+        if (first != cfg.values().end() && first->first.rfind(key + ".", 0) == 0) cfg.fail(first->first, what);
+        throw InputError(fmt::format("{}: {}", cfg.scenario_name(), what));
       }
+      auto& slot = table[m.pair(std::min(ia, ib), std::max(ia, ib))];
+      if (!slot.empty())
+        throw InputError(fmt::format("{}: tables [{}] and [{}] describe the same pair of groups; keep one",
+                                     cfg.scenario_name(), slot, key));
+      slot = key;
     }
   }
   for (int a = 0; a < ng; ++a) {
     for (int b = a; b < ng; ++b) {
       const std::string ga = m.group_names[a], gb = m.group_names[b];
-      const std::string ct = find_pair_table(cfg, "dem.contact", ga, gb);
+      const std::string& ct = contact_table[m.pair(a, b)];
       if (ct.empty())
         throw InputError(fmt::format("{}: contact properties of the group pair {}-{} are missing: add a table "
                                      "[dem.contact.{}-{}] (keys emod, kratio, friction, ...)",
@@ -102,7 +159,7 @@ Materials build_materials(const Config& cfg) {
       m.linear[m.pair(a, b)] = m.linear[m.pair(b, a)] = lp;
       m.hertz[m.pair(a, b)] = m.hertz[m.pair(b, a)] = hp;
       if (m.bond_law == BondLaw::None) continue;
-      const std::string bt = find_pair_table(cfg, "dem.bond", ga, gb);
+      const std::string& bt = bond_table[m.pair(a, b)];
       if (bt.empty())
         throw InputError(fmt::format("{}: bond properties of the group pair {}-{} are missing: add a table "
                                      "[dem.bond.{}-{}] (or set dem.bond_law = \"none\")",

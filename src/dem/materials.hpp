@@ -11,6 +11,11 @@
 
 namespace ff::dem {
 
+// Every pair of groups has its own contact (and bond) table, n (n + 1) / 2 of them, and the
+// pair tables below hold n^2 entries: 64 groups need 2,080 tables, far more phases than a
+// segmented rock image has. Scenarios declaring more are refused (dem::build_materials).
+inline constexpr int kMaxGroups = 64;
+
 enum class ContactLaw : std::uint8_t { Linear, HertzMindlin };
 enum class BondLaw : std::uint8_t { None, Parallel, Rotational };
 

@@ -9,6 +9,7 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "dem/dem_params.hpp"
 #include "geometry/packing.hpp"
 #include "geometry/point_in_mesh.hpp"
 #include "geometry/shapes.hpp"
@@ -65,6 +66,10 @@ namespace {
 std::vector<Region> read_regions(const Config& cfg, const Materials& mat, std::vector<int>& region_group) {
   std::vector<Region> regions;
   auto names = cfg.names("sample.region");
+  if (names.size() > kMaxRegions)
+    throw InputError(fmt::format("{}: the scenario has {} [[sample.region]] entries; the limit is {} (every particle is "
+                                 "tested against every region; merge inclusions into one STL surface)",
+                                 cfg.scenario_name(), names.size(), kMaxRegions));
   std::sort(names.begin(), names.end(), [](const std::string& a, const std::string& b) {
     return a.size() != b.size() ? a.size() < b.size() : a < b;  // [[sample.region]] order
   });
@@ -266,7 +271,84 @@ Real shrink_factor_for_stress(const DemSystem& sys, Real goal, Real volume) {
   return lo;
 }
 
+// The container and packing the sample keys ask for, checked without making the packing.
+struct SampleGeometry {
+  geom::PackingSpec spec;
+  bool cylinder = true;
+  Real width = 0, height = 0, volume = 0;
+};
+
+SampleGeometry sample_geometry(const Config& cfg, int dim) {
+  SampleGeometry g;
+  g.cylinder = cfg.string("sample.shape") == "cylinder";
+  if (dim == 2 && g.cylinder) cfg.fail("sample.shape", "a 2D sample is a rectangle: use shape = \"box\"");
+  const Real rmin = cfg.real("sample.radius_min"), rmax = cfg.real("sample.radius_max");
+  if (rmax < rmin)
+    cfg.fail("sample.radius_max", fmt::format("{} m is below sample.radius_min = {} m; radius_max must be >= radius_min",
+                                              rmax, rmin));
+  geom::PackingSpec& spec = g.spec;
+  spec.dim = dim;
+  spec.radius_min = rmin;
+  spec.radius_max = rmax;
+  spec.porosity = cfg.real("sample.porosity");
+  spec.seed = static_cast<std::uint64_t>(cfg.integer("sample.seed"));
+  const Real H = cfg.real("sample.height");
+  const Real width = g.cylinder ? cfg.real("sample.diameter") : cfg.real("sample.width");
+  if (width < 4 * rmax || H < 4 * rmax)
+    cfg.fail(width < 4 * rmax ? (g.cylinder ? "sample.diameter" : "sample.width") : "sample.height",
+             fmt::format("the sample must be at least 4 particle radii wide and high (radius_max = {} m)", rmax));
+  if (g.cylinder) {
+    spec.container = geom::PackingSpec::Container::Cylinder;
+    spec.cyl_radius = 0.5 * width;
+    spec.cyl_height = H;
+    g.volume = kPi * 0.25 * width * width * H;
+  } else {
+    if (dim == 3 && cfg.real("sample.depth") < 4 * rmax)
+      cfg.fail("sample.depth", fmt::format("the sample must be at least 4 particle radii deep (radius_max = {} m)", rmax));
+    spec.container = geom::PackingSpec::Container::Box;
+    spec.box_lo = Vec3::Zero();
+    spec.box_hi = dim == 3 ? Vec3(width, cfg.real("sample.depth"), H) : Vec3(width, H, 0);
+    g.volume = dim == 3 ? width * cfg.real("sample.depth") * H : width * H;
+  }
+  g.width = width;
+  g.height = H;
+  const Real min_por = dim == 3 ? geom::kMinPorosity3D : geom::kMinPorosity2D;
+  if (spec.porosity < min_por)
+    cfg.fail("sample.porosity", fmt::format("{} is denser than a random packing can be made here; use >= {}", spec.porosity, min_por));
+  try {
+    geom::check_packing_spec(spec);
+  } catch (const InputError& e) {
+    cfg.fail("sample.radius_min", e.what());
+  }
+  return g;
+}
+
+// Group of the particles outside every region and window. Group tables come back from TOML in
+// name order, not file order, so "the first group" would be a surprise (inclusion before
+// matrix): with several groups the user must name it.
+int default_group(const Config& cfg, const Materials& mat) {
+  const std::string& name = cfg.string("sample.default_group");
+  if (name.empty() && mat.groups() > 1)
+    cfg.fail("sample.default_group", fmt::format("{} groups are declared; name the one that fills the sample (e.g. \"{}\")",
+                                                 mat.groups(), mat.group_names[0]));
+  if (name.empty()) return 0;
+  const int g = mat.group_index(name);
+  if (g < 0) cfg.fail("sample.default_group", fmt::format("'{}' is not a declared group ({}); declare it with [dem.group.{}]",
+                                                          name, group_list(mat), name));
+  return g;
+}
+
 }  // namespace
+
+void validate_dem_sample(const Config& cfg) {
+  const DemSettings settings = build_settings(cfg);
+  const Materials mat = build_materials(cfg);
+  sample_geometry(cfg, settings.dim);
+  read_voxel_groups(cfg, mat);
+  std::vector<int> region_group;
+  read_regions(cfg, mat, region_group);
+  default_group(cfg, mat);
+}
 
 SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -274,37 +356,11 @@ SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
   const int dim = sys.settings.dim;
   info.dim = dim;
   info.axis = dim == 3 ? 2 : 1;
-  const std::string shape = cfg.string("sample.shape");
-  info.cylinder = shape == "cylinder";
-  if (dim == 2 && info.cylinder) cfg.fail("sample.shape", "a 2D sample is a rectangle: use shape = \"box\"");
-  const Real rmin = cfg.real("sample.radius_min"), rmax = cfg.real("sample.radius_max");
-  if (rmax < rmin) cfg.fail("sample.radius_max", fmt::format("must be >= sample.radius_min ({} m)", rmin));
-
-  geom::PackingSpec spec;
-  spec.dim = dim;
-  spec.radius_min = rmin;
-  spec.radius_max = rmax;
-  spec.porosity = cfg.real("sample.porosity");
-  spec.seed = static_cast<std::uint64_t>(cfg.integer("sample.seed"));
-  const Real H = cfg.real("sample.height");
-  Real width = info.cylinder ? cfg.real("sample.diameter") : cfg.real("sample.width");
-  if (width < 4 * rmax || H < 4 * rmax)
-    cfg.fail(info.cylinder ? "sample.diameter" : "sample.width",
-             fmt::format("the sample must be at least 4 particle radii wide and high (radius_max = {} m)", rmax));
-  if (info.cylinder) {
-    spec.container = geom::PackingSpec::Container::Cylinder;
-    spec.cyl_radius = 0.5 * width;
-    spec.cyl_height = H;
-    info.volume = kPi * 0.25 * width * width * H;
-  } else {
-    spec.container = geom::PackingSpec::Container::Box;
-    spec.box_lo = Vec3::Zero();
-    spec.box_hi = dim == 3 ? Vec3(width, cfg.real("sample.depth"), H) : Vec3(width, H, 0);
-    info.volume = dim == 3 ? width * cfg.real("sample.depth") * H : width * H;
-  }
-  const Real min_por = dim == 3 ? geom::kMinPorosity3D : geom::kMinPorosity2D;
-  if (spec.porosity < min_por)
-    cfg.fail("sample.porosity", fmt::format("{} is denser than a random packing can be made here; use >= {}", spec.porosity, min_por));
+  const SampleGeometry geo = sample_geometry(cfg, dim);
+  const geom::PackingSpec& spec = geo.spec;
+  info.cylinder = geo.cylinder;
+  info.volume = geo.volume;
+  const Real H = geo.height, width = geo.width;
   const VoxelGroups voxels = read_voxel_groups(cfg, sys.materials);  // before the packing: bad input fails fast
   geom::Packing pk;
   try {
@@ -317,17 +373,7 @@ SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
   // Groups: default, then regions (the last containing region wins), then voxel windows.
   std::vector<int> region_group;
   const auto regions = read_regions(cfg, sys.materials, region_group);
-  int default_group = 0;
-  // Group tables come back from TOML in name order, not file order, so "the first group" would be
-  // a surprise (inclusion before matrix): with several groups the user must name it.
-  if (cfg.string("sample.default_group").empty() && sys.materials.groups() > 1)
-    cfg.fail("sample.default_group", fmt::format("{} groups are declared; name the one that fills the sample (e.g. \"{}\")",
-                                                 sys.materials.groups(), sys.materials.group_names[0]));
-  if (!cfg.string("sample.default_group").empty()) {
-    default_group = sys.materials.group_index(cfg.string("sample.default_group"));
-    if (default_group < 0) cfg.fail("sample.default_group", "not a declared group ([dem.group.NAME])");
-  }
-  auto groups = geom::assign_groups(pk.position, regions, region_group, default_group);
+  auto groups = geom::assign_groups(pk.position, regions, region_group, default_group(cfg, sys.materials));
   constexpr int kUnlabelled = -2;
   if (!voxels.empty()) {
     const auto label = geom::label_points(voxels.image, pk.position, voxels.windows, kUnlabelled);

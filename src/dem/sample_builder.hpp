@@ -32,6 +32,14 @@ struct SampleInfo {
 
 void declare_sample_params(ParamTable& t);
 
+// Regions are tested against every particle; more are refused (read at most once per run).
+inline constexpr std::size_t kMaxRegions = 10000;
+
+// Every check of the [dem] and [sample] keys that build_sample() and the materials make before
+// packing: groups and pair tables, laws, radii and sizes, porosity, regions (STL files read),
+// the voxel stack (read) and the default group. The `validate` of the DEM drivers.
+void validate_dem_sample(const Config& cfg);
+
 // Label of the grey-value window named "pore": particles whose centre lies in such a voxel are removed.
 inline constexpr int kPoreLabel = -1;
 

@@ -42,6 +42,11 @@ struct Driver {
   std::string_view summary;
   void (*declare)(ParamTable&);
   RunStatus (*run)(const Config&, const RunOptions&);
+  // Every cross-parameter check that needs no sample or lattice (pairs of keys, groups named
+  // but not declared, files the scenario names, LBM stability limits...), throwing InputError
+  // as run() would. Called for `check`, `run`, sweeps and calibration before anything is
+  // written, so that `check` refuses what `run` refuses; run() calls the same functions.
+  void (*validate)(const Config&) = nullptr;
 };
 
 std::span<const Driver> all_drivers();

@@ -20,7 +20,11 @@ using packing_detail::State;
 using packing_detail::VerletList;
 using packing_detail::Walls;
 
-void validate(const PackingSpec& p) {
+Real particle_measure(int dim, Real r) { return dim == 3 ? 4.0 / 3.0 * kPi * r * r * r : kPi * r * r; }
+
+}  // namespace
+
+void check_packing_spec(const PackingSpec& p) {
   auto bad = [](const std::string& what) { throw InputError("packing: " + what); };
   if (p.dim != 2 && p.dim != 3) bad(fmt::format("dim = {} must be 2 or 3", p.dim));
   if (p.dim == 2 && p.container != PackingSpec::Container::Box) {
@@ -54,9 +58,19 @@ void validate(const PackingSpec& p) {
   if (!(p.start_radius_scale > 0 && p.start_radius_scale <= 1)) {
     bad(fmt::format("start_radius_scale {} must be in (0, 1]", p.start_radius_scale));
   }
+  const Real container = p.container == PackingSpec::Container::Cylinder
+                             ? kPi * p.cyl_radius * p.cyl_radius * p.cyl_height
+                             : (p.box_hi - p.box_lo).head(p.dim).prod();
+  const Real expected = (1 - p.porosity) * container / particle_measure(p.dim, 0.5 * (p.radius_min + p.radius_max));
+  if (expected > 5e7) {
+    throw InputError(fmt::format("packing: about {:.3g} particles requested; the limit is 5e7 (use larger radii or a "
+                                 "smaller container)",
+                                 expected));
+  }
 }
 
-Real particle_measure(int dim, Real r) { return dim == 3 ? 4.0 / 3.0 * kPi * r * r * r : kPi * r * r; }
+namespace {
+
 
 // Largest overlap / min(r_i, r_j) over all pairs, from a fresh list without skin.
 Real max_overlap_ratio(const Walls& walls, std::vector<Vec3>& x, std::vector<Real>& r) {
@@ -82,7 +96,7 @@ Real max_overlap_ratio(const Walls& walls, std::vector<Vec3>& x, std::vector<Rea
 }  // namespace
 
 Packing dense_random_packing(const PackingSpec& spec) {
-  validate(spec);
+  check_packing_spec(spec);
   Walls walls;
   walls.dim = spec.dim;
   walls.cylinder = spec.container == PackingSpec::Container::Cylinder;
@@ -92,12 +106,6 @@ Packing dense_random_packing(const PackingSpec& spec) {
   walls.hi = spec.box_hi;
   const Real container = walls.measure();
   const Real target_solid = (1 - spec.porosity) * container;
-  const Real expected = target_solid / particle_measure(spec.dim, 0.5 * (spec.radius_min + spec.radius_max));
-  if (expected > 5e7) {
-    throw InputError(fmt::format("packing: about {:.3g} particles requested; the limit is 5e7 (use larger radii or a "
-                                 "smaller container)",
-                                 expected));
-  }
 
   // 1. Radii: draw until the solid volume is closest to the target.
   Rng rng(spec.seed);

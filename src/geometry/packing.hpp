@@ -59,6 +59,11 @@ struct PackingSpec {
   Real start_radius_scale = 0.9;   // radii start at this fraction of their final size
 };
 
+// Throws ff::InputError for a spec dense_random_packing() refuses (radii, porosity below the
+// achievable minimum, a container smaller than two diameters, more than 5e7 particles),
+// without making the packing.
+void check_packing_spec(const PackingSpec& spec);
+
 struct Packing {
   std::vector<Vec3> position;  // [m]; z = 0 in 2D
   std::vector<Real> radius;    // [m]

@@ -6,6 +6,8 @@
 #include <array>
 #include <cmath>
 #include <sstream>
+#include <string_view>
+#include <unordered_set>
 
 #include "core/error.hpp"
 
@@ -108,28 +110,35 @@ std::string ParamSpec::allowed() const {
   return a;
 }
 
-static std::vector<std::string> split_dots(const std::string& k) {
-  std::vector<std::string> out;
-  std::string cur;
-  for (char c : k) {
-    if (c == '.') { out.push_back(cur); cur.clear(); } else cur += c;
-  }
-  out.push_back(cur);
-  return out;
-}
-
+// Segment-wise comparison without allocating (find() runs once per key of a scenario).
 bool ParamSpec::matches(const std::string& k) const {
   if (key.find('*') == std::string::npos) return key == k;
-  const auto a = split_dots(key), b = split_dots(k);
-  if (a.size() != b.size()) return false;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    if (a[i] != "*" && a[i] != b[i]) return false;
-  return true;
+  std::size_t i = 0, j = 0;  // positions in key and k
+  for (;;) {
+    const std::size_t ie = std::min(key.find('.', i), key.size()), je = std::min(k.find('.', j), k.size());
+    const std::string_view a(key.data() + i, ie - i), b(k.data() + j, je - j);
+    if (a != "*" && a != b) return false;
+    const bool a_end = ie == key.size(), b_end = je == k.size();
+    if (a_end || b_end) return a_end && b_end;
+    i = ie + 1;
+    j = je + 1;
+  }
+}
+
+static std::string last_segment(const std::string& k) {
+  const auto dot = k.rfind('.');
+  return dot == std::string::npos ? k : k.substr(dot + 1);
 }
 
 ParamSpec& ParamTable::add(ParamSpec s) {
-  for (auto& e : specs_)
-    if (e.key == s.key) throw Error("internal: parameter '" + s.key + "' declared twice");
+  if (exact_.count(s.key)) throw Error("internal: parameter '" + s.key + "' declared twice");
+  const std::size_t at = specs_.size();
+  exact_.emplace(s.key, at);
+  if (s.key.find('*') != std::string::npos) {
+    const std::string leaf = last_segment(s.key);
+    if (leaf == "*") wild_any_leaf_.push_back(at);
+    else wild_by_leaf_[leaf].push_back(at);
+  }
   specs_.push_back(std::move(s));
   return specs_.back();
 }
@@ -166,11 +175,23 @@ ParamSpec& ParamTable::string_list(std::string key, std::vector<std::string> def
 }
 
 const ParamSpec* ParamTable::find(const std::string& key) const {
-  for (auto& s : specs_)  // exact names win over wildcards
-    if (s.key == key) return &s;
-  for (auto& s : specs_)
-    if (s.matches(key)) return &s;
-  return nullptr;
+  if (auto it = exact_.find(key); it != exact_.end()) return &specs_[it->second];  // exact names win over wildcards
+  // The first wildcard in declaration order that matches.
+  std::size_t best = specs_.size();
+  if (auto it = wild_by_leaf_.find(last_segment(key)); it != wild_by_leaf_.end())
+    for (std::size_t i : it->second)
+      if (specs_[i].matches(key)) {
+        best = i;
+        break;
+      }
+  for (std::size_t i : wild_any_leaf_) {
+    if (i >= best) break;
+    if (specs_[i].matches(key)) {
+      best = i;
+      break;
+    }
+  }
+  return best < specs_.size() ? &specs_[best] : nullptr;
 }
 
 std::string ParamTable::markdown() const {
@@ -220,13 +241,13 @@ const std::vector<std::string>& Config::string_list(const std::string& k) const 
 bool Config::has(const std::string& key) const { return values_.count(key) > 0; }
 
 std::vector<std::string> Config::names(const std::string& prefix) const {
+  // Keys with the prefix are contiguous in the sorted map; a set keeps the scan linear.
   std::vector<std::string> out;
+  std::unordered_set<std::string> seen;
   const std::string p = prefix + ".";
-  for (auto& [k, v] : values_) {
-    if (k.rfind(p, 0) != 0) continue;
-    std::string rest = k.substr(p.size());
-    std::string name = rest.substr(0, rest.find('.'));
-    if (std::find(out.begin(), out.end(), name) == out.end()) out.push_back(name);
+  for (auto it = values_.lower_bound(p); it != values_.end() && it->first.compare(0, p.size(), p) == 0; ++it) {
+    std::string name = it->first.substr(p.size(), it->first.find('.', p.size()) - p.size());
+    if (seen.insert(name).second) out.push_back(std::move(name));
   }
   return out;
 }
@@ -248,25 +269,32 @@ void Config::fail(const std::string& key, const std::string& what) const {
 void Config::set(const std::string& key, ParamValue v, ParamOrigin o) { values_[key] = {std::move(v), std::move(o)}; }
 
 std::vector<std::pair<std::string, const ParamSpec*>> Config::expanded_keys() const {
+  // One pass sorts the explicit keys by their spec (values_ is sorted, so each list is too);
+  // the names at a wildcard level are listed once per prefix. Linear in the number of keys.
+  std::unordered_map<const ParamSpec*, std::vector<std::string>> explicit_keys;
+  for (auto& [k, v] : values_)
+    if (const ParamSpec* s = table_->find(k)) explicit_keys[s].push_back(k);
+  std::unordered_map<std::string, std::vector<std::string>> names_at;
   std::vector<std::pair<std::string, const ParamSpec*>> out;
   for (auto& s : table_->specs()) {
     if (s.key.find('*') == std::string::npos) { out.emplace_back(s.key, &s); continue; }
-    // Expand the wildcard with the names that appear in the explicit values.
-    std::vector<std::string> done;
-    for (auto& [k, v] : values_)
-      if (s.matches(k) && std::find(done.begin(), done.end(), k) == done.end()) done.push_back(k);
+    std::vector<std::string> keys;
+    if (auto it = explicit_keys.find(&s); it != explicit_keys.end()) keys = it->second;
+    const std::size_t n_explicit = keys.size();
     // Also instantiate defaults for names present at the wildcard's level.
     const auto pos = s.key.find('*');
     const std::string prefix = s.key.substr(0, pos == 0 ? 0 : pos - 1);
     const std::string suffix = s.key.substr(pos + 1);
     if (suffix.find('*') == std::string::npos) {
-      for (auto& name : names(prefix)) {
+      auto [it, fresh] = names_at.try_emplace(prefix);
+      if (fresh) it->second = names(prefix);
+      for (auto& name : it->second) {
         std::string k = prefix + "." + name + suffix;
-        if (std::find(done.begin(), done.end(), k) == done.end() && table_->find(k) == &s) done.push_back(k);
+        if (!values_.count(k) && table_->find(k) == &s) keys.push_back(std::move(k));
       }
     }
-    std::sort(done.begin(), done.end());
-    for (auto& k : done) out.emplace_back(k, &s);
+    if (keys.size() > n_explicit) std::sort(keys.begin(), keys.end());
+    for (auto& k : keys) out.emplace_back(std::move(k), &s);
   }
   return out;
 }

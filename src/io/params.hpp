@@ -7,6 +7,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <unordered_map>
 #include <variant>
 #include <vector>
 
@@ -65,6 +66,12 @@ class ParamTable {
  private:
   ParamSpec& add(ParamSpec s);
   std::vector<ParamSpec> specs_;
+  // find() is called once per key of a scenario (and per read): indexes keep it O(1) for
+  // exact keys and a few candidates for wildcards (those ending in the same segment), so a
+  // large file costs linear time. Positions in specs_, in declaration order.
+  std::unordered_map<std::string, std::size_t> exact_;
+  std::unordered_map<std::string, std::vector<std::size_t>> wild_by_leaf_;
+  std::vector<std::size_t> wild_any_leaf_;  // wildcards whose last segment is "*"
 };
 
 // Where a resolved value came from.

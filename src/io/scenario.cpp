@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <toml++/toml.h>
@@ -14,6 +15,10 @@
 namespace ff {
 
 std::string read_text_file(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))  // an ifstream opens a folder and reads it as empty
+    throw InputError(fmt::format("'{}' is a folder, not a scenario file; give a .toml file (e.g. examples/ucs_default.toml)",
+                                 path));
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(fmt::format("cannot open scenario file '{}': no such file or not readable", path));
   std::ostringstream ss;
@@ -53,7 +58,8 @@ std::string sanitize(std::string_view text, const std::string& source) {
 // given ASCII: non-ASCII characters in basic strings become \uXXXX escapes, literal strings
 // become equivalent basic strings, comments lose theirs, and anywhere else (never valid TOML
 // 1.0) they are an error. Newlines are kept, so line numbers in messages stay right.
-std::string to_ascii_toml(std::string_view t, const std::string& source) {
+// `keys` counts the '=' outside strings and comments: one per key = value pair.
+std::string to_ascii_toml(std::string_view t, const std::string& source, std::size_t& keys) {
   enum State { Normal, Comment, Basic, Literal, MultiBasic, MultiLiteral } st = Normal;
   std::string o;
   o.reserve(t.size() + t.size() / 8);
@@ -85,6 +91,7 @@ std::string to_ascii_toml(std::string_view t, const std::string& source) {
     switch (st) {
       case Normal:
         if (ch == '#') st = Comment;
+        if (ch == '=') ++keys;
         if (ch == '"' || ch == '\'') {
           const bool multi = run(i, ch) >= 3;
           st = ch == '"' ? (multi ? MultiBasic : Basic) : (multi ? MultiLiteral : Literal);
@@ -284,7 +291,13 @@ std::string suggestion(const ParamTable& t, const std::string& key) {
 }  // namespace
 
 std::vector<RawEntry> parse_toml_flat(std::string_view text, const std::string& source) {
-  const std::string clean = to_ascii_toml(sanitize(text, source), source);
+  std::size_t keys = 0;
+  const std::string clean = to_ascii_toml(sanitize(text, source), source, keys);
+  // Checked before toml++ builds its tree (the memory and time of a huge file).
+  if (keys > kMaxScenarioKeys)
+    throw InputError(fmt::format("{}: the scenario has {} keys; the limit is {} (a scenario with every group pair and "
+                                 "region allowed has fewer)",
+                                 source, keys, kMaxScenarioKeys));
   toml::table doc;
   try {
     doc = toml::parse(clean, std::string_view(source));
@@ -298,7 +311,11 @@ std::vector<RawEntry> parse_toml_flat(std::string_view text, const std::string& 
 }
 
 std::string peek_driver(std::string_view text, const std::string& source) {
-  for (auto& e : parse_toml_flat(text, source))
+  return peek_driver(parse_toml_flat(text, source), source);
+}
+
+std::string peek_driver(const std::vector<RawEntry>& entries, const std::string& source) {
+  for (auto& e : entries)
     if (e.key == "driver") {
       if (auto s = std::get_if<std::string>(&e.value)) return *s;
       throw InputError(fmt::format("{}:{}: key 'driver' must be a string naming the driver", source, e.line));
@@ -320,7 +337,7 @@ Config build_config(const ParamTable& table, const std::string& source, const st
   for (auto& o : overrides) {
     const auto eq = o.find('=');
     if (eq == std::string::npos || eq == 0)
-      throw InputError(fmt::format("--set '{}': expected key=value, e.g. --set dem.damping=0.5", o));
+      throw InputError(fmt::format("--set '{}': expected key=value, e.g. --set dem.local_damping=0.5", o));
     std::string key = o.substr(0, eq), val = o.substr(eq + 1);
     while (!key.empty() && key.back() == ' ') key.pop_back();
     if (key.empty() || key.front() == '.' || key.back() == '.' || key.find("..") != std::string::npos)
@@ -335,7 +352,7 @@ Config build_config(const ParamTable& table, const std::string& source, const st
     // Exactly one plain value: `{}` gives no entry, `{a=1}` gives "v.a", "1\nw=2" two entries.
     if (parsed.size() != 1 || parsed.front().key != "v")
       throw InputError(fmt::format("--set '{}': the value must be one number, string, boolean or list, "
-                                   "e.g. --set dem.damping=0.5 or --set load.pressures=[1e6,2e6]", o));
+                                   "e.g. --set dem.local_damping=0.5 or --set dem.gravity=[0,0,-9.81]", o));
     RawEntry e = parsed.front();
     e.key = key;
     e.line = 0;
@@ -350,8 +367,20 @@ Config build_config(const ParamTable& table, const std::string& source, const st
 
 Config load_scenario(const ParamTable& table, const std::string& path, std::string_view text,
                      const std::vector<std::string>& overrides) {
+  return load_scenario(table, path, parse_toml_flat(text, path.empty() ? "<built-in default scenario>" : path),
+                       overrides);
+}
+
+Config load_scenario(const ParamTable& table, const std::string& path, const std::vector<RawEntry>& entries,
+                     const std::vector<std::string>& overrides) {
   const std::string source = path.empty() ? "<built-in default scenario>" : path;
-  return build_config(table, source, parse_toml_flat(text, source), overrides);
+  Config cfg = build_config(table, source, entries, overrides);
+  if (!path.empty() && entries.empty())  // after build_config, so that a bad --set is reported as such
+    throw InputError(fmt::format("{}: the scenario file sets no key (it is empty or holds only comments); write at "
+                                 "least driver = \"NAME\" and the keys to change (`fracflow drivers` lists the drivers), "
+                                 "or run `fracflow run` without a file for the built-in default scenario",
+                                 source));
+  return cfg;
 }
 
 }  // namespace ff

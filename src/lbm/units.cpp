@@ -36,8 +36,11 @@ Units Units::from_time_step(double dx, double dt, double nu, double rho) {
   return u;
 }
 
-StabilityCheck Units::check(double u, int resolution, const std::string& resolution_key, bool tau_mode) const {
+StabilityCheck Units::check(double u, int resolution, const std::string& resolution_key, bool tau_mode,
+                            const std::string& collision) const {
   StabilityCheck r;
+  const bool bgk = collision == "bgk";
+  const std::string model = bgk ? "BGK (lbm.collision = \"bgk\")" : "TRT (lbm.collision = \"trt\")";
   const double ulb = to_lattice_velocity(std::abs(u));
   const double ma = ulb / kCs;
   // Fixes for the Mach number: with tau fixed u_lb scales as 1/N; with dt fixed as dt.
@@ -46,17 +49,16 @@ StabilityCheck Units::check(double u, int resolution, const std::string& resolut
     const int n_needed = int(std::ceil(resolution * f));
     if (tau_mode) {
       const double tau_needed = 0.5 + (tau_ - 0.5) / f;
-      return fmt::format("raise {} to at least {} (same tau), or lower lbm.tau to {:.4g}", resolution_key, n_needed,
-                         tau_needed);
+      return fmt::format("set {} = {} or more (same lbm.tau), or lbm.tau = {:.4g}", resolution_key, n_needed, tau_needed);
     }
-    return fmt::format("lower lbm.time_step to at most {:.4g} s (tau becomes {:.4g}), or raise {} to at least {} with "
+    return fmt::format("set lbm.time_step = {:.4g} s or less (tau becomes {:.4g}), or {} = {} or more with "
                        "lbm.time_step scaled by (old/new resolution)^2",
                        dt_ / f, 0.5 + (tau_ - 0.5) / f, resolution_key, n_needed);
   };
   if (!(tau_ > 0.5)) {
     const double dt_needed = (0.55 - 0.5) * dx_ * dx_ / (3 * nu_);
-    r.error = fmt::format("relaxation time tau = {:.6g} must be above 1/2 (nu_lb = {:.3g} <= 0): raise lbm.time_step to "
-                          "at least {:.4g} s (tau = 0.55) or lower {} (coarser cells)",
+    r.error = fmt::format("relaxation time tau = {:.6g} must be above 1/2 (nu_lb = {:.3g} <= 0): set lbm.time_step = "
+                          "{:.4g} s or more (tau = 0.55), or lower {} (coarser cells)",
                           tau_, nu_lb(), dt_needed, resolution_key);
     return r;
   }
@@ -73,20 +75,25 @@ StabilityCheck Units::check(double u, int resolution, const std::string& resolut
     // Larger tau at fixed Mach needs more cells: u_lb = Re_cell (tau - 1/2)/3 with Re_cell ~ 1/N.
     const double tau_target = 0.5 + kTauWarn * 5;
     const double f = (tau_target - 0.5) / (tau_ - 0.5);
-    std::string fix = tau_mode ? fmt::format("raise lbm.tau to {:.3g}", tau_target)
-                               : fmt::format("raise lbm.time_step to {:.4g} s (tau = {:.3g})", dt_ * f, tau_target);
-    r.warnings.push_back(fmt::format("relaxation time tau = {:.5g} is within {} of 1/2: BGK becomes unstable and walls "
-                                     "inaccurate; {} and raise {} to at least {} to keep the Mach number",
-                                     tau_, kTauWarn, fix, resolution_key, int(std::ceil(resolution * f))));
+    std::string fix = tau_mode ? fmt::format("set lbm.tau = {:.3g} (allowed: above 0.5)", tau_target)
+                               : fmt::format("set lbm.time_step = {:.4g} s (tau = {:.3g})", dt_ * f, tau_target);
+    const std::string risk = bgk ? "BGK is at its stability limit there and its walls are inaccurate (TRT, "
+                                   "lbm.collision = \"trt\", tolerates it better)"
+                                 : "TRT stays stable only while the flow is well resolved, and the viscosity it carries "
+                                   "is close to zero";
+    r.warnings.push_back(fmt::format("relaxation time tau = {:.5g} is within {} of 1/2 with the {} collision: {}; {} "
+                                     "and {} = {} or more to keep the Mach number",
+                                     tau_, kTauWarn, model, risk, fix, resolution_key, int(std::ceil(resolution * f))));
   }
   if (tau_ > kTauLarge) {
     const double tau_target = 2.0, f = (tau_target - 0.5) / (tau_ - 0.5);
-    std::string fix = tau_mode ? fmt::format("lower lbm.tau to {}", tau_target)
-                               : fmt::format("lower lbm.time_step to {:.4g} s (tau = {})", dt_ * f, tau_target);
-    r.warnings.push_back(fmt::format("relaxation time tau = {:.4g} is large: BGK walls slip (an error growing as "
-                                     "tau^2) and open-face corners can become unstable with TRT; {} (the Mach number "
-                                     "only drops)",
-                                     tau_, fix));
+    std::string fix = tau_mode ? fmt::format("set lbm.tau = {}", tau_target)
+                               : fmt::format("set lbm.time_step = {:.4g} s (tau = {})", dt_ * f, tau_target);
+    const std::string risk = bgk ? "BGK walls slip (an error growing as tau^2)"
+                                 : "open-face corners can become unstable with TRT";
+    r.warnings.push_back(fmt::format("relaxation time tau = {:.4g} is large with the {} collision: {}; {} (the Mach "
+                                     "number only drops)",
+                                     tau_, model, risk, fix));
   }
   return r;
 }

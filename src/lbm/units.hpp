@@ -52,8 +52,10 @@ class Units {
   // tau > 1/2 needed, tau - 1/2 >= 0.01 advisable; Ma = u_lb / c_s below 0.1 advisable, above
   // 0.3 the compressibility error is unacceptable). `resolution` is the number of cells across
   // the characteristic length, named `resolution_key` in the scenario; `tau_mode` says whether
-  // the scenario fixed tau (else the time step). Each message names a value that fixes it.
-  StabilityCheck check(double u, int resolution, const std::string& resolution_key, bool tau_mode) const;
+  // the scenario fixed tau (else the time step); `collision` is lbm.collision ("trt" or "bgk"),
+  // named in the messages, whose limits differ. Each message names a key and a value that fixes it.
+  StabilityCheck check(double u, int resolution, const std::string& resolution_key, bool tau_mode,
+                       const std::string& collision) const;
 
   // The table printed at the start of a run.
   std::string describe(int dim) const;

@@ -157,6 +157,11 @@ class CavityCase : public FlowCase {
   lbm::Units units_;
 };
 
+void validate(const Config& cfg) {
+  CavityCase c(cfg);  // its constructor checks the geometry keys
+  validate_flow(cfg, c);
+}
+
 RunStatus run(const Config& cfg, const RunOptions& opt) {
   CavityCase c(cfg);
   return run_flow(cfg, opt, c, "flow/cavity");
@@ -165,7 +170,8 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
 }  // namespace
 
 Driver flow_cavity_driver() {
-  return Driver{"flow/cavity", "LBM lid-driven cavity against Ghia, Ghia & Shin (1982) ([S003] 3.2)", declare, run};
+  return Driver{"flow/cavity", "LBM lid-driven cavity against Ghia, Ghia & Shin (1982) ([S003] 3.2)", declare, run,
+                validate};
 }
 
 }  // namespace ff::drivers

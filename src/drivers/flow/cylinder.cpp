@@ -75,7 +75,16 @@ class CylinderCase : public FlowCase {
     if (xc_ - D_ / 2 <= 0 || xc_ + D_ / 2 >= len_)
       cfg.fail("cylinder.x", "the cylinder must lie wholly between the inlet and the outlet");
     if (yc_ - D_ / 2 <= 0 || yc_ + D_ / 2 >= H_) cfg.fail("cylinder.y", "the cylinder must not touch the sides of the channel");
+    if (!image_.empty()) {  // read here, so that `fracflow check` finds a missing or bad file too
+      try {
+        obstacles_ = lbm::read_pgm(image_);
+      } catch (const InputError& e) {
+        cfg.fail("obstacles.image", e.what());
+      }
+    }
   }
+
+
 
   double cell_size() const override { return D_ / n_; }
   int resolution() const override { return n_; }
@@ -118,7 +127,7 @@ class CylinderCase : public FlowCase {
       DomainSpec::Object img;
       img.name = "image obstacles";
       img.center = c;
-      img.cells = lbm::solid_cells(lbm::read_pgm(image_), d.nx, d.ny, threshold_);
+      img.cells = lbm::solid_cells(obstacles_, d.nx, d.ny, threshold_);
       d.objects.push_back(img);
     }
     const double kick = kick_ * u.to_lattice_velocity(u_ref());
@@ -205,10 +214,16 @@ class CylinderCase : public FlowCase {
   int n_;
   bool parabolic_, inlet_bb_, periodic_;
   std::string image_;
+  lbm::GreyImage obstacles_;  // of image_, when set
   int threshold_;
   lbm::WallScheme scheme_ = lbm::WallScheme::Bouzidi;
   lbm::Units units_;
 };
+
+void validate(const Config& cfg) {
+  CylinderCase c(cfg);  // its constructor checks the geometry keys
+  validate_flow(cfg, c);
+}
 
 RunStatus run(const Config& cfg, const RunOptions& opt) {
   CylinderCase c(cfg);
@@ -218,7 +233,8 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
 }  // namespace
 
 Driver flow_cylinder_driver() {
-  return Driver{"flow/cylinder", "LBM cylinder between plates: drag, lift, Strouhal number ([S003] 3.3)", declare, run};
+  return Driver{"flow/cylinder", "LBM cylinder between plates: drag, lift, Strouhal number ([S003] 3.3)", declare, run,
+                validate};
 }
 
 }  // namespace ff::drivers

@@ -80,4 +80,9 @@ class FlowCase {
   virtual std::string progress_text(const std::vector<double>& row) const { return {}; }
 };
 
+// Every check of a flow scenario that needs no lattice: lbm.depth_cells, lbm.tau against
+// lbm.time_step, and the Mach and relaxation-time limits (lbm::Units::check). Called by each
+// flow driver's validate() and by run_flow(). Throws InputError naming the key.
+void validate_flow(const Config& cfg, const FlowCase& fc);
+
 }  // namespace ff::drivers

@@ -243,7 +243,8 @@ RunStatus Runner<L, T>::run() {
   const auto wall_start = std::chrono::steady_clock::now();
   const bool tau_mode = !(cfg_.real("lbm.time_step") > 0);
   {
-    const auto chk = units_.check(fc_.characteristic_speed(), fc_.resolution(), fc_.resolution_key(), tau_mode);
+    const auto chk = units_.check(fc_.characteristic_speed(), fc_.resolution(), fc_.resolution_key(), tau_mode,
+                                  cfg_.string("lbm.collision"));
     if (!chk.error.empty()) cfg_.fail(tau_mode ? "lbm.tau" : "lbm.time_step", chk.error);
     build();
     log::info("{}", units_.describe(L::D));
@@ -418,8 +419,7 @@ RunStatus run_typed(const Config& cfg, const RunOptions& opt, FlowCase& fc, std:
 RunStatus run_flow(const Config& cfg, const RunOptions& opt, FlowCase& fc, std::string_view driver) {
   const bool d3 = cfg.string("lbm.lattice") == "D3Q19";
   const bool dbl = cfg.string("lbm.precision") == "double";
-  if (!d3 && cfg.has("lbm.depth_cells") && cfg.integer("lbm.depth_cells") != 1)
-    cfg.fail("lbm.depth_cells", "only D3Q19 has a depth; set lbm.lattice = \"D3Q19\" or remove lbm.depth_cells");
+  validate_flow(cfg, fc);  // the checks `fracflow check` makes too
   if (d3) return dbl ? run_typed<lbm::D3Q19, double>(cfg, opt, fc, driver) : run_typed<lbm::D3Q19, float>(cfg, opt, fc, driver);
   return dbl ? run_typed<lbm::D2Q9, double>(cfg, opt, fc, driver) : run_typed<lbm::D2Q9, float>(cfg, opt, fc, driver);
 }

@@ -159,6 +159,11 @@ class PoiseuilleCase : public FlowCase {
   lbm::Units units_;
 };
 
+void validate(const Config& cfg) {
+  PoiseuilleCase c(cfg);  // its constructor checks the geometry keys
+  validate_flow(cfg, c);
+}
+
 RunStatus run(const Config& cfg, const RunOptions& opt) {
   PoiseuilleCase c(cfg);
   return run_flow(cfg, opt, c, "flow/poiseuille");
@@ -168,7 +173,7 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
 
 Driver flow_poiseuille_driver() {
   return Driver{"flow/poiseuille", "LBM channel flow between plates against the analytic profile ([S003] 3.1)", declare,
-                run};
+                run, validate};
 }
 
 }  // namespace ff::drivers

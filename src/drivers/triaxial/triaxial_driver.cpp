@@ -250,6 +250,28 @@ void make_plots(const fs::path& out, const Config& cfg) {
   plot_series(jobs);  // one python process for all three
 }
 
+// The triaxial test's own checks that need no sample (run() and validate() both call it).
+void check_triaxial_keys(const Config& cfg) {
+  if (cfg.integer("dem.dim") != 3) cfg.fail("dem.dim", "a triaxial test needs a 3D cylinder sample (dim = 3)");
+  if (cfg.string("sample.shape") != "cylinder") cfg.fail("sample.shape", "a triaxial test needs shape = \"cylinder\"");
+  membrane_friction(cfg);
+  if (cfg.string("triaxial.lateral") != "particle_membrane") return;
+  if (cfg.boolean("particle_membrane.bonded") && cfg.string("dem.bond_law") == "none")
+    cfg.fail("particle_membrane.bonded", "a bonded particle membrane needs bonds: set dem.bond_law = \"parallel\" or "
+                                         "\"rotational\", or particle_membrane.bonded = false");
+  dem::Materials m = dem::build_materials(cfg);
+  try {
+    dem::add_particle_membrane_group(m, particle_membrane_material(cfg));  // its group name is reserved
+  } catch (const InputError& e) {
+    cfg.fail("triaxial.lateral", e.what());
+  }
+}
+
+void validate(const Config& cfg) {
+  check_triaxial_keys(cfg);
+  dem::validate_dem_sample(cfg);
+}
+
 RunStatus run(const Config& cfg, const RunOptions& opt) {
   const auto wall_start = std::chrono::steady_clock::now();
   const Real p = cfg.real("triaxial.confining_pressure");
@@ -263,9 +285,7 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
   dem::DemSystem sys;
   sys.settings = dem::build_settings(cfg);
   sys.materials = dem::build_materials(cfg);
-  if (sys.settings.dim != 3) cfg.fail("dem.dim", "a triaxial test needs a 3D cylinder sample (dim = 3)");
-  if (cfg.string("sample.shape") != "cylinder") cfg.fail("sample.shape", "a triaxial test needs shape = \"cylinder\"");
-  membrane_friction(cfg);  // checked before anything is built
+  check_triaxial_keys(cfg);  // checked before anything is built
   dem::SampleInfo info;
   TriaxialState st;
   const std::size_t cyl = lat.cylinder_wall;  // the rigid cylinder is wall 2 (after the platens)
@@ -572,7 +592,7 @@ Driver triaxial_driver() {
   return Driver{"triaxial",
                 "triaxial compression in a flexible membrane, rigid cylinder or particle membrane (isotropic stage, then "
                 "deviatoric loading)",
-                declare, run};
+                declare, run, validate};
 }
 
 }  // namespace ff::drivers

@@ -243,7 +243,8 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
 }  // namespace
 
 Driver ucs_driver() {
-  return Driver{"ucs", "uniaxial compression of a bonded-particle sample (UCS, E, nu, cracks)", declare, run};
+  return Driver{"ucs", "uniaxial compression of a bonded-particle sample (UCS, E, nu, cracks)", declare, run,
+                dem::validate_dem_sample};
 }
 
 }  // namespace ff::drivers

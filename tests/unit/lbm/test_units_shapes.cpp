@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "lbm/analysis.hpp"
@@ -34,30 +35,57 @@ TEST(LbmUnits, ConversionFactors) {
 
 TEST(LbmUnits, StabilityChecksNameTheFix) {
   const Units u = Units::from_tau(1e-3, 0.6, 1e-3, 1000);  // u_r = 30 m/s
-  EXPECT_TRUE(u.check(0.3, 50, "lbm.resolution", true).warnings.empty());  // Ma 0.017
+  EXPECT_TRUE(u.check(0.3, 50, "lbm.resolution", true, "trt").warnings.empty());  // Ma 0.017
   // Ma = 0.17: a warning naming a resolution that brings it below 0.1.
-  const auto w = u.check(3.0, 50, "lbm.resolution", true);
+  const auto w = u.check(3.0, 50, "lbm.resolution", true, "trt");
   ASSERT_EQ(w.warnings.size(), 1u);
   EXPECT_TRUE(w.error.empty());
-  EXPECT_NE(w.warnings[0].find("lbm.resolution to at least 87"), std::string::npos) << w.warnings[0];
+  EXPECT_NE(w.warnings[0].find("lbm.resolution = 87 or more"), std::string::npos) << w.warnings[0];
   // Ma = 0.52: an error.
-  const auto e = u.check(9.0, 50, "lbm.resolution", true);
+  const auto e = u.check(9.0, 50, "lbm.resolution", true, "trt");
   EXPECT_NE(e.error.find("Mach number"), std::string::npos);
   // In time-step mode the fix is a smaller time step.
   const Units d = Units::from_time_step(1e-3, u.dt(), 1e-3, 1000);
-  EXPECT_NE(d.check(3.0, 50, "lbm.resolution", false).warnings[0].find("lbm.time_step to at most"), std::string::npos);
+  EXPECT_NE(d.check(3.0, 50, "lbm.resolution", false, "trt").warnings[0].find("set lbm.time_step = "), std::string::npos);
   // tau close to 1/2, or large: a warning.
-  EXPECT_EQ(Units::from_tau(1e-3, 0.505, 1e-6, 1000).check(0.01, 50, "lbm.resolution", true).warnings.size(), 1u);
-  const auto big = Units::from_tau(1e-3, 4.0, 1e-6, 1000).check(1e-6, 50, "lbm.resolution", true);
+  EXPECT_EQ(Units::from_tau(1e-3, 0.505, 1e-6, 1000).check(0.01, 50, "lbm.resolution", true, "trt").warnings.size(), 1u);
+  const auto big = Units::from_tau(1e-3, 4.0, 1e-6, 1000).check(1e-6, 50, "lbm.resolution", true, "trt");
   ASSERT_EQ(big.warnings.size(), 1u);
-  EXPECT_NE(big.warnings[0].find("lower lbm.tau to 2"), std::string::npos) << big.warnings[0];
+  EXPECT_NE(big.warnings[0].find("set lbm.tau = 2"), std::string::npos) << big.warnings[0];
 }
 
 TEST(LbmUnits, TauAtOrBelowHalfIsAnError) {
   Units u = Units::from_tau(1e-3, 0.5, 1e-6, 1000);
-  const auto c = u.check(1e-6, 20, "lbm.resolution", true);
+  const auto c = u.check(1e-6, 20, "lbm.resolution", true, "trt");
   EXPECT_NE(c.error.find("above 1/2"), std::string::npos) << c.error;
-  EXPECT_NE(c.error.find("lbm.time_step to at least"), std::string::npos) << c.error;
+  EXPECT_NE(c.error.find("set lbm.time_step = "), std::string::npos) << c.error;
+}
+
+// The warning names the collision model of the run (it used to blame BGK in TRT runs) and a
+// value of the real key that the scenario accepts.
+TEST(LbmUnits, TauNearHalfWarningNamesTheCollisionModelAndAnAllowedTau) {
+  const Units u = Units::from_tau(1e-3, 0.505, 1e-6, 1000);
+  for (const std::string model : {"trt", "bgk"}) {
+    const auto c = u.check(0.001, 50, "lbm.resolution", true, model);
+    ASSERT_EQ(c.warnings.size(), 1u) << model;
+    const std::string& w = c.warnings[0];
+    const std::string in_use = model == "trt" ? "with the TRT (lbm.collision = \"trt\") collision"
+                                              : "with the BGK (lbm.collision = \"bgk\") collision";
+    EXPECT_NE(w.find(in_use), std::string::npos) << w;
+    if (model == "trt") {
+      EXPECT_EQ(w.find("BGK"), std::string::npos) << w;
+    }
+    const auto at = w.find("set lbm.tau = ");
+    ASSERT_NE(at, std::string::npos) << w;
+    const double tau = std::stod(w.substr(at + 14));
+    EXPECT_GT(tau, 0.5 + 0.01) << w;  // allowed (> 1/2) and out of the warning's range
+    EXPECT_TRUE(Units::from_tau(1e-3, tau, 1e-6, 1000).check(0.001, 50, "lbm.resolution", true, model).warnings.empty());
+  }
+  // In time-step mode the fix is a time step, for the model in use.
+  const Units d = Units::from_time_step(1e-3, u.dt(), 1e-6, 1000);
+  const auto w = d.check(0.001, 50, "lbm.resolution", false, "bgk").warnings.at(0);
+  EXPECT_NE(w.find("BGK (lbm.collision = \"bgk\")"), std::string::npos) << w;
+  EXPECT_NE(w.find("set lbm.time_step = "), std::string::npos) << w;
 }
 
 TEST(LbmShapes, InsideAndLinkFractions) {
