@@ -51,6 +51,18 @@ def read_csv(path):
     return {n: data[:, i] for i, n in enumerate(names)}
 
 
+# Column names end in their SI unit (fracflow's rule: "axial_stress_Pa", "time_s"); the axis
+# labels give the plotted unit (often scaled, e.g. MPa), so legends leave the suffix out.
+UNIT_SUFFIXES = ("_m2_per_s2", "_m2_per_s", "_N_per_m", "_m_per_s", "_Pa", "_J", "_s", "_m")
+
+
+def legend_label(name):
+    for suffix in UNIT_SUFFIXES:
+        if name.endswith(suffix) and len(name) > len(suffix):
+            return name[: -len(suffix)]
+    return name
+
+
 def column(table, name, path):
     if name not in table:
         raise ValueError(f"{path}: no column '{name}' (columns: {', '.join(table)})")
@@ -66,7 +78,7 @@ def plot(job):
     lines = []
     for name in job.get("y", []):
         colour = colours[len(lines) % len(colours)]
-        lines += ax.plot(x, column(table, name, csv) * job.get("y_scale", 1.0), color=colour, label=name)
+        lines += ax.plot(x, column(table, name, csv) * job.get("y_scale", 1.0), color=colour, label=legend_label(name))
     ref = job.get("reference_csv", "")
     if ref:
         rt = read_csv(ref)
@@ -84,7 +96,7 @@ def plot(job):
         ax2 = ax.twinx()
         for name in job["y2"]:  # colours continue the left axis's cycle; dashed = right axis
             colour = colours[len(lines) % len(colours)]
-            lines += ax2.plot(x, column(table, name, csv) * job.get("y2_scale", 1.0), "--", color=colour, label=name)
+            lines += ax2.plot(x, column(table, name, csv) * job.get("y2_scale", 1.0), "--", color=colour, label=legend_label(name))
         ax2.set_ylabel(job.get("y2label", ""))
     if lines:
         ax.legend(lines, [l.get_label() for l in lines], loc="best", fontsize="small")

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -195,6 +196,11 @@ int run_calibrate_command(const CalibrateArgs& a) {
       throw Error(fmt::format("calibration run {} was interrupted (ABORT file?); its folder is {}", it,
                               run.out_dir.string()));
     const RunSummary s = read_run_summary(run.out_dir);
+    // A run without a peak or an elastic fit has nothing to update from (null in summary.json).
+    if (!std::isfinite(s.youngs_modulus_Pa) || !std::isfinite(s.poisson_ratio) || !std::isfinite(s.ucs_Pa))
+      throw Error(fmt::format("calibration run {} measured no {}: {}; see {}", it,
+                              std::isfinite(s.ucs_Pa) ? "E and nu" : "UCS",
+                              s.missing.empty() ? "summary.json holds no value" : s.missing, run.out_dir.string()));
     MacroProperties m{s.youngs_modulus_Pa, s.poisson_ratio, s.ucs_Pa, 0.0};
     if (measure_slope) {
       const fs::path dir = out / fmt::format("iter_{:02d}_triaxial", it);

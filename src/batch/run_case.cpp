@@ -82,8 +82,7 @@ RunStatus run_in_process(const std::string& scenario_path, const std::vector<std
   }
 }
 
-namespace {
-double number_at(const nlohmann::json& j, std::initializer_list<const char*> path) {
+double json_number(const nlohmann::json& j, std::initializer_list<const char*> path) {
   const nlohmann::json* p = &j;
   for (const char* k : path) {
     if (!p->is_object() || !p->contains(k)) return std::numeric_limits<double>::quiet_NaN();
@@ -91,7 +90,6 @@ double number_at(const nlohmann::json& j, std::initializer_list<const char*> pat
   }
   return p->is_number() ? p->get<double>() : std::numeric_limits<double>::quiet_NaN();
 }
-}  // namespace
 
 RunSummary read_run_summary(const fs::path& out_dir) {
   const fs::path file = out_dir / "summary.json";
@@ -104,16 +102,23 @@ RunSummary read_run_summary(const fs::path& out_dir) {
     throw Error(fmt::format("'{}' is not valid JSON: {}", file.string(), e.what()));
   }
   s.driver = s.raw.value("driver", std::string());
-  s.ucs_Pa = number_at(s.raw, {"ucs_Pa"});
-  s.peak_differential_stress_Pa = number_at(s.raw, {"peak_differential_stress_Pa"});
-  s.confining_pressure_Pa = number_at(s.raw, {"confining_pressure_Pa"});
-  s.youngs_modulus_Pa = number_at(s.raw, {"youngs_modulus_Pa"});
-  s.poisson_ratio = number_at(s.raw, {"poisson_ratio"});
-  s.strain_at_peak = number_at(s.raw, {"strain_at_peak"});
-  s.cracks_tensile = number_at(s.raw, {"cracks", "tensile"});
-  s.cracks_shear = number_at(s.raw, {"cracks", "shear"});
-  s.cracks_total = number_at(s.raw, {"cracks", "total"});
-  s.wall_time_s = number_at(s.raw, {"wall_time_s"});
+  s.ucs_Pa = json_number(s.raw, {"ucs_Pa"});
+  s.peak_differential_stress_Pa = json_number(s.raw, {"peak_differential_stress_Pa"});
+  s.confining_pressure_Pa = json_number(s.raw, {"confining_pressure_Pa"});
+  s.youngs_modulus_Pa = json_number(s.raw, {"youngs_modulus_Pa"});
+  s.poisson_ratio = json_number(s.raw, {"poisson_ratio"});
+  s.strain_at_peak = json_number(s.raw, {"strain_at_peak"});
+  s.cracks_tensile = json_number(s.raw, {"cracks", "tensile"});
+  s.cracks_shear = json_number(s.raw, {"cracks", "shear"});
+  s.cracks_total = json_number(s.raw, {"cracks", "total"});
+  s.wall_time_s = json_number(s.raw, {"wall_time_s"});
+  for (const char* block : {"peak", "elastic_fit"}) {
+    const auto it = s.raw.find(block);
+    if (it == s.raw.end() || !it->is_object() || !it->contains("reason") || !(*it)["reason"].is_string()) continue;
+    s.missing += fmt::format("{}{}: {}", s.missing.empty() ? "" : "; ",
+                             std::string(block) == "peak" ? "no peak" : "no elastic constants",
+                             (*it)["reason"].get<std::string>());
+  }
   return s;
 }
 

@@ -46,15 +46,23 @@ struct InProcessRun {
 RunStatus run_in_process(const std::string& scenario_path, const std::vector<std::string>& overrides,
                          const InProcessRun& run);
 
-// The headline numbers of a finished run's summary.json; absent numbers are NaN.
+// The headline numbers of a finished run's summary.json; absent and null numbers are NaN
+// (a run writes null where it has no trustworthy value, e.g. an elastic fit without points).
 struct RunSummary {
   std::string driver;
   double ucs_Pa = 0, peak_differential_stress_Pa = 0, confining_pressure_Pa = 0;
   double youngs_modulus_Pa = 0, poisson_ratio = 0, strain_at_peak = 0;
   double cracks_tensile = 0, cracks_shear = 0, cracks_total = 0;
   double wall_time_s = 0;
+  // Why the peak or the elastic constants are null ("" when both are there), from the reasons
+  // summary.json gives beside them.
+  std::string missing;
   nlohmann::json raw;  // the whole file
 };
+
+// The number at `path` in `j` (nested keys); NaN when a key is absent or the value is not a number
+// (null included).
+double json_number(const nlohmann::json& j, std::initializer_list<const char*> path);
 
 // Reads out_dir/summary.json; throws ff::Error naming the file when it is missing or unreadable.
 RunSummary read_run_summary(const std::filesystem::path& out_dir);

@@ -158,6 +158,7 @@ void write_outputs(const SweepOptions& opt, const SweepResult& r) {
     const auto nums = numbers_of(c);
     for (std::size_t i = 0; i < kNumberColumns.size(); ++i) cj[kNumberColumns[i]] = nums[i];  // NaN -> null
     if (c.summary) cj["driver"] = c.summary->driver;
+    if (c.summary && !c.summary->missing.empty()) cj["missing"] = c.summary->missing;  // why numbers are null
     j["cases"].push_back(cj);
   }
   if (r.fit)

@@ -8,6 +8,7 @@
 #include <map>
 
 #include "batch/mohr_coulomb.hpp"
+#include "batch/run_case.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "io/plot.hpp"
@@ -95,14 +96,19 @@ TriaxialRunResult read_triaxial_result(const fs::path& dir, const std::string& l
   TriaxialRunResult r;
   r.label = label;
   r.dir = dir;
+  // Present but null (no peak, no elastic fit: the run's summary says why) reads as NaN.
+  auto number = [&](const char* key) {
+    const auto& v = j.at(key);
+    return v.is_null() ? std::nan("") : v.get<double>();
+  };
   try {
     r.lateral = j.at("lateral").get<std::string>();
     r.sigma3_Pa = j.at("confining_pressure_Pa").get<double>();
-    r.peak_differential_Pa = j.at("peak_differential_stress_Pa").get<double>();
-    r.strain_at_peak = j.at("strain_at_peak").get<double>();
-    r.confinement_at_peak_Pa = j.at("confinement_at_peak_Pa").get<double>();
-    r.youngs_modulus_Pa = j.at("youngs_modulus_Pa").get<double>();
-    r.poisson_ratio = j.at("poisson_ratio").get<double>();
+    r.peak_differential_Pa = number("peak_differential_stress_Pa");
+    r.strain_at_peak = number("strain_at_peak");
+    r.confinement_at_peak_Pa = number("confinement_at_peak_Pa");
+    r.youngs_modulus_Pa = number("youngs_modulus_Pa");
+    r.poisson_ratio = number("poisson_ratio");
     r.cracks_total = j.at("cracks").at("total").get<double>();
     r.cracks_tensile = j.at("cracks").at("tensile").get<double>();
     r.cracks_shear = j.at("cracks").at("shear").get<double>();
@@ -252,9 +258,9 @@ CalibrationNumbers calibration_numbers(const nlohmann::json& c) {
   n.present = true;
   n.converged = c.value("converged", false);
   const auto& m = c["final_measured"];
-  n.E = m.value("youngs_modulus_Pa", 0.0);
-  n.nu = m.value("poisson_ratio", 0.0);
-  n.ucs = m.value("ucs_Pa", 0.0);
+  n.E = json_number(m, {"youngs_modulus_Pa"});  // NaN when null: the check below then fails
+  n.nu = json_number(m, {"poisson_ratio"});
+  n.ucs = json_number(m, {"ucs_Pa"});
   n.b = m.value("slope_b", 0.0);
   n.runs = c.contains("iterations") ? static_cast<int>(c["iterations"].size()) : 0;
   return n;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <fstream>
 
+#include "batch/run_case.hpp"
 #include "batch/triaxial_validation.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -35,7 +36,7 @@ void write_curves_csv(const fs::path& csv, const std::vector<std::pair<std::stri
       cols.push_back(line.substr(a, b - a));
     }
     const auto ie = std::find(cols.begin(), cols.end(), "axial_strain") - cols.begin();
-    const auto iq = std::find(cols.begin(), cols.end(), "differential_stress") - cols.begin();
+    const auto iq = std::find(cols.begin(), cols.end(), "differential_stress_Pa") - cols.begin();
     if (ie >= static_cast<long>(cols.size()) || iq >= static_cast<long>(cols.size())) continue;
     while (std::getline(f, line)) {
       std::vector<double> v;
@@ -237,8 +238,8 @@ void write_validation_report(const ValidationReport& r, const fs::path& doc) {
       const bool b_measured = it.value("slope_measured", it.value("slope_b", 0.0) > 0);
       md += fmt::format("| {} | {:.4g} | {:.4g} | {:.4g} / {:.4g} | {:.3g} | {:.3f} | {:.3f} | {:.2f} | {} |\n",
                         it.value("iteration", 0), 1e-9 * get(".emod"), get(".kratio"), 1e-6 * get(".tensile_strength"),
-                        1e-6 * get(".cohesion"), get(".friction_angle"), 1e-9 * it.value("youngs_modulus_Pa", 0.0),
-                        it.value("poisson_ratio", 0.0), 1e-6 * it.value("ucs_Pa", 0.0),
+                        1e-6 * get(".cohesion"), get(".friction_angle"), 1e-9 * json_number(it, {"youngs_modulus_Pa"}),
+                        json_number(it, {"poisson_ratio"}), 1e-6 * json_number(it, {"ucs_Pa"}),
                         b_measured ? fmt::format("{:.2f}", it.value("slope_b", 0.0)) : std::string("-"));
     }
     md += fmt::format("\nTargets: E = 2.37 GPa, nu = 0.35, UCS = 14.97 MPa (Table 5), b = {:.2f} (Eq. 1, the slope of "

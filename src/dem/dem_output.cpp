@@ -173,7 +173,8 @@ void DemVtkWriter::write(const DemSystem& sys, long index, Real wall_extent) {
 void append_cracks_csv(const std::filesystem::path& csv, const CrackLog& log, const Materials& mat, std::size_t from) {
   std::FILE* f = std::fopen(csv.c_str(), from == 0 ? "w" : "a");
   if (!f) throw Error(fmt::format("cannot write '{}'", csv.string()));
-  if (from == 0) fmt::print(f, "time,x,y,z,nx,ny,nz,size,mode,group_a,group_b,particle_a,particle_b\n");
+  // Names end in their SI unit (size_m: the crack disc radius, the bond's); the normal is a unit vector.
+  if (from == 0) fmt::print(f, "time_s,x_m,y_m,z_m,nx,ny,nz,size_m,mode,group_a,group_b,particle_a,particle_b\n");
   for (std::size_t k = from; k < log.events.size(); ++k) {
     const auto& e = log.events[k];
     fmt::print(f, "{},{},{},{},{},{},{},{},{},{},{},{},{}\n", e.time, e.position.x(), e.position.y(), e.position.z(),

@@ -36,7 +36,7 @@ diameter = 10e-3          # m
 height = 20e-3            # m
 radius_min = 0.4e-3
 radius_max = 0.6e-3
-porosity = 0.38
+porosity = 0.40           # 0.39 or less is denser than this small cylinder packs (warning)
 seed = 1
 bond_gap = 0.05e-3
 

@@ -26,12 +26,6 @@ dem::SampleInfo sample_info(const SampleRecord& s) {
   return i;
 }
 
-nlohmann::json params_json(const Config& cfg) {
-  nlohmann::json j = nlohmann::json::object();
-  for (auto& [k, v] : cfg.resolved_values()) std::visit([&](const auto& x) { j[k] = x; }, v);
-  return j;
-}
-
 nlohmann::json cracks_json(const dem::DemSystem& sys, int groups) {
   nlohmann::json j = {{"tensile", sys.cracks.tensile}, {"shear", sys.cracks.shear}, {"total", sys.cracks.total()}};
   nlohmann::json by_pair = nlohmann::json::object();

@@ -9,6 +9,7 @@
 
 #include "dem/dem_system.hpp"
 #include "dem/sample_builder.hpp"
+#include "drivers/summary_values.hpp"  // params_json, shared with the flow drivers
 #include "io/checkpoint.hpp"
 #include "io/plot.hpp"
 #include "io/params.hpp"
@@ -24,8 +25,6 @@ struct SampleRecord {
 SampleRecord sample_record(const dem::SampleInfo& info);
 dem::SampleInfo sample_info(const SampleRecord& record);
 
-// Every resolved parameter, key -> value.
-nlohmann::json params_json(const Config& cfg);
 // Crack counts by type and by pair of the first `groups` groups (-1: all; a particle
 // membrane's group comes last and is left out).
 nlohmann::json cracks_json(const dem::DemSystem& sys, int groups = -1);

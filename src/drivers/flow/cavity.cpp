@@ -58,7 +58,10 @@ class CavityCase : public FlowCase {
     for (int x = 0; x < s.nx; ++x) v[x] = 0.5 * (s.velocity[s.at(x, ya)].y() + s.velocity[s.at(x, yb)].y()) / U_;
   }
 
-  std::vector<std::string> columns() const override { return {"u_centre", "v_centre", "kinetic_energy", "lid_force"}; }
+  // Names end in their SI unit (kinetic energy per mass, force per unit depth).
+  std::vector<std::string> columns() const override {
+    return {"u_centre_m_per_s", "v_centre_m_per_s", "kinetic_energy_m2_per_s2", "lid_force_N_per_m"};
+  }
   void measure(const FlowSample& s, std::vector<double>& row) const override {
     const int xa = (s.nx - 1) / 2, xb = s.nx / 2, ya = (s.ny - 1) / 2, yb = s.ny / 2;
     Vec3 c = Vec3::Zero();
@@ -141,9 +144,9 @@ class CavityCase : public FlowCase {
     }
     PlotSpec k;
     k.title = "Lid-driven cavity: approach to steady state";
-    k.x = "time";
+    k.x = "time_s";
     k.xlabel = "time [s]";
-    k.y = {"kinetic_energy"};
+    k.y = {"kinetic_energy_m2_per_s2"};
     k.ylabel = "mean kinetic energy per mass [m^2/s^2]";
     const PlotJob jobs[] = {{out / "profile_u_vertical_centreline.csv", out / "plots" / "u_vertical_centreline.png", pu},
                             {out / "profile_v_horizontal_centreline.csv", out / "plots" / "v_horizontal_centreline.png", pv},

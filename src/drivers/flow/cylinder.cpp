@@ -139,7 +139,8 @@ class CylinderCase : public FlowCase {
     return d;
   }
 
-  std::vector<std::string> columns() const override { return {"Fx", "Fy", "Cd", "Cl"}; }
+  // Forces per unit depth with their unit; the coefficients are dimensionless.
+  std::vector<std::string> columns() const override { return {"Fx_N_per_m", "Fy_N_per_m", "Cd", "Cl"}; }
   void measure(const FlowSample& s, std::vector<double>& row) const override {
     const Vec3 F = s.force[0];
     const double q = 0.5 * rho_ * u_ref() * u_ref() * D_;
@@ -178,7 +179,11 @@ class CylinderCase : public FlowCase {
     res["cl_amplitude"] = 0.5 * (lift.max - lift.min);
     res["cl_mean"] = lift.mean;
     res["shedding"] = shedding;
-    res["strouhal"] = shedding ? lift.frequency * D_ / u_ref() : 0.0;
+    // No shedding, no frequency: null with the reason rather than a Strouhal number of 0.
+    res["strouhal"] = shedding ? nlohmann::json(lift.frequency * D_ / u_ref()) : nlohmann::json(nullptr);
+    if (!shedding)
+      res["strouhal_reason"] = fmt::format("no vortex shedding: {} lift cycles after {:.4g} s (2 needed), Cl amplitude {:.3g}",
+                                           lift.cycles, t_from, 0.5 * (lift.max - lift.min));
     res["shedding_periods_averaged"] = shedding ? lift.cycles : 0;
     res["lambda_wall_factor"] = fx.back() / (rho_ * nu_ * u_max());  // [S003] Eq. 16
     res["wall_scheme"] = scheme_ == lbm::WallScheme::Bouzidi ? "bouzidi" : scheme_ == lbm::WallScheme::Yu ? "yu" : "halfway";
@@ -191,7 +196,7 @@ class CylinderCase : public FlowCase {
     if (!plots) return;
     PlotSpec p;
     p.title = fmt::format("Cylinder in a channel, Re = {:.4g}: force coefficients", re);
-    p.x = "time";
+    p.x = "time_s";
     p.xlabel = "time [s]";
     p.y = {"Cd"};
     p.ylabel = "drag coefficient Cd";
@@ -199,9 +204,9 @@ class CylinderCase : public FlowCase {
     p.y2label = "lift coefficient Cl";
     PlotSpec f;
     f.title = "Cylinder in a channel: force per unit depth";
-    f.x = "time";
+    f.x = "time_s";
     f.xlabel = "time [s]";
-    f.y = {"Fx", "Fy"};
+    f.y = {"Fx_N_per_m", "Fy_N_per_m"};
     f.ylabel = "force [N/m]";
     const PlotJob jobs[] = {{out / "series.csv", out / "plots" / "force_coefficients.png", p},
                             {out / "series.csv", out / "plots" / "forces.png", f}};

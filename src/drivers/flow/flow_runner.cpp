@@ -9,6 +9,8 @@
 #include "core/log.hpp"
 #include "core/progress.hpp"
 #include "fracflow/version.hpp"
+#include "drivers/run_estimate.hpp"
+#include "drivers/summary_values.hpp"
 #include "io/checkpoint.hpp"
 #include "io/csv.hpp"
 #include "io/json_out.hpp"
@@ -285,7 +287,8 @@ RunStatus Runner<L, T>::run() {
     log::info("inflow ramped up over {} steps ({:.4g} s)", ramp_steps, double(ramp_steps) * units_.dt());
   const auto steady_col = fc_.steady_column();
 
-  std::vector<std::string> columns = {"step", "time"};
+  // Names end in their SI unit (time_s, ..._Pa, ..._m_per_s); dimensionless ones have none.
+  std::vector<std::string> columns = {"step", "time_s"};
   for (auto& c : fc_.columns()) columns.push_back(c);
   ncols_ = columns.size();
   history_.reserve(std::size_t(n_samples) * ncols_);
@@ -311,6 +314,10 @@ RunStatus Runner<L, T>::run() {
   }
 
   Progress progress(driver_, opt_.progress_interval_s);
+  LongRunNotice long_run(double(steps_total - sol_->time_step()),
+                         fmt::format("run.end_time, a smaller {} or a larger {}", fc_.resolution_key(),
+                                     tau_mode ? "lbm.tau" : "lbm.time_step"),
+                         sol_->time_step());
   RunStatus status = RunStatus::Finished;
   std::string stop_reason = fmt::format("reached run.end_time = {} s", cfg_.real("run.end_time"));
   const auto loop_start = std::chrono::steady_clock::now();
@@ -357,6 +364,7 @@ RunStatus Runner<L, T>::run() {
       break;
     }
     progress.update(sol_->time_step(), s.time, double(sol_->time_step()) / double(steps_total), fc_.progress_text(row_));
+    long_run.update(sol_->time_step());
   }
   const double loop_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - loop_start).count();
   series.close();
@@ -402,9 +410,7 @@ void Runner<L, T>::summary(const FlowSample& last, const std::string& stop_reaso
     rows.emplace_back(history_.begin() + std::ptrdiff_t(i), history_.begin() + std::ptrdiff_t(i + ncols_));
   fc_.finish(last, rows, opt_.out_dir, plots, results);
   j["results"] = results;
-  nlohmann::json params = nlohmann::json::object();
-  for (auto& [k, v] : cfg_.values()) params[k] = format_value(v.first);
-  j["parameters"] = params;
+  j["parameters"] = params_json(cfg_);  // typed, as the DEM drivers write them
   write_json_atomic(opt_.out_dir / "summary.json", j);
 }
 

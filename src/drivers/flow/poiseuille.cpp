@@ -76,7 +76,8 @@ class PoiseuilleCase : public FlowCase {
   }
 
   std::vector<std::string> columns() const override {
-    return {"u_max", "u_max_analytic", "flow_rate", "wall_shear_stress"};
+    // Names end in their SI unit (the flow rate is per unit depth).
+    return {"u_max_m_per_s", "u_max_analytic_m_per_s", "flow_rate_m2_per_s", "wall_shear_stress_Pa"};
   }
   void measure(const FlowSample& s, std::vector<double>& row) const override {
     const int x = s.nx / 2;
@@ -99,7 +100,7 @@ class PoiseuilleCase : public FlowCase {
               nlohmann::json& res) const override {
     // Profile across the channel in the middle, against Eq. 14.
     CsvWriter prof;
-    prof.open(out / "profile.csv", {"y", "u_lbm", "u_analytic"});
+    prof.open(out / "profile.csv", {"y_m", "u_lbm_m_per_s", "u_analytic_m_per_s"});
     const int x = s.nx / 2;
     double err2 = 0, umean = 0;
     for (int y = 0; y < s.ny; ++y) {
@@ -112,7 +113,7 @@ class PoiseuilleCase : public FlowCase {
     prof.close();
     {  // the analytic curve, finely sampled wall to wall, for the plot
       CsvWriter ana;
-      ana.open(out / "profile_analytic.csv", {"y", "u_analytic"});
+      ana.open(out / "profile_analytic.csv", {"y_m", "u_analytic_m_per_s"});
       for (int k = 0; k <= 100; ++k) ana.row({H_ * k / 100.0, analytic(H_ * k / 100.0)});
     }
     const double l2 = std::sqrt(err2 / s.ny) / u_max();
@@ -130,21 +131,21 @@ class PoiseuilleCase : public FlowCase {
     if (!plots) return;
     PlotSpec p;
     p.title = "Poiseuille flow: velocity profile (LBM vs [S003] Eq. 14)";
-    p.x = "y";
+    p.x = "y_m";
     p.x_scale = 1e3;
     p.xlabel = "y [mm]";
-    p.y = {"u_analytic"};
+    p.y = {"u_analytic_m_per_s"};
     p.y_scale = 1e3;
     p.ylabel = "u [mm/s]";
     p.reference_csv = out / "profile.csv";
-    p.ref_x = "y";
-    p.ref_y = "u_lbm";
+    p.ref_x = "y_m";
+    p.ref_y = "u_lbm_m_per_s";
     p.ref_label = "LBM (cell centres)";
     PlotSpec h;
     h.title = "Poiseuille flow: approach to steady state";
-    h.x = "time";
+    h.x = "time_s";
     h.xlabel = "time [s]";
-    h.y = {"u_max", "u_max_analytic"};
+    h.y = {"u_max_m_per_s", "u_max_analytic_m_per_s"};
     h.y_scale = 1e3;
     h.ylabel = "centre-line velocity [mm/s]";
     const PlotJob jobs[] = {{out / "profile_analytic.csv", out / "plots" / "velocity_profile.png", p},

@@ -14,6 +14,7 @@
 #include "dem/dem_params.hpp"
 #include "dem/sample_builder.hpp"
 #include "drivers/dem_results.hpp"
+#include "drivers/run_estimate.hpp"
 #include "drivers/triaxial/triaxial_boundary.hpp"
 #include "drivers/ucs/ucs_measure.hpp"
 #include "fracflow/version.hpp"
@@ -222,7 +223,8 @@ void read_checkpoint(const Config& cfg, const fs::path& dir, dem::DemSystem& sys
 
 // Series columns; crack counts by pair of the sample's groups (the first `groups`).
 std::vector<std::string> columns(const dem::Materials& mat, int groups) {
-  std::vector<std::string> c = {"step", "time", "axial_strain", "axial_stress", "differential_stress", "confinement",
+  // Names end in their SI unit (_s, _Pa, _J); strains, counts and ratios have none.
+  std::vector<std::string> c = {"step", "time_s", "axial_strain", "axial_stress_Pa", "differential_stress_Pa", "confinement_Pa",
                                 "lateral_strain", "volumetric_strain", "cracks_tensile", "cracks_shear", "cracks_total"};
   for (int a = 0; a < groups; ++a)
     for (int b = a; b < groups; ++b) {
@@ -230,7 +232,7 @@ std::vector<std::string> columns(const dem::Materials& mat, int groups) {
       c.push_back("cracks_" + p + "_tensile");
       c.push_back("cracks_" + p + "_shear");
     }
-  for (const char* s : {"intact_bonds", "kinetic_energy", "unbalanced_force_ratio"}) c.emplace_back(s);
+  for (const char* s : {"intact_bonds", "kinetic_energy_J", "unbalanced_force_ratio"}) c.emplace_back(s);
   return c;
 }
 
@@ -241,10 +243,10 @@ void make_plots(const fs::path& out, const Config& cfg) {
       axial_strain_plot(out, "stress_strain_cracks",
                         fmt::format("Triaxial compression, sigma3 = {:g} MPa: stress and cracks",
                                     1e-6 * cfg.real("triaxial.confining_pressure")),
-                        {"differential_stress"}, 1e-6, "differential stress [MPa]"),
+                        {"differential_stress_Pa"}, 1e-6, "differential stress [MPa]"),
       axial_strain_plot(out, "strains", "Triaxial compression: strains", {"lateral_strain", "volumetric_strain"}, 100,
                         "strain [%] (compression > 0)"),
-      axial_strain_plot(out, "confinement", "Applied lateral confinement", {"confinement"}, 1e-6, "confinement [MPa]")};
+      axial_strain_plot(out, "confinement", "Applied lateral confinement", {"confinement_Pa"}, 1e-6, "confinement [MPa]")};
   jobs[0].spec.y2 = {"cracks_total", "cracks_tensile", "cracks_shear"};
   jobs[0].spec.y2label = "number of cracks";
   plot_series(jobs);  // one python process for all three
@@ -319,7 +321,7 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
 
   // Outputs. On resume, rows after the checkpoint are dropped (they are recomputed identically).
   const auto cols = columns(sys.materials, sample_groups);
-  const std::vector<std::string> iso_cols = {"step", "time", "axial_stress", "confinement", "unbalanced_force_ratio"};
+  const std::vector<std::string> iso_cols = {"step", "time_s", "axial_stress_Pa", "confinement_Pa", "unbalanced_force_ratio"};
   CsvWriter series, iso;
   if (opt.resume) {
     iso.reopen(opt.out_dir / "isotropic.csv", iso_cols, static_cast<std::size_t>(st.iso_rows));
@@ -348,11 +350,15 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
   const Real stop_fraction = cfg.real("triaxial.stop_fraction"), max_strain = cfg.real("triaxial.max_strain");
   const Real vtk_every = cfg.real("triaxial.vtk_strain_interval"), v_platen = cfg.real("triaxial.platen_velocity");
   Progress progress("triaxial", opt.progress_interval_s);
+  // At most the isotropic cap, then the platens (v each) to the strain cap: max_strain h / (2 v dt).
+  LongRunNotice long_run(static_cast<double>(iso_max) + max_strain * info.height / (2 * v_platen * sys.settings.dt) -
+                             static_cast<double>(sys.step_count),
+                         "triaxial.platen_velocity, triaxial.max_strain or triaxial.isotropic_max_steps", sys.step_count);
   std::vector<Real> e_hist, s_hist, l_hist;
   if (opt.resume && st.stage == 1 && st.rows > 0) {  // the elastic fit needs the whole curve
     const CsvTable t = read_csv(opt.out_dir / "series.csv");
     e_hist = t.column("axial_strain");
-    s_hist = t.column("differential_stress");
+    s_hist = t.column("differential_stress_Pa");
     l_hist = t.column("lateral_strain");
   }
   int iso_ok_rows = 0;
@@ -489,6 +495,7 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
                         fmt::format("strain {:.3f}%  q {:.3f} MPa  confinement {:.3f} MPa  cracks {}", 100 * ea,
                                     1e-6 * diff, 1e-6 * conf, sys.cracks.total()));
       }
+      long_run.update(sys.step_count);
       dem::append_cracks_csv(cracks_csv, sys.cracks, sys.materials, static_cast<std::size_t>(st.cracks_written));
       st.cracks_written = static_cast<long>(sys.cracks.events.size());
       if (!stop_reason.empty()) break;
@@ -523,14 +530,21 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
   j["lateral"] = cfg.string("triaxial.lateral");
   j["stop_reason"] = stop_reason;
   j["confining_pressure_Pa"] = p;
-  j["peak_differential_stress_Pa"] = st.peak_diff;
-  j["peak_axial_stress_Pa"] = st.peak_diff + p;
-  j["confinement_at_peak_Pa"] = st.conf_at_peak;
-  j["strain_at_peak"] = st.strain_at_peak;
-  j["youngs_modulus_Pa"] = fit.youngs_modulus;
-  j["poisson_ratio"] = fit.poisson_ratio;
-  j["elastic_fit"] = {{"method", "least squares on the pre-peak differential stress between 20% and 50% of its peak"},
-                      {"points", fit.points}};
+  // No peak (still rising at triaxial.max_strain) or no fit: null with the reason, never a number.
+  const std::string no_peak = peak_problem(st.peak_diff, st.peak_row, st.rows,
+                                           stop_reason.find("triaxial.max_strain") != std::string::npos, "triaxial.max_strain");
+  auto at_peak = [&](Real v) { return no_peak.empty() ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  j["peak_differential_stress_Pa"] = at_peak(st.peak_diff);
+  j["peak_axial_stress_Pa"] = at_peak(st.peak_diff + p);
+  j["confinement_at_peak_Pa"] = at_peak(st.conf_at_peak);
+  j["strain_at_peak"] = at_peak(st.strain_at_peak);
+  j["peak"] = {{"reached", no_peak.empty()}};
+  if (!no_peak.empty()) {
+    j["peak"]["reason"] = no_peak;
+    j["peak"]["largest_differential_stress_Pa"] = st.peak_diff;
+    log::warn("no peak differential stress (null in summary.json): {}", no_peak);
+  }
+  put_elastic_fit(j, fit, "least squares on the pre-peak differential stress between 20% and 50% of its peak");
   nlohmann::json spheres = nlohmann::json::array();
   for (int s = 0; s < 3; ++s)
     spheres.push_back({{"axial_Pa", st.sphere_axial[s]}, {"lateral_Pa", st.sphere_lateral[s]}, {"particles", st.sphere_particles[s]},
@@ -579,9 +593,12 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
   j["parameters"] = params_json(cfg);
   write_json_atomic(opt.out_dir / "summary.json", j);
   make_plots(opt.out_dir, cfg);
-  log::info("triaxial sigma3 = {:.3f} MPa: peak differential stress {:.3f} MPa at axial strain {:.3f}%, E = {:.3f} GPa, "
-            "nu = {:.3f}, cracks {} ({} tensile, {} shear); {}",
-            1e-6 * p, 1e-6 * st.peak_diff, 100 * st.strain_at_peak, 1e-9 * fit.youngs_modulus, fit.poisson_ratio,
+  log::info("triaxial sigma3 = {:.3f} MPa: {}, {}, cracks {} ({} tensile, {} shear); {}", 1e-6 * p,
+            no_peak.empty() ? fmt::format("peak differential stress {:.3f} MPa at axial strain {:.3f}%", 1e-6 * st.peak_diff,
+                                          100 * st.strain_at_peak)
+                            : std::string("no peak"),
+            fit.ok() ? fmt::format("E = {:.3f} GPa, nu = {:.3f}", 1e-9 * fit.youngs_modulus, fit.poisson_ratio)
+                     : std::string("no E or nu"),
             sys.cracks.total(), sys.cracks.tensile, sys.cracks.shear, stop_reason);
   return RunStatus::Finished;
 }

@@ -14,6 +14,7 @@
 #include "dem/dem_params.hpp"
 #include "dem/sample_builder.hpp"
 #include "drivers/dem_results.hpp"
+#include "drivers/run_estimate.hpp"
 #include "drivers/ucs/ucs_measure.hpp"
 #include "fracflow/version.hpp"
 #include "io/csv.hpp"
@@ -38,9 +39,10 @@ void declare(ParamTable& t) {
   t.integer("ucs.checkpoint_interval", 20000, "steps", "steps between checkpoints (0: only at the end and on interruption)").non_negative();
 }
 
-const std::vector<std::string> kColumns = {"step", "time", "axial_strain", "axial_stress", "lateral_strain",
+// Column names end in their SI unit (_s, _Pa, _J); strains, counts and ratios have none.
+const std::vector<std::string> kColumns = {"step", "time_s", "axial_strain", "axial_stress_Pa", "lateral_strain",
                                            "volumetric_strain", "cracks_tensile", "cracks_shear", "cracks_total",
-                                           "intact_bonds", "kinetic_energy", "unbalanced_force_ratio"};
+                                           "intact_bonds", "kinetic_energy_J", "unbalanced_force_ratio"};
 
 // Driver state that must survive a restart.
 struct UcsState {
@@ -81,7 +83,7 @@ void make_plots(const fs::path& out, const Config& cfg) {
   if (!cfg.boolean("output.plots")) return;
   fs::create_directories(out / "plots");
   std::vector<PlotJob> jobs = {
-      axial_strain_plot(out, "stress_strain_cracks", "Uniaxial compression: stress and cracks", {"axial_stress"}, 1e-6,
+      axial_strain_plot(out, "stress_strain_cracks", "Uniaxial compression: stress and cracks", {"axial_stress_Pa"}, 1e-6,
                         "axial stress [MPa]"),
       axial_strain_plot(out, "strains", "Uniaxial compression: strains", {"lateral_strain", "volumetric_strain"}, 100,
                         "strain [%] (compression > 0)")};
@@ -145,12 +147,16 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
   const Real stop_fraction = cfg.real("ucs.stop_fraction"), max_strain = cfg.real("ucs.max_strain");
   const Real vtk_every = cfg.real("ucs.vtk_strain_interval");
   Progress progress("ucs", opt.progress_interval_s);
+  // Each platen moves at v: the strain cap is reached after max_strain h0 / (2 v dt) steps.
+  LongRunNotice long_run(max_strain * st.h0 / (2 * cfg.real("ucs.platen_velocity") * sys.settings.dt) -
+                             static_cast<double>(sys.step_count),
+                         "ucs.platen_velocity or ucs.max_strain", sys.step_count);
   std::vector<Real> e_hist, s_hist, l_hist;
   {  // The elastic fit needs the whole curve: re-read the rows kept so far.
     if (opt.resume && st.rows > 0) {
       const CsvTable t = read_csv(opt.out_dir / "series.csv");
       e_hist = t.column("axial_strain");
-      s_hist = t.column("axial_stress");
+      s_hist = t.column("axial_stress_Pa");
       l_hist = t.column("lateral_strain");
     }
   }
@@ -190,6 +196,7 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
       progress.update(sys.step_count, sys.time, std::min(fraction, 1.0),
                       fmt::format("strain {:.3f}%  stress {:.3f} MPa  cracks {}", 100 * m.axial_strain, 1e-6 * m.axial_stress,
                                   sys.cracks.total()));
+      long_run.update(sys.step_count);
       if (!stop_reason.empty()) break;
       if (cp_every > 0 && (sys.step_count / series_every) % std::max(1L, cp_every / series_every) == 0)
         write_checkpoint(cp_dir, sys, st, info);
@@ -219,12 +226,18 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
   j["driver"] = "ucs";
   j["title"] = cfg.string("title");
   j["stop_reason"] = stop_reason;
-  j["ucs_Pa"] = st.peak_stress;
-  j["strain_at_peak"] = st.strain_at_peak;
-  j["youngs_modulus_Pa"] = fit.youngs_modulus;
-  j["poisson_ratio"] = fit.poisson_ratio;
-  j["elastic_fit"] = {{"method", "least squares on the pre-peak curve between 20% and 50% of the peak stress"},
-                      {"points", fit.points}};
+  // No peak (still rising at ucs.max_strain) or no fit: null with the reason, never a number.
+  const std::string no_peak = peak_problem(st.peak_stress, st.peak_row, st.rows,
+                                           stop_reason.find("ucs.max_strain") != std::string::npos, "ucs.max_strain");
+  j["ucs_Pa"] = no_peak.empty() ? nlohmann::json(st.peak_stress) : nlohmann::json(nullptr);
+  j["strain_at_peak"] = no_peak.empty() ? nlohmann::json(st.strain_at_peak) : nlohmann::json(nullptr);
+  j["peak"] = {{"reached", no_peak.empty()}};
+  if (!no_peak.empty()) {
+    j["peak"]["reason"] = no_peak;
+    j["peak"]["largest_stress_Pa"] = st.peak_stress;
+    log::warn("no UCS (null in summary.json): {}", no_peak);
+  }
+  put_elastic_fit(j, fit, "least squares on the pre-peak curve between 20% and 50% of the peak stress");
   j["cracks"] = cracks_json(sys);
   j["sample"] = sample_json(sys, info);
   j["time_step_s"] = sys.settings.dt;
@@ -234,9 +247,12 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
   j["parameters"] = params_json(cfg);
   write_json_atomic(opt.out_dir / "summary.json", j);
   make_plots(opt.out_dir, cfg);
-  log::info("UCS {:.3f} MPa at axial strain {:.3f}%, E = {:.3f} GPa, nu = {:.3f}, cracks {} ({} tensile, {} shear); {}",
-            1e-6 * st.peak_stress, 100 * st.strain_at_peak, 1e-9 * fit.youngs_modulus, fit.poisson_ratio, sys.cracks.total(),
-            sys.cracks.tensile, sys.cracks.shear, stop_reason);
+  log::info("{}, {}, cracks {} ({} tensile, {} shear); {}",
+            no_peak.empty() ? fmt::format("UCS {:.3f} MPa at axial strain {:.3f}%", 1e-6 * st.peak_stress, 100 * st.strain_at_peak)
+                            : std::string("no UCS"),
+            fit.ok() ? fmt::format("E = {:.3f} GPa, nu = {:.3f}", 1e-9 * fit.youngs_modulus, fit.poisson_ratio)
+                     : std::string("no E or nu"),
+            sys.cracks.total(), sys.cracks.tensile, sys.cracks.shear, stop_reason);
   return RunStatus::Finished;
 }
 

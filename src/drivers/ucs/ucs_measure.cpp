@@ -1,6 +1,10 @@
 #include "drivers/ucs/ucs_measure.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
+
+#include "core/log.hpp"
 
 namespace ff::drivers {
 
@@ -52,8 +56,16 @@ CompressionState CompressionGauge::measure(const dem::DemSystem& sys, const dem:
 ElasticFit fit_elastic(const std::vector<Real>& e, const std::vector<Real>& s, const std::vector<Real>& l,
                        std::size_t peak, Real lo, Real hi) {
   ElasticFit f;
-  if (e.empty() || peak >= s.size()) return f;
+  const std::string window = fmt::format("{:g}%-{:g}% of the peak", 100 * lo, 100 * hi);
+  if (e.empty() || peak >= s.size()) {
+    f.reason = "the run recorded no stress-strain curve";
+    return f;
+  }
   const Real speak = s[peak];
+  if (!(speak > 0)) {
+    f.reason = "the stress never rose above zero";
+    return f;
+  }
   Real n = 0, se = 0, ss = 0, see = 0, ses = 0, sl = 0, sel = 0;
   for (std::size_t k = 0; k <= peak; ++k) {
     if (s[k] < lo * speak || s[k] > hi * speak) continue;
@@ -67,10 +79,33 @@ ElasticFit fit_elastic(const std::vector<Real>& e, const std::vector<Real>& s, c
   }
   f.points = static_cast<int>(n);
   const Real den = n * see - se * se;
-  if (n < 2 || den <= 0) return f;
-  f.youngs_modulus = (n * ses - se * ss) / den;
+  if (n < 2) {
+    f.reason = fmt::format("{} point{} of the curve before the peak lie between {} (2 needed): the curve is sampled too "
+                           "coarsely, or the run stopped long before the stress peaked",
+                           f.points, f.points == 1 ? "" : "s", window);
+    return f;
+  }
+  if (!(den > 0)) {
+    f.reason = fmt::format("the {} points between {} all have the same axial strain", f.points, window);
+    return f;
+  }
+  const Real E = (n * ses - se * ss) / den;
+  if (!(E > 0) || !std::isfinite(E)) {
+    f.reason = fmt::format("the stress does not rise with the strain between {} (slope {:.4g} Pa)", window, E);
+    return f;
+  }
+  f.youngs_modulus = E;
   f.poisson_ratio = -(n * sel - se * sl) / den;
   return f;
+}
+
+void put_elastic_fit(nlohmann::json& j, const ElasticFit& f, const std::string& method) {
+  j["youngs_modulus_Pa"] = f.ok() ? nlohmann::json(f.youngs_modulus) : nlohmann::json(nullptr);
+  j["poisson_ratio"] = f.ok() ? nlohmann::json(f.poisson_ratio) : nlohmann::json(nullptr);
+  j["elastic_fit"] = {{"method", method}, {"points", f.points}};
+  if (f.ok()) return;
+  j["elastic_fit"]["reason"] = f.reason;
+  log::warn("no Young's modulus or Poisson's ratio (null in summary.json): {}", f.reason);
 }
 
 }  // namespace ff::drivers

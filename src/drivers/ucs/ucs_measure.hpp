@@ -3,6 +3,10 @@
 // pre-peak curve. Rock-mechanics signs: compression positive (bulging gives negative lateral
 // strain), volumetric strain = axial + 2 lateral (3D) or axial + lateral (2D).
 #pragma once
+#include <nlohmann/json.hpp>
+
+#include <limits>
+#include <string>
 #include <vector>
 
 #include "dem/dem_system.hpp"
@@ -29,12 +33,20 @@ class CompressionGauge {
 };
 
 // Young's modulus and Poisson's ratio from a least-squares line through the pre-peak points
-// whose stress lies in [lo, hi] x peak (ISRM-style average modulus; default 20%-50%).
+// whose stress lies in [lo, hi] x peak (ISRM-style average modulus; default 20%-50%). Without
+// a usable line (fewer than 2 points, no strain spread, no positive peak or slope) both are
+// NaN and `reason` says why: summary.json then holds null, never a made-up 0.
 struct ElasticFit {
-  Real youngs_modulus = 0, poisson_ratio = 0;
+  Real youngs_modulus = std::numeric_limits<Real>::quiet_NaN(), poisson_ratio = std::numeric_limits<Real>::quiet_NaN();
   int points = 0;
+  std::string reason;  // empty when the fit is usable
+  bool ok() const { return reason.empty(); }
 };
 ElasticFit fit_elastic(const std::vector<Real>& axial_strain, const std::vector<Real>& stress,
                        const std::vector<Real>& lateral_strain, std::size_t peak_index, Real lo = 0.2, Real hi = 0.5);
+
+// youngs_modulus_Pa, poisson_ratio and the "elastic_fit" block (method, points, and the reason
+// when there is no fit) of summary.json; an unusable fit also gets a warning on screen.
+void put_elastic_fit(nlohmann::json& summary, const ElasticFit& fit, const std::string& method);
 
 }  // namespace ff::drivers

@@ -68,8 +68,8 @@ TEST(TriaxialValidation, MembraneIsotropicStageAndEquilibrium) {
   }
   // Deviatoric stage: the membrane holds the confinement (mean over the loaded band) within 5%
   // up to the peak, the curve has a peak and softens to the stop fraction.
-  const auto& conf = r.series.column("confinement");
-  const auto& q = r.series.column("differential_stress");
+  const auto& conf = r.series.column("confinement_Pa");
+  const auto& q = r.series.column("differential_stress_Pa");
   std::size_t peak = 0;
   for (std::size_t k = 0; k < q.size(); ++k)
     if (q[k] > q[peak]) peak = k;

@@ -30,7 +30,7 @@ void check_ucs_curve(int dim) {
   ASSERT_EQ(test::run_scenario(test::small_ucs_scenario(dim), {}, out, 1), RunStatus::Finished);
   const auto r = test::collect(out);
   const auto& e = r.series.column("axial_strain");
-  const auto& s = r.series.column("axial_stress");
+  const auto& s = r.series.column("axial_stress_Pa");
   const auto& c = r.series.column("cracks_total");
   std::size_t peak = 0;
   for (std::size_t k = 0; k < s.size(); ++k)

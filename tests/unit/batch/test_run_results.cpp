@@ -1,0 +1,160 @@
+// What a finished run reports, through the fracflow program on tiny samples (a few seconds in
+// all): null with a reason instead of an untrustworthy number, typed parameters in every
+// driver's summary.json, units in the CSV column names, the notice of a very long run, and the
+// default scenario as the README describes it.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// ~150 spheres (as the sweep tests): about a second per run on one thread.
+const std::string kTiny =
+    " --set sample.diameter=5e-3 --set sample.height=8e-3 --set sample.porosity=0.45 --set output.vtk=false"
+    " --set output.plots=false --set output.progress_interval=0 --threads 1";
+
+fs::path scratch(const std::string& name) {
+  const auto p = fs::temp_directory_path() / ("fracflow_test_results_" + name);
+  fs::remove_all(p);
+  return p;
+}
+
+struct Result {
+  int code;
+  std::string output;
+};
+Result run_cli(const std::string& args) {
+  const std::string cmd = std::string(FRACFLOW_BIN) + " " + args + " 2>&1";
+  Result r{-1, {}};
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return r;
+  char buf[4096];
+  while (std::fgets(buf, sizeof buf, p)) r.output += buf;
+  const int st = pclose(p);
+  r.code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return r;
+}
+
+nlohmann::json read_json(const fs::path& p) {
+  std::ifstream f(p);
+  return nlohmann::json::parse(f);
+}
+
+std::string first_line(const fs::path& p) {
+  std::ifstream f(p);
+  std::string line;
+  std::getline(f, line);
+  return line;
+}
+
+bool has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+// Warning lines other than those that say a value is null (expected where a test stops a run early).
+std::string other_warnings(const std::string& output) {
+  std::istringstream in(output);
+  std::string line, out;
+  while (std::getline(in, line))
+    if (line.rfind("warning:", 0) == 0 && !has(line, "(null in summary.json)")) out += line + "\n";
+  return out;
+}
+
+}  // namespace
+
+// Stopped at ucs.max_strain = 0.1% (3 rows, stress still rising): no row lies in the 20-50%
+// window of a peak that was never reached. E, nu and the UCS are null with their reasons, and
+// the screen says so; never 0.
+TEST(RunResults, UcsWithoutFitWindowOrPeakReportsNullWithReason) {
+  const auto out = scratch("nofit");
+  const auto r = run_cli("run --out " + out.string() + kTiny + " --set ucs.max_strain=1e-3");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const auto j = read_json(out / "summary.json");
+  EXPECT_TRUE(j["youngs_modulus_Pa"].is_null()) << j.dump(2);
+  EXPECT_TRUE(j["poisson_ratio"].is_null());
+  EXPECT_LT(j["elastic_fit"]["points"].get<int>(), 2);
+  EXPECT_TRUE(j["elastic_fit"]["reason"].is_string()) << j.dump(2);
+  EXPECT_TRUE(j["ucs_Pa"].is_null());
+  EXPECT_TRUE(j["strain_at_peak"].is_null());
+  EXPECT_FALSE(j["peak"]["reached"].get<bool>());
+  EXPECT_TRUE(has(j["peak"]["reason"].get<std::string>(), "ucs.max_strain")) << j.dump(2);
+  EXPECT_TRUE(has(r.output, "warning: no Young's modulus")) << r.output;
+  EXPECT_TRUE(has(r.output, "warning: no UCS")) << r.output;
+  EXPECT_TRUE(has(r.output, "no UCS, no E or nu")) << r.output;
+  fs::remove_all(out);
+}
+
+// A full tiny run: numbers where they exist, parameters with their types, units in the columns.
+TEST(RunResults, UcsSummaryIsTypedAndColumnsCarryUnits) {
+  const auto out = scratch("ucs");
+  const auto r = run_cli("run --out " + out.string() + kTiny + " --set ucs.max_strain=0.03");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(other_warnings(r.output) + "", "") << r.output;
+  const auto j = read_json(out / "summary.json");
+  EXPECT_GT(j["ucs_Pa"].get<double>(), 0) << j.dump(2);
+  EXPECT_GT(j["youngs_modulus_Pa"].get<double>(), 0);
+  EXPECT_TRUE(j["peak"]["reached"].get<bool>());
+  const auto& p = j["parameters"];
+  EXPECT_TRUE(p["sample.porosity"].is_number_float());
+  EXPECT_TRUE(p["ucs.series_interval"].is_number_integer());
+  EXPECT_TRUE(p["output.vtk"].is_boolean());
+  EXPECT_TRUE(p["driver"].is_string());
+  EXPECT_EQ(first_line(out / "series.csv"),
+            "step,time_s,axial_strain,axial_stress_Pa,lateral_strain,volumetric_strain,cracks_tensile,cracks_shear,"
+            "cracks_total,intact_bonds,kinetic_energy_J,unbalanced_force_ratio");
+  EXPECT_EQ(first_line(out / "cracks.csv"), "time_s,x_m,y_m,z_m,nx,ny,nz,size_m,mode,group_a,group_b,particle_a,particle_b");
+  fs::remove_all(out);
+}
+
+// The flow drivers wrote every parameter as a string; now as the DEM drivers do.
+TEST(RunResults, FlowSummaryParametersKeepTheirTypes) {
+  const auto out = scratch("flow");
+  const auto r = run_cli("run " + std::string(FRACFLOW_SOURCE_DIR) + "/examples/poiseuille.toml --out " + out.string() +
+                         " --set run.end_time=0.02 --set output.vtk=false --set output.plots=false --quiet --threads 1");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const auto j = read_json(out / "summary.json");
+  const auto& p = j["parameters"];
+  EXPECT_TRUE(p["lbm.resolution"].is_number_integer()) << p.dump(2);
+  EXPECT_TRUE(p["fluid.density"].is_number_float());
+  EXPECT_TRUE(p["run.end_time"].is_number_float());
+  EXPECT_TRUE(p["output.vtk"].is_boolean());
+  EXPECT_TRUE(p["lbm.lattice"].is_string());
+  EXPECT_EQ(first_line(out / "series.csv"),
+            "step,time_s,u_max_m_per_s,u_max_analytic_m_per_s,flow_rate_m2_per_s,wall_shear_stress_Pa");
+  EXPECT_EQ(first_line(out / "profile.csv"), "y_m,u_lbm_m_per_s,u_analytic_m_per_s");
+  fs::remove_all(out);
+}
+
+// Platens at 10 um/s: ~2.7e8 steps to ucs.max_strain. The run says so, naming the keys, before
+// its first step; --max-steps stops it right after.
+TEST(RunResults, VeryLongRunPrintsItsEstimateFirst) {
+  const auto out = scratch("long");
+  const auto r = run_cli("run --out " + out.string() + kTiny + " --set ucs.platen_velocity=1e-5 --max-steps 300");
+  const auto at = r.output.find("this run needs up to");
+  ASSERT_NE(at, std::string::npos) << r.output;
+  EXPECT_TRUE(has(r.output, "million steps")) << r.output;
+  EXPECT_TRUE(has(r.output, "ucs.platen_velocity or ucs.max_strain shorten it")) << r.output;
+  const auto step = r.output.find("step 300");  // the interruption message comes after the estimate
+  if (step != std::string::npos) EXPECT_LT(at, step);
+  fs::remove_all(out);
+}
+
+// README walk-through: "about 1,700 bonded spheres", "porosity 0.40", and a run without
+// warnings. The sample alone (stopped at 0.01% strain: only the null-value warnings that cap
+// causes) matches within 3% of the count and 0.005 of the porosity.
+TEST(RunResults, DefaultScenarioBuildsTheSampleTheReadmeDescribes) {
+  const auto out = scratch("default");
+  const auto r = run_cli("run --out " + out.string() +
+                         " --set ucs.max_strain=1e-4 --set output.vtk=false --set output.plots=false --quiet --threads 1");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(other_warnings(r.output), "") << r.output;
+  const auto s = read_json(out / "summary.json")["sample"];
+  EXPECT_NEAR(s["particles"].get<double>(), 1700, 0.03 * 1700) << s.dump(2);
+  EXPECT_NEAR(s["porosity"].get<double>(), 0.40, 0.005) << s.dump(2);
+  fs::remove_all(out);
+}
