@@ -17,6 +17,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "io/json_out.hpp"
+#include "io/run_folder.hpp"
 
 namespace fs = std::filesystem;
 using namespace ff;
@@ -130,13 +131,8 @@ int run_calibrate_command(const CalibrateArgs& a) {
   const fs::path out = a.out.empty() ? fs::path("runs") / ("calibrate_" + (a.scenario.empty() ? std::string("default")
                                                                                               : fs::path(a.scenario).stem().string()))
                                      : fs::path(a.out);
-  if (fs::exists(out) && !fs::is_empty(out)) {
-    if (!a.overwrite)
-      throw InputError(fmt::format("calibration folder '{}' already holds files; pass --overwrite to replace it or "
-                                   "--out to choose another folder", out.string()));
-    fs::remove_all(out);
-  }
-  fs::create_directories(out);
+  // Replaces only a folder of ours; held locked while the calibration writes it.
+  const FolderLock out_lock = prepare_batch_folder(out, a.overwrite, "calibration folder");
   const auto& t = a.settings.target;
   log::info("calibrating {} of {} to E = {:.4g} GPa, nu = {:.3f}, UCS = {:.4g} MPa (tolerances {:.0f}%, {:.3f}, {:.0f}%), "
             "at most {} UCS runs in {}",

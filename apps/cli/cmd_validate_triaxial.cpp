@@ -22,6 +22,7 @@
 #include "commands.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "io/run_folder.hpp"
 
 namespace fs = std::filesystem;
 using namespace ff;
@@ -157,12 +158,8 @@ int run_validate(const ValidateArgs& a) {
       throw InputError(fmt::format("--laterals: '{}' is not a lateral boundary to compare; allowed: particle_membrane, "
                                    "rigid_cylinder", l));
   if (a.report_only) return write_report(a, out, start);
-  if (fs::exists(out) && !fs::is_empty(out)) {
-    if (!a.overwrite)
-      throw InputError(fmt::format("validation folder '{}' already holds files; pass --overwrite to replace it or --out "
-                                   "to choose another folder", out.string()));
-    fs::remove_all(out);
-  }
+  // Replaces only a folder of ours; held locked while the validation writes it.
+  const FolderLock out_lock = prepare_batch_folder(out, a.overwrite, "validation folder");
   fs::create_directories(out / "scenarios");
   fs::create_directories(out / "logs");
   const auto& s = a.sample;

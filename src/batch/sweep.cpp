@@ -14,6 +14,7 @@
 #include "core/log.hpp"
 #include "io/json_out.hpp"
 #include "io/plot.hpp"
+#include "io/run_folder.hpp"
 
 namespace fs = std::filesystem;
 
@@ -229,12 +230,8 @@ SweepResult run_sweep(const SweepOptions& opt) {
   }
   if (!fs::exists(opt.executable))
     throw InputError(fmt::format("sweep: the fracflow program '{}' does not exist", opt.executable.string()));
-  if (fs::exists(opt.out_dir) && !fs::is_empty(opt.out_dir)) {
-    if (!opt.overwrite)
-      throw InputError(fmt::format("sweep folder '{}' already holds files; pass --overwrite to replace it or --out to "
-                                   "choose another folder", opt.out_dir.string()));
-    fs::remove_all(opt.out_dir);
-  }
+  // Replaces only a folder of ours; held locked while the sweep writes it.
+  const FolderLock out_lock = prepare_batch_folder(opt.out_dir, opt.overwrite, "sweep folder");
   const fs::path out = fs::absolute(opt.out_dir);
   fs::create_directories(out / "logs");
   for (auto& c : r.cases) {

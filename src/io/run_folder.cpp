@@ -6,11 +6,13 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <nlohmann/json.hpp>
 
@@ -68,6 +70,15 @@ std::string utc_now() {
   char buf[32];
   std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
   return buf;
+}
+
+// This process's arguments, space-separated (for the marker of a batch folder).
+std::string process_command_line() {
+  std::ifstream in("/proc/self/cmdline", std::ios::binary);
+  std::string s((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  while (!s.empty() && s.back() == '\0') s.pop_back();
+  std::replace(s.begin(), s.end(), '\0', ' ');
+  return s;
 }
 
 bool is_empty_dir(const fs::path& dir) {
@@ -234,6 +245,38 @@ void NewRunFolder::discard_if_empty() {
   std::error_code ec;
   fs::remove_all(dir_, ec);
   begun_ = false;
+}
+
+FolderLock prepare_batch_folder(const fs::path& dir, bool overwrite, const std::string& what) {
+  refuse_protected_out_dir(dir, {});
+  std::error_code ec;
+  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+    throw InputError(fmt::format("--out '{}' is a file, not a folder; choose another folder with --out", dir.string()));
+  if (fs::exists(dir, ec) && !is_empty_dir(dir)) {
+    if (!is_fracflow_run(dir))
+      throw InputError(fmt::format("{} '{}' is not empty and holds no fracflow results (no {}), so fracflow neither "
+                                   "writes into it nor deletes it, with or without --overwrite; choose a new or empty "
+                                   "folder with --out",
+                                   what, dir.string(), run_marker_file(dir).string()));
+    if (!overwrite)
+      throw InputError(fmt::format("{} '{}' already holds results; pass --overwrite to replace it or --out to choose "
+                                   "another folder",
+                                   what, dir.string()));
+    probe_writable(dir.parent_path().empty() ? fs::path(".") : dir.parent_path());
+    FolderLock old = FolderLock::acquire(dir);  // refused while another process writes it
+    fs::remove_all(dir);
+  }
+  probe_writable(dir);
+  fs::create_directories(dir);
+  FolderLock lock = FolderLock::acquire(dir);
+  nlohmann::json marker = {{"fracflow_run", 1},
+                           {"kind", what},
+                           {"version", kVersion},
+                           {"created_utc", utc_now()},
+                           {"command", process_command_line()},
+                           {"pid", static_cast<long>(::getpid())}};
+  write_file_atomic(run_marker_file(dir), marker.dump(2) + "\n");
+  return lock;
 }
 
 std::vector<ScenarioChange> scenario_changes(const std::vector<std::pair<std::string, ParamValue>>& original,

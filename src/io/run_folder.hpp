@@ -76,6 +76,12 @@ class NewRunFolder {
   FolderLock old_lock_, lock_;
 };
 
+// The folder of a batch tool (`sweep`, `calibrate`, `validate-triaxial`; `what` names it in
+// messages, e.g. "sweep folder"): the same refusals as NewRunFolder, then, with `overwrite`, the
+// old folder of ours is deleted (the tools call this once every input has been checked), DIR is
+// created with its marker and the returned lock is held while the tool writes.
+FolderLock prepare_batch_folder(const std::filesystem::path& dir, bool overwrite, const std::string& what);
+
 // One key whose resolved value differs between the scenario at the start of a run and now.
 struct ScenarioChange {
   std::string key, before, after;  // "(absent)" when the key exists on one side only

@@ -144,6 +144,20 @@ TEST(CliRuns, OverwriteReplacesARunOfOursWithoutLeftovers) {
   EXPECT_EQ(std::distance(fs::directory_iterator(s.path), fs::directory_iterator()), 1) << "no moved-aside copy left";
 }
 
+TEST(CliRuns, BatchToolsNeverOverwriteAFolderThatHoldsNoResults) {
+  Scratch s;
+  const fs::path dir = s / "thesis";
+  fs::create_directories(dir);
+  std::ofstream(dir / "chapter1.tex") << "precious";
+  for (const std::string cmd : {"sweep --vary ucs.platen_velocity=0.2,0.3", "calibrate --target-E 2e9 --target-nu 0.3 "
+                                "--target-ucs 1e7", "validate-triaxial"}) {
+    const auto r = run(cmd + " --out " + dir.string() + " --overwrite");
+    EXPECT_EQ(r.code, 2) << cmd << "\n" << r.output;
+    EXPECT_NE(r.output.find("holds no fracflow results"), std::string::npos) << cmd << "\n" << r.output;
+  }
+  EXPECT_EQ(slurp(dir / "chapter1.tex"), "precious");
+}
+
 TEST(CliRuns, CurrentDirectoryHomeAndScenarioFolderAreRefusedWhateverTheyHold) {
   Scratch s;
   std::ofstream(s / "notes.txt") << "mine";

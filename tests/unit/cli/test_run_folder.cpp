@@ -195,3 +195,27 @@ TEST(RunFolder, ScenarioChangesNameEveryEditedKeyWithOldAndNewValue) {
   EXPECT_EQ(c[2].after, "(absent)");
   EXPECT_TRUE(scenario_changes(a, a).empty());
 }
+
+TEST(RunFolder, BatchFolderReplacesOnlyAFolderOfOurs) {
+  Scratch s;
+  const fs::path foreign = s.path / "mine";
+  touch(foreign / "data.csv", "precious");
+  for (bool overwrite : {false, true})
+    EXPECT_NE(message_of([&] { prepare_batch_folder(foreign, overwrite, "sweep folder"); }).find("holds no fracflow results"),
+              std::string::npos);
+  EXPECT_TRUE(fs::exists(foreign / "data.csv"));
+  const fs::path dir = s.path / "sweep";
+  {
+    FolderLock l = prepare_batch_folder(dir, false, "sweep folder");
+    EXPECT_TRUE(is_fracflow_run(dir));
+    touch(dir / "case_000" / "series.csv");
+    EXPECT_NE(message_of([&] { prepare_batch_folder(dir, true, "sweep folder"); }).find("in use"), std::string::npos)
+        << "a sweep still writing its folder keeps it";
+  }
+  EXPECT_NE(message_of([&] { prepare_batch_folder(dir, false, "sweep folder"); }).find("--overwrite"), std::string::npos);
+  FolderLock l = prepare_batch_folder(dir, true, "sweep folder");
+  EXPECT_FALSE(fs::exists(dir / "case_000"));
+  EXPECT_TRUE(is_fracflow_run(dir));
+  EXPECT_NE(message_of([&] { prepare_batch_folder(".", true, "sweep folder"); }).find("current directory"),
+            std::string::npos);
+}
