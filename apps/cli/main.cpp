@@ -113,13 +113,15 @@ int execute(const batch::LoadedScenario& l, RunOptions opt, NewRunFolder* folder
     const RunStatus st = l.driver->run(l.config, opt);
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const std::string dir = opt.out_dir.string();
+    // How to continue is printed even with --quiet: a stopped run must never look finished.
     if (st == RunStatus::Interrupted && folder && !folder->begun())
-      log::info("run stopped by {} before it started; nothing was written", stop_reason(opt, elapsed));
+      fmt::print("run stopped by {} before it started; nothing was written\n", stop_reason(opt, elapsed));
     else if (st == RunStatus::Interrupted)
-      log::info("run stopped by {}; a checkpoint is in {}/checkpoint. Continue with: fracflow resume {}",
-                stop_reason(opt, elapsed), dir, dir);
+      fmt::print("run stopped by {}; a checkpoint is in {}/checkpoint. Continue with: fracflow resume {}\n",
+                 stop_reason(opt, elapsed), dir, dir);
     else
       log::info("results in {}", dir);
+    std::fflush(stdout);
     return 0;
   } catch (const InputError& e) {
     log::error("{}", e.what());

@@ -246,9 +246,10 @@ namespace {
 
 // Starts a tiny run that lasts a few seconds, sends `sig` once the sample is built, and checks
 // that the run stops at once with a checkpoint, exit code 0 and a message naming the signal
-// and `fracflow resume DIR`.
-void stop_with_signal(const fs::path& dir, int sig, const std::string& name) {
+// and `fracflow resume DIR` (also with --quiet).
+void stop_with_signal(const fs::path& dir, int sig, const std::string& name, bool quiet) {
   std::vector<std::string> args = {"run", "--out", dir.string()};
+  if (quiet) args.push_back("-q");  // the way to continue is printed all the same
   std::istringstream tiny(kTiny);
   for (std::string w; tiny >> w;) args.push_back(w);
   for (const char* a : {"--set", "ucs.platen_velocity=0.004"}) args.push_back(a);  // ~3 s
@@ -276,7 +277,7 @@ void stop_with_signal(const fs::path& dir, int sig, const std::string& name) {
 TEST(CliRuns, SigintWritesACheckpointAndResumeFinishesTheRun) {
   Scratch s;
   const fs::path dir = s / "run";
-  stop_with_signal(dir, SIGINT, "SIGINT");
+  stop_with_signal(dir, SIGINT, "SIGINT", false);
   const auto r = run("resume " + dir.string() + " -q");
   EXPECT_EQ(r.code, 0) << r.output;
   EXPECT_TRUE(fs::exists(dir / "summary.json"));
@@ -284,5 +285,5 @@ TEST(CliRuns, SigintWritesACheckpointAndResumeFinishesTheRun) {
 
 TEST(CliRuns, SigtermWritesACheckpoint) {
   Scratch s;
-  stop_with_signal(s / "run", SIGTERM, "SIGTERM");
+  stop_with_signal(s / "run", SIGTERM, "SIGTERM", true);
 }
