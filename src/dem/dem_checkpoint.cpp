@@ -85,6 +85,13 @@ void save_dem(CheckpointWriter& w, const DemSystem& s) {
     w.put("dem.membrane.x", std::vector<Vec3>(x.begin(), x.end()));
     w.put("dem.membrane.v", std::vector<Vec3>(v.begin(), v.end()));
     w.put_value("dem.membrane.pressure", s.membrane->settings().pressure);
+    // Shear history of the element contacts (frictional membranes depend on it).
+    auto& m = const_cast<FlexibleMembrane&>(*s.membrane);
+    const auto cp = m.candidate_particles(), ce = m.candidate_elements();
+    const auto cs = m.contact_states();
+    w.put("dem.membrane.cand_p", std::vector<Index>(cp.begin(), cp.end()));
+    w.put("dem.membrane.cand_e", std::vector<Index>(ce.begin(), ce.end()));
+    w.put("dem.membrane.state", std::vector<ContactState>(cs.begin(), cs.end()));
   }
 }
 
@@ -161,7 +168,8 @@ void load_dem(CheckpointReader& r, DemSystem& s) {
   }
   s.wall_motion_since_build() = r.get_value<Real>("dem.wall_motion");
   // A membrane is built by the driver from its settings before load_dem(); its vertices come
-  // back here and its candidates are searched again (contact shear history starts afresh).
+  // back here, its candidates are searched again and every candidate found again gets its
+  // contact history back (both lists are sorted by particle, then element).
   if (s.membrane) {
     if (!r.has("dem.membrane.x"))
       throw InputError("checkpoint holds no flexible membrane, but the scenario has one; resume with the scenario it was written with");
@@ -171,6 +179,20 @@ void load_dem(CheckpointReader& r, DemSystem& s) {
     s.membrane->restore_vertices(x, v);
     s.membrane->set_pressure(r.get_value<Real>("dem.membrane.pressure"));
     s.rebuild_membrane_candidates();
+    if (r.has("dem.membrane.state")) {
+      std::vector<Index> op, oe;
+      std::vector<ContactState> os;
+      r.get("dem.membrane.cand_p", op);
+      r.get("dem.membrane.cand_e", oe);
+      r.get("dem.membrane.state", os);
+      const auto np = s.membrane->candidate_particles(), ne = s.membrane->candidate_elements();
+      const auto ns = s.membrane->contact_states();
+      std::size_t k = 0;
+      for (std::size_t c = 0; c < np.size(); ++c) {
+        while (k < op.size() && (op[k] < np[c] || (op[k] == np[c] && oe[k] < ne[c]))) ++k;
+        if (k < op.size() && op[k] == np[c] && oe[k] == ne[c]) ns[c] = os[k];
+      }
+    }
   }
 }
 

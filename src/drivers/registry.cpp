@@ -45,6 +45,10 @@ void declare_common_params(ParamTable& t) {
   t.boolean("output.vtk", true, "write VTK (ParaView) files under vtk/");
   t.boolean("output.plots", true, "draw the headline plots under plots/ (matplotlib via /usr/bin/python3)");
   t.real("output.progress_interval", 5.0, "s", "wall-clock seconds between status lines (0: none)").non_negative();
+  t.real("output.checkpoint_wall_interval", 60.0, "s",
+         "wall-clock seconds between checkpoints, so a killed run (kill -9, power loss) loses at most this much work; "
+         "there is also one at the end of each stage and of the run, and on SIGINT/SIGTERM/ABORT (0: none by wall clock)")
+      .non_negative();
 }
 
 ParamTable parameter_table(const Driver& d) {

@@ -8,6 +8,8 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/progress.hpp"
+#include "drivers/run_control.hpp"
+#include "drivers/run_record.hpp"
 #include "fracflow/version.hpp"
 #include "drivers/run_estimate.hpp"
 #include "drivers/summary_values.hpp"
@@ -46,7 +48,10 @@ void declare_lbm_params(ParamTable& t, const LbmDefaults& d) {
       .at_least(-1);
   t.integer("output.samples", 200, "-", "rows of series.csv over run.end_time").at_least(1);
   t.integer("output.snapshots", 10, "-", "VTK snapshots over run.end_time (plus the first and last)").non_negative();
-  t.integer("output.checkpoints", 10, "-", "checkpoints over run.end_time (there is always one at the end)").non_negative();
+  t.integer("output.checkpoints", 0, "-",
+            "extra checkpoints evenly spread over run.end_time (0: none; checkpoints come every "
+            "output.checkpoint_wall_interval seconds, at the end and on interruption)")
+      .non_negative();
 }
 
 lbm::Units make_units(const Config& cfg, double dx) {
@@ -198,7 +203,7 @@ void Runner<L, T>::write_vtk(const FlowSample& s) {
 template <class L, class T>
 void Runner<L, T>::write_checkpoint(const fs::path& dir) {
   fs::create_directories(dir);
-  CheckpointWriter w(dir / "state.ffcp");
+  CheckpointWriter w(dir / "state.ffcp", /*keep_previous=*/true);
   const auto& f = sol_->populations();
   w.put("lbm.populations", std::vector<T>(f.begin(), f.end()));
   st_.step = sol_->time_step();
@@ -212,7 +217,7 @@ void Runner<L, T>::write_checkpoint(const fs::path& dir) {
 
 template <class L, class T>
 void Runner<L, T>::read_checkpoint() {
-  CheckpointReader r(opt_.out_dir / "checkpoint" / "state.ffcp");
+  CheckpointReader r = open_checkpoint(opt_.out_dir / "checkpoint" / "state.ffcp");
   const std::string expect = fmt::format("{} {} {}x{}x{}", L::name, sizeof(T) == 8 ? "double" : "float", dom_.nx,
                                          dom_.ny, nz_);
   const std::string have = r.get_string("flow.lattice");
@@ -242,7 +247,7 @@ void Runner<L, T>::unstable(const std::string& what) {
 
 template <class L, class T>
 RunStatus Runner<L, T>::run() {
-  const auto wall_start = std::chrono::steady_clock::now();
+  RunControl control(cfg_, opt_);
   const bool tau_mode = !(cfg_.real("lbm.time_step") > 0);
   {
     const auto chk = units_.check(fc_.characteristic_speed(), fc_.resolution(), fc_.resolution_key(), tau_mode,
@@ -262,6 +267,7 @@ RunStatus Runner<L, T>::run() {
               units_.to_lattice_velocity(fc_.characteristic_speed()));
     for (auto& w : chk.warnings) log::warn("{}", w);
   }
+  begin_output(opt_);  // the lattice is built and checked: from here on files go into out_dir
   const long steps_total = std::max(1L, std::lround(cfg_.real("run.end_time") / units_.dt()));
   const long samples = cfg_.integer("output.samples");
   const long sample_every = std::max(1L, steps_total / samples);
@@ -356,12 +362,15 @@ RunStatus Runner<L, T>::run() {
     const bool done = last || steady;
     if (vtk_every > 0 && (k % vtk_every == 0 || done)) write_vtk(s);
     if (done) break;
-    if (cp_every > 0 && k % cp_every == 0) write_checkpoint(cp_dir);
-    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-    if ((opt_.max_wall_s > 0 && elapsed >= opt_.max_wall_s) || (!opt_.abort_file.empty() && fs::exists(opt_.abort_file))) {
+    if (const std::string why = control.stop_reason(sol_->time_step()); !why.empty()) {
       write_checkpoint(cp_dir);
+      log_interruption(why, sol_->time_step());
       status = RunStatus::Interrupted;
       break;
+    }
+    if (control.checkpoint_due() || (cp_every > 0 && k % cp_every == 0)) {
+      write_checkpoint(cp_dir);
+      control.checkpoint_written();
     }
     progress.update(sol_->time_step(), s.time, double(sol_->time_step()) / double(steps_total), fc_.progress_text(row_));
     long_run.update(sol_->time_step());
@@ -369,9 +378,10 @@ RunStatus Runner<L, T>::run() {
   const double loop_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - loop_start).count();
   series.close();
   if (status == RunStatus::Interrupted) return status;
+  summary(s, stop_reason, loop_s, sol_->time_step() - loop_first_step);
+  // Marked finished only once summary.json exists (a run killed before resumes and writes it).
   st_.finished = 1;
   write_checkpoint(cp_dir);
-  summary(s, stop_reason, loop_s, sol_->time_step() - loop_first_step);
   return status;
 }
 
@@ -411,6 +421,7 @@ void Runner<L, T>::summary(const FlowSample& last, const std::string& stop_reaso
   fc_.finish(last, rows, opt_.out_dir, plots, results);
   j["results"] = results;
   j["parameters"] = params_json(cfg_);  // typed, as the DEM drivers write them
+  add_run_record(j, opt_);
   write_json_atomic(opt_.out_dir / "summary.json", j);
 }
 

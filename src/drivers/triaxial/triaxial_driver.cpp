@@ -14,6 +14,8 @@
 #include "dem/dem_params.hpp"
 #include "dem/sample_builder.hpp"
 #include "drivers/dem_results.hpp"
+#include "drivers/run_control.hpp"
+#include "drivers/run_record.hpp"
 #include "drivers/run_estimate.hpp"
 #include "drivers/triaxial/triaxial_boundary.hpp"
 #include "drivers/ucs/ucs_measure.hpp"
@@ -58,7 +60,10 @@ void declare(ParamTable& t) {
   t.real("triaxial.max_strain", 0.06, "-", "stop at this axial strain (deviatoric stage) in any case").positive();
   t.integer("triaxial.series_interval", 100, "steps", "steps between rows of series.csv").positive();
   t.real("triaxial.vtk_strain_interval", 2e-3, "-", "axial strain between VTK snapshots").positive();
-  t.integer("triaxial.checkpoint_interval", 20000, "steps", "steps between checkpoints (0: only at the end and on interruption)").non_negative();
+  t.integer("triaxial.checkpoint_interval", 0, "steps",
+            "steps between extra checkpoints (0: none; checkpoints come every output.checkpoint_wall_interval seconds, at "
+            "the end of each stage and on interruption)")
+      .non_negative();
   t.integer("membrane.n_theta", 24, "-", "membrane: square units around the circumference (seed 000 demo: 16)").at_least(6);
   t.integer("membrane.n_z", 0, "-", "membrane: rows of units along the axis (0: nearly square units)").non_negative();
   t.real("membrane.length_factor", 1.2, "-", "membrane sleeve length / sample height (longer than the sample)").at_least(1);
@@ -192,10 +197,12 @@ dem::ParticleMembraneLayout add_particle_membrane(const Config& cfg, dem::DemSys
   return l;
 }
 
+// `iso_ok_rows`: rows in a row the isotropic stage has met its criteria (it ends at 5).
 void write_checkpoint(const fs::path& dir, const dem::DemSystem& sys, const TriaxialState& st, const dem::SampleInfo& info,
-                      const Lateral& lat) {
+                      const Lateral& lat, int iso_ok_rows) {
   fs::create_directories(dir);
-  CheckpointWriter w(dir / "state.ffcp");
+  CheckpointWriter w(dir / "state.ffcp", /*keep_previous=*/true);
+  w.put_value("triaxial.iso_ok_rows", iso_ok_rows);
   if (sys.membrane) w.put_value("triaxial.membrane_settings", sys.membrane->settings());
   if (lat.kind == LateralKind::ParticleMembrane) w.put_value("triaxial.particle_membrane", lat.particles);
   dem::save_dem(w, sys);
@@ -205,8 +212,9 @@ void write_checkpoint(const fs::path& dir, const dem::DemSystem& sys, const Tria
 }
 
 void read_checkpoint(const Config& cfg, const fs::path& dir, dem::DemSystem& sys, TriaxialState& st, dem::SampleInfo& info,
-                     Lateral& lat) {
-  CheckpointReader r(dir / "state.ffcp");
+                     Lateral& lat, int& iso_ok_rows) {
+  CheckpointReader r = open_checkpoint(dir / "state.ffcp");
+  iso_ok_rows = r.get_value<int>("triaxial.iso_ok_rows");
   if (r.has("triaxial.membrane_settings")) sys.membrane.emplace(r.get_value<dem::MembraneSettings>("triaxial.membrane_settings"));
   if ((lat.kind == LateralKind::ParticleMembrane) != r.has("triaxial.particle_membrane"))
     cfg.fail("triaxial.lateral", "the checkpoint was written with another lateral boundary; resume with the scenario it was "
@@ -276,6 +284,7 @@ void validate(const Config& cfg) {
 
 RunStatus run(const Config& cfg, const RunOptions& opt) {
   const auto wall_start = std::chrono::steady_clock::now();
+  RunControl control(cfg, opt);
   const Real p = cfg.real("triaxial.confining_pressure");
   const std::string lateral_name = cfg.string("triaxial.lateral");
   Lateral lat;
@@ -290,10 +299,11 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
   check_triaxial_keys(cfg);  // checked before anything is built
   dem::SampleInfo info;
   TriaxialState st;
+  int iso_ok_rows = 0;
   const std::size_t cyl = lat.cylinder_wall;  // the rigid cylinder is wall 2 (after the platens)
   const fs::path cp_dir = opt.out_dir / "checkpoint";
   if (opt.resume) {
-    read_checkpoint(cfg, cp_dir, sys, st, info, lat);
+    read_checkpoint(cfg, cp_dir, sys, st, info, lat, iso_ok_rows);
     if (st.finished) {
       log::info("this run had already finished; nothing to resume");
       return RunStatus::Finished;
@@ -312,6 +322,7 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
     }
     dem::choose_time_step(cfg, sys);
     if (kind == LateralKind::ParticleMembrane) lat.particles = add_particle_membrane(cfg, sys, info);
+    begin_output(opt);  // sample and boundary are built: from here on files go into out_dir
   }
   const Real area = info.area;  // initial cross-section (stresses on it, as the UCS test)
   // The sample proper: a particle membrane's spheres and group come after the sample's.
@@ -344,6 +355,10 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
 
   const long every = cfg.integer("triaxial.series_interval");
   const long cp_every = cfg.integer("triaxial.checkpoint_interval");
+  auto checkpoint = [&] {
+    write_checkpoint(cp_dir, sys, st, info, lat, iso_ok_rows);
+    control.checkpoint_written();
+  };
   const long iso_max = cfg.integer("triaxial.isotropic_max_steps");
   const Real iso_tol = cfg.real("triaxial.isotropic_tolerance");
   const Real iso_ubf = cfg.real("triaxial.isotropic_unbalanced_ratio");
@@ -361,7 +376,6 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
     s_hist = t.column("differential_stress_Pa");
     l_hist = t.column("lateral_strain");
   }
-  int iso_ok_rows = 0;
   RunStatus status = RunStatus::Finished;
   std::string stop_reason;
 
@@ -375,6 +389,7 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
     st.iso_cracks = static_cast<int>(sys.cracks.total());
     series.open(opt.out_dir / "series.csv", cols);
     if (vtk) writer.write(sys, st.vtk_index++, extent);
+    checkpoint();  // the end of a stage
   };
 
   try {
@@ -499,18 +514,17 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
       dem::append_cracks_csv(cracks_csv, sys.cracks, sys.materials, static_cast<std::size_t>(st.cracks_written));
       st.cracks_written = static_cast<long>(sys.cracks.events.size());
       if (!stop_reason.empty()) break;
-      if (cp_every > 0 && (sys.step_count / every) % std::max(1L, cp_every / every) == 0)
-        write_checkpoint(cp_dir, sys, st, info, lat);
-      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-      if ((opt.max_wall_s > 0 && elapsed >= opt.max_wall_s) || (opt.max_steps > 0 && sys.step_count >= opt.max_steps) ||
-          (!opt.abort_file.empty() && fs::exists(opt.abort_file))) {
-        write_checkpoint(cp_dir, sys, st, info, lat);
+      if (const std::string why = control.stop_reason(sys.step_count); !why.empty()) {
+        checkpoint();
+        log_interruption(why, sys.step_count);
         status = RunStatus::Interrupted;
         break;
       }
+      if (control.checkpoint_due() || (cp_every > 0 && (sys.step_count / every) % std::max(1L, cp_every / every) == 0))
+        checkpoint();
     }
   } catch (const NumericalError&) {
-    write_checkpoint(opt.out_dir / "checkpoint_failed", sys, st, info, lat);
+    write_checkpoint(opt.out_dir / "checkpoint_failed", sys, st, info, lat, iso_ok_rows);
     series.close();
     iso.close();
     throw;
@@ -519,8 +533,6 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
   iso.close();
   if (status == RunStatus::Interrupted) return status;
 
-  st.finished = 1;
-  write_checkpoint(cp_dir, sys, st, info, lat);
   if (vtk) writer.write(sys, st.vtk_index++, extent);
   const ElasticFit fit = fit_elastic(e_hist, s_hist, l_hist, static_cast<std::size_t>(st.peak_row));
   nlohmann::json j;
@@ -591,8 +603,12 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
   j["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   j["threads"] = opt.threads;
   j["parameters"] = params_json(cfg);
+  add_run_record(j, opt);
   write_json_atomic(opt.out_dir / "summary.json", j);
   make_plots(opt.out_dir, cfg);
+  // Marked finished only once summary.json exists (a run killed before resumes and writes it).
+  st.finished = 1;
+  checkpoint();
   log::info("triaxial sigma3 = {:.3f} MPa: {}, {}, cracks {} ({} tensile, {} shear); {}", 1e-6 * p,
             no_peak.empty() ? fmt::format("peak differential stress {:.3f} MPa at axial strain {:.3f}%", 1e-6 * st.peak_diff,
                                           100 * st.strain_at_peak)

@@ -14,7 +14,9 @@
 #include "dem/dem_params.hpp"
 #include "dem/sample_builder.hpp"
 #include "drivers/dem_results.hpp"
+#include "drivers/run_control.hpp"
 #include "drivers/run_estimate.hpp"
+#include "drivers/run_record.hpp"
 #include "drivers/ucs/ucs_measure.hpp"
 #include "fracflow/version.hpp"
 #include "io/csv.hpp"
@@ -36,7 +38,10 @@ void declare(ParamTable& t) {
   t.real("ucs.max_strain", 0.05, "-", "stop at this axial strain in any case").positive();
   t.integer("ucs.series_interval", 100, "steps", "steps between rows of series.csv").positive();
   t.real("ucs.vtk_strain_interval", 1e-3, "-", "axial strain between VTK snapshots").positive();
-  t.integer("ucs.checkpoint_interval", 20000, "steps", "steps between checkpoints (0: only at the end and on interruption)").non_negative();
+  t.integer("ucs.checkpoint_interval", 0, "steps",
+            "steps between extra checkpoints (0: none; checkpoints come every output.checkpoint_wall_interval seconds, at "
+            "the end and on interruption)")
+      .non_negative();
 }
 
 // Column names end in their SI unit (_s, _Pa, _J); strains, counts and ratios have none.
@@ -63,20 +68,26 @@ template <> struct is_checkpoint_pod<dem::SampleInfo> : std::false_type {};
 namespace ff::drivers {
 namespace {
 
-void write_checkpoint(const fs::path& dir, const dem::DemSystem& sys, const UcsState& st, const dem::SampleInfo& info) {
+void write_checkpoint(const fs::path& dir, const dem::DemSystem& sys, const UcsState& st, const dem::SampleInfo& info,
+                      const CompressionGauge& gauge) {
   fs::create_directories(dir);
-  CheckpointWriter w(dir / "state.ffcp");
+  CheckpointWriter w(dir / "state.ffcp", /*keep_previous=*/true);
   dem::save_dem(w, sys);
   w.put_value("ucs.state", st);
   w.put_value("ucs.sample", sample_record(info));
+  w.put("ucs.gauge", gauge.particles());
   w.commit();
 }
 
-void read_checkpoint(const fs::path& dir, dem::DemSystem& sys, UcsState& st, dem::SampleInfo& info) {
-  CheckpointReader r(dir / "state.ffcp");
+void read_checkpoint(const fs::path& dir, dem::DemSystem& sys, UcsState& st, dem::SampleInfo& info,
+                     CompressionGauge& gauge) {
+  CheckpointReader r = open_checkpoint(dir / "state.ffcp");
   dem::load_dem(r, sys);
   st = r.get_value<UcsState>("ucs.state");
   info = sample_info(r.get_value<SampleRecord>("ucs.sample"));
+  std::vector<Index> g;
+  r.get("ucs.gauge", g);
+  gauge.restore(std::move(g), st.h0);
 }
 
 void make_plots(const fs::path& out, const Config& cfg) {
@@ -94,14 +105,16 @@ void make_plots(const fs::path& out, const Config& cfg) {
 
 RunStatus run(const Config& cfg, const RunOptions& opt) {
   const auto wall_start = std::chrono::steady_clock::now();
+  RunControl control(cfg, opt);
   dem::DemSystem sys;
   sys.settings = dem::build_settings(cfg);
   sys.materials = dem::build_materials(cfg);
   dem::SampleInfo info;
   UcsState st;
+  CompressionGauge gauge;
   const fs::path cp_dir = opt.out_dir / "checkpoint";
   if (opt.resume) {
-    read_checkpoint(cp_dir, sys, st, info);
+    read_checkpoint(cp_dir, sys, st, info, gauge);
     if (st.finished) {
       log::info("this run had already finished; nothing to resume");
       return RunStatus::Finished;
@@ -114,11 +127,10 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
     const Real v = cfg.real("ucs.platen_velocity");
     sys.walls[0].velocity[info.axis] = v;
     sys.walls[1].velocity[info.axis] = -v;
+    gauge.init(sys, info);
+    st.h0 = gauge.initial_height();
+    begin_output(opt);  // the sample is built: from here on files go into out_dir
   }
-  CompressionGauge gauge;
-  gauge.init(sys, info);
-  if (opt.resume) gauge.set_initial_height(st.h0);
-  else st.h0 = gauge.initial_height();
 
   // Outputs (on resume: rows and snapshots after the checkpoint are dropped; they are
   // recomputed identically).
@@ -144,6 +156,10 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
 
   const long series_every = cfg.integer("ucs.series_interval");
   const long cp_every = cfg.integer("ucs.checkpoint_interval");
+  auto checkpoint = [&] {
+    write_checkpoint(cp_dir, sys, st, info, gauge);
+    control.checkpoint_written();
+  };
   const Real stop_fraction = cfg.real("ucs.stop_fraction"), max_strain = cfg.real("ucs.max_strain");
   const Real vtk_every = cfg.real("ucs.vtk_strain_interval");
   Progress progress("ucs", opt.progress_interval_s);
@@ -198,27 +214,25 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
                                   sys.cracks.total()));
       long_run.update(sys.step_count);
       if (!stop_reason.empty()) break;
-      if (cp_every > 0 && (sys.step_count / series_every) % std::max(1L, cp_every / series_every) == 0)
-        write_checkpoint(cp_dir, sys, st, info);
-      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-      if ((opt.max_wall_s > 0 && elapsed >= opt.max_wall_s) || (opt.max_steps > 0 && sys.step_count >= opt.max_steps) ||
-          (!opt.abort_file.empty() && fs::exists(opt.abort_file))) {
-        write_checkpoint(cp_dir, sys, st, info);
+      if (const std::string why = control.stop_reason(sys.step_count); !why.empty()) {
+        checkpoint();
+        log_interruption(why, sys.step_count);
         status = RunStatus::Interrupted;
         break;
       }
+      if (control.checkpoint_due() ||
+          (cp_every > 0 && (sys.step_count / series_every) % std::max(1L, cp_every / series_every) == 0))
+        checkpoint();
     }
   } catch (const NumericalError&) {
     // Keep the last good checkpoint; save the failing state beside it for inspection.
-    write_checkpoint(opt.out_dir / "checkpoint_failed", sys, st, info);
+    write_checkpoint(opt.out_dir / "checkpoint_failed", sys, st, info, gauge);
     series.close();
     throw;
   }
   series.close();
   if (status == RunStatus::Interrupted) return status;
 
-  st.finished = 1;
-  write_checkpoint(cp_dir, sys, st, info);
   if (vtk) writer.write(sys, st.vtk_index++, extent);
   const ElasticFit fit = fit_elastic(e_hist, s_hist, l_hist, static_cast<std::size_t>(st.peak_row));
   nlohmann::json j;
@@ -245,8 +259,13 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
   j["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   j["threads"] = opt.threads;
   j["parameters"] = params_json(cfg);
+  add_run_record(j, opt);
   write_json_atomic(opt.out_dir / "summary.json", j);
   make_plots(opt.out_dir, cfg);
+  // Marked finished only once summary.json exists: a run killed before this point resumes from
+  // the last checkpoint and writes it again.
+  st.finished = 1;
+  checkpoint();
   log::info("{}, {}, cracks {} ({} tensile, {} shear); {}",
             no_peak.empty() ? fmt::format("UCS {:.3f} MPa at axial strain {:.3f}%", 1e-6 * st.peak_stress, 100 * st.strain_at_peak)
                             : std::string("no UCS"),

@@ -25,7 +25,13 @@ class CompressionGauge {
   void init(const dem::DemSystem& sys, const dem::SampleInfo& info);
   CompressionState measure(const dem::DemSystem& sys, const dem::SampleInfo& info) const;
   Real initial_height() const { return h0_; }
-  void set_initial_height(Real h) { h0_ = h; }
+  // The gauge particles, for checkpoints: on resume they are restored, never re-selected (the
+  // platens have moved since, so a new selection would pick other particles).
+  const std::vector<Index>& particles() const { return gauge_; }
+  void restore(std::vector<Index> particles, Real h0) {
+    gauge_ = std::move(particles);
+    h0_ = h0;
+  }
 
  private:
   std::vector<Index> gauge_;

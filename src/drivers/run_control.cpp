@@ -1,0 +1,44 @@
+#include "drivers/run_control.hpp"
+
+#include <fmt/format.h>
+
+#include <csignal>
+#include <filesystem>
+
+#include "core/interrupt.hpp"
+#include "core/log.hpp"
+
+namespace ff::drivers {
+
+RunControl::RunControl(const Config& cfg, const RunOptions& opt)
+    : opt_(opt), wall_interval_s_(cfg.real("output.checkpoint_wall_interval")), start_(Clock::now()),
+      last_checkpoint_(start_) {}
+
+double RunControl::elapsed_s() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
+
+bool RunControl::checkpoint_due() const {
+  return wall_interval_s_ > 0 && std::chrono::duration<double>(Clock::now() - last_checkpoint_).count() >= wall_interval_s_;
+}
+
+void RunControl::checkpoint_written() { last_checkpoint_ = Clock::now(); }
+
+std::string RunControl::stop_reason(long step) const {
+  if (stop_requested()) {
+    const int sig = stop_signal();
+    if (sig == SIGINT) return "SIGINT (Ctrl-C) received";
+    if (sig == SIGTERM) return "SIGTERM received";
+    return sig > 0 ? fmt::format("signal {} received", sig) : std::string("stop requested");
+  }
+  if (!opt_.abort_file.empty() && std::filesystem::exists(opt_.abort_file))
+    return fmt::format("the file {} appeared", opt_.abort_file.string());
+  if (opt_.max_steps > 0 && step >= opt_.max_steps) return fmt::format("step {} reached (--max-steps)", opt_.max_steps);
+  if (opt_.max_wall_s > 0 && elapsed_s() >= opt_.max_wall_s)
+    return fmt::format("{} s of wall-clock time reached (--max-wall)", opt_.max_wall_s);
+  return {};
+}
+
+void log_interruption(const std::string& reason, long step) {
+  log::info("{}: checkpoint written at step {}; the run stops here", reason, step);
+}
+
+}  // namespace ff::drivers

@@ -1,0 +1,51 @@
+// Comparison of an interrupted-and-resumed run with an uninterrupted one: series.csv, cracks.csv
+// and summary.json must be byte for byte the same, apart from the timings in summary.json
+// (wall_time_s, mlups and any key ending in _seconds), which measure the machine, not the run.
+#pragma once
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <functional>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+namespace ff::test {
+
+inline std::string read_bytes(const std::filesystem::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+// summary.json without its timings, as text (so a difference shows in the failure message).
+inline std::string summary_without_timings(const std::filesystem::path& dir) {
+  auto j = nlohmann::json::parse(read_bytes(dir / "summary.json"));
+  std::function<void(nlohmann::json&)> strip = [&](nlohmann::json& x) {
+    if (!x.is_object()) return;
+    for (auto it = x.begin(); it != x.end();) {
+      const std::string& k = it.key();
+      const bool timing = k == "wall_time_s" || k == "mlups" ||
+                          (k.size() > 8 && k.compare(k.size() - 8, 8, "_seconds") == 0);
+      if (timing) it = x.erase(it);
+      else strip(*it++);
+    }
+  };
+  strip(j);
+  return j.dump(1);
+}
+
+// Every result file of `resumed` equals that of `whole` (cracks.csv where the driver writes one).
+inline void expect_same_results(const std::filesystem::path& whole, const std::filesystem::path& resumed,
+                                const std::string& what) {
+  ASSERT_TRUE(std::filesystem::exists(resumed / "summary.json")) << what;
+  EXPECT_TRUE(read_bytes(whole / "series.csv") == read_bytes(resumed / "series.csv")) << what << ": series.csv differs";
+  if (std::filesystem::exists(whole / "cracks.csv")) {
+    EXPECT_TRUE(read_bytes(whole / "cracks.csv") == read_bytes(resumed / "cracks.csv")) << what << ": cracks.csv differs";
+  }
+  EXPECT_EQ(summary_without_timings(whole), summary_without_timings(resumed)) << what << ": summary.json differs";
+}
+
+}  // namespace ff::test
