@@ -264,7 +264,10 @@ int main(int argc, char** argv) {
       if (!fs::exists(dir / "scenario.toml"))
         throw InputError(fmt::format("'{}' is not a fracflow results folder (no scenario.toml)", resume_dir));
       if (!fs::exists(dir / "checkpoint"))
-        throw InputError(fmt::format("'{}' has no checkpoint/ to resume from", resume_dir));
+        throw InputError(fmt::format("'{}' has no checkpoint/ to resume from (the run stopped before writing one); "
+                                     "run it again with fracflow run SCENARIO --out {} --overwrite ({}/scenario.toml "
+                                     "holds its parameters: copy it out of the folder to use it as SCENARIO)",
+                                     resume_dir, resume_dir, resume_dir));
       const FolderLock lock = FolderLock::acquire(dir);  // one writer per folder, until this process ends
       auto l = batch::load_scenario_for_run((dir / "scenario.toml").string(), {}, /*resume=*/true);
       opt.accepted_scenario_changes = edited_scenario(dir, *l, accept_edited);

@@ -230,6 +230,21 @@ TEST(CliRuns, EditedScenarioIsRefusedAtResumeUnlessAccepted) {
   EXPECT_EQ(summary["resumed_with_edited_scenario"][0], "ucs.platen_velocity: " + old_line.substr(18) + " -> 0.25");
 }
 
+TEST(CliRuns, ResumeWithoutACheckpointSaysHowToStartAgainAndThatWorks) {
+  // kill -9 before the first checkpoint: the folder has its marker and scenario.toml only.
+  Scratch s;
+  const fs::path dir = s / "run";
+  interrupted_run(dir);
+  fs::remove_all(dir / "checkpoint");
+  auto r = run("resume " + dir.string() + " -q");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("--out " + dir.string() + " --overwrite"), std::string::npos) << r.output;
+  fs::copy_file(dir / "scenario.toml", s / "again.toml");
+  r = run("run " + (s / "again.toml").string() + " --out " + dir.string() + " --overwrite -q");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(dir / "summary.json"));
+}
+
 TEST(CliRuns, ResumeOfARunWithoutMarkerStillWorks) {
   // Runs made before results folders carried .fracflow/ resume as before, and lose nothing.
   Scratch s;
