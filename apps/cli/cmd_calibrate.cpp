@@ -195,7 +195,9 @@ int run_calibrate_command(const CalibrateArgs& a) {
     // A run without a peak or an elastic fit has nothing to update from (null in summary.json).
     if (!std::isfinite(s.youngs_modulus_Pa) || !std::isfinite(s.poisson_ratio) || !std::isfinite(s.ucs_Pa))
       throw Error(fmt::format("calibration run {} measured no {}: {}; see {}", it,
-                              std::isfinite(s.ucs_Pa) ? "E and nu" : "UCS",
+                              !std::isfinite(s.ucs_Pa) && !std::isfinite(s.youngs_modulus_Pa) ? "UCS, E or nu"
+                              : std::isfinite(s.ucs_Pa)                                       ? "E or nu"
+                                                                                              : "UCS",
                               s.missing.empty() ? "summary.json holds no value" : s.missing, run.out_dir.string()));
     MacroProperties m{s.youngs_modulus_Pa, s.poisson_ratio, s.ucs_Pa, 0.0};
     if (measure_slope) {

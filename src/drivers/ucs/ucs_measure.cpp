@@ -80,9 +80,9 @@ ElasticFit fit_elastic(const std::vector<Real>& e, const std::vector<Real>& s, c
   f.points = static_cast<int>(n);
   const Real den = n * see - se * se;
   if (n < 2) {
-    f.reason = fmt::format("{} point{} of the curve before the peak lie between {} (2 needed): the curve is sampled too "
+    f.reason = fmt::format("{} point{} of the curve before the peak {} between {} (2 needed): the curve is sampled too "
                            "coarsely, or the run stopped long before the stress peaked",
-                           f.points, f.points == 1 ? "" : "s", window);
+                           f.points, f.points == 1 ? "" : "s", f.points == 1 ? "lies" : "lie", window);
     return f;
   }
   if (!(den > 0)) {

@@ -158,3 +158,20 @@ TEST(RunResults, DefaultScenarioBuildsTheSampleTheReadmeDescribes) {
   EXPECT_NEAR(s["porosity"].get<double>(), 0.40, 0.005) << s.dump(2);
   fs::remove_all(out);
 }
+
+// A calibration run whose E, nu and UCS are null stops the calibration with their reasons; it
+// never enters the update as 0.
+TEST(RunResults, CalibrationRefusesARunWithoutPeakOrFit) {
+  const auto out = scratch("calibrate");
+  std::string sets;
+  for (const char* s : {"sample.diameter=5e-3", "sample.height=8e-3", "sample.porosity=0.45", "output.vtk=false",
+                        "output.plots=false", "ucs.max_strain=1e-3"})
+    sets += std::string(" --set ") + s;
+  const auto r = run_cli("calibrate --target-E 2.37e9 --target-nu 0.35 --target-ucs 14.97e6 --max-iter 3 --out " +
+                         out.string() + sets);
+  EXPECT_NE(r.code, 0) << r.output;
+  EXPECT_TRUE(has(r.output, "calibration run 1 measured no UCS, E or nu")) << r.output;
+  EXPECT_TRUE(has(r.output, "raise ucs.max_strain")) << r.output;
+  EXPECT_FALSE(fs::exists(out / "iter_02")) << "a second run was started from a run without results";
+  fs::remove_all(out);
+}
