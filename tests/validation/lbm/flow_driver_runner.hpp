@@ -20,11 +20,11 @@ inline std::filesystem::path flow_test_dir(const std::string& name) {
   return std::filesystem::temp_directory_path() / "fracflow_lbm_validation" / name;
 }
 
-// Runs (or, with resume, continues) the scenario in flow_test_dir(name); max_wall_s > 0 stops
-// it early with a checkpoint, as `fracflow run --max-wall` does.
+// Runs (or, with resume, continues) the scenario in flow_test_dir(name); max_wall_s > 0 or
+// max_steps > 0 stops it early with a checkpoint, as `fracflow run --max-wall/--max-steps` do.
 inline RunStatus run_flow_driver_status(const std::string& name, const std::string& scenario,
                                         const std::vector<std::string>& sets, bool resume = false,
-                                        double max_wall_s = 0) {
+                                        double max_wall_s = 0, long max_steps = 0) {
   const Driver& d = find_driver(peek_driver(scenario, name));
   const ParamTable table = parameter_table(d);
   const Config cfg = load_scenario(table, "", scenario, sets);
@@ -38,6 +38,7 @@ inline RunStatus run_flow_driver_status(const std::string& name, const std::stri
   opt.progress_interval_s = 0;
   opt.resume = resume;
   opt.max_wall_s = max_wall_s;
+  opt.max_steps = max_steps;
   log::quiet() = true;
   return d.run(cfg, opt);
 }

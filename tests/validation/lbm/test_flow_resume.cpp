@@ -7,7 +7,9 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "flow_driver_runner.hpp"
+#include "resume_compare.hpp"
 
 namespace {
 
@@ -89,4 +91,88 @@ TEST(LbmFlowResume, UnstableRunStopsWithAFix) {
     EXPECT_NE(std::string(e.what()).find("lbm.resolution"), std::string::npos) << e.what();
     EXPECT_TRUE(std::filesystem::exists(ff::testing::flow_test_dir("unstable_run") / "checkpoint_failed" / "state.ffcp"));
   }
+}
+
+// Every flow driver, interrupted at several points (during the inflow ramp, mid-run, and
+// resume -> interrupt -> resume) by --max-steps, gives the same series.csv, summary.json
+// (timings excepted: resume_compare.hpp) and VTK series as the uninterrupted run.
+namespace {
+
+const char* kPoiseuille = R"(
+driver = "flow/poiseuille"
+[channel]
+height = 1.0e-3
+length = 1.0e-3
+[lbm]
+resolution = 10
+[run]
+end_time = 2.0
+steady_tolerance = 1.0e-7
+[output]
+samples = 40
+snapshots = 4
+plots = false
+)";
+
+const char* kCavity = R"(
+driver = "flow/cavity"
+[cavity]
+size = 0.1
+lid_velocity = 1.0e-3
+[fluid]
+viscosity = 1.0e-6
+[lbm]
+resolution = 12
+tau = 0.55
+[run]
+end_time = 2000
+[output]
+samples = 40
+snapshots = 4
+plots = false
+)";
+
+void expect_every_resume_identical(const std::string& name, const std::string& text, const std::vector<std::string>& sets) {
+  using namespace ff::testing;
+  const auto whole = flow_test_dir(name + "_whole"), cut = flow_test_dir(name + "_cut");
+  ASSERT_EQ(run_flow_driver_status(name + "_whole", text, sets), ff::RunStatus::Finished);
+  const long n = read_summary(name + "_whole")["steps"];
+  for (const std::vector<long>& stops : {std::vector<long>{n / 4}, std::vector<long>{n / 2, 3 * n / 4}}) {
+    std::string what = name + " interrupted at";
+    for (std::size_t k = 0; k < stops.size(); ++k) {
+      ASSERT_EQ(run_flow_driver_status(name + "_cut", text, sets, k > 0, 0, stops[k]), ff::RunStatus::Interrupted);
+      what += " " + std::to_string(stops[k]);
+    }
+    ASSERT_EQ(run_flow_driver_status(name + "_cut", text, sets, true), ff::RunStatus::Finished) << what;
+    ff::test::expect_same_results(whole, cut, what);
+    EXPECT_EQ(slurp(whole / "vtk" / "flow.pvd"), slurp(cut / "vtk" / "flow.pvd")) << what;
+  }
+}
+
+}  // namespace
+
+TEST(LbmFlowResume, PoiseuilleResumedAtSeveralPointsIsBitForBit) {
+  expect_every_resume_identical("every_poiseuille", kPoiseuille, {});
+}
+TEST(LbmFlowResume, PoiseuilleVelocityInletD3Q19ResumedAtSeveralPointsIsBitForBit) {
+  expect_every_resume_identical("every_poiseuille_v", kPoiseuille,
+                                {"channel.drive=\"velocity\"", "lbm.lattice=\"D3Q19\"", "lbm.depth_cells=2"});
+}
+TEST(LbmFlowResume, CavityResumedAtSeveralPointsIsBitForBit) { expect_every_resume_identical("every_cavity", kCavity, {}); }
+TEST(LbmFlowResume, CylinderResumedInTheRampAndAfterIsBitForBit) {
+  // The inflow ramp (20 domain lengths at the sound speed, ~2500 steps) covers the first stop.
+  expect_every_resume_identical("every_cylinder", kCylinder, {"output.checkpoints=0"});
+}
+
+TEST(LbmFlowResume, StopRequestWritesACheckpointAndResumes) {
+  using namespace ff::testing;
+  ASSERT_EQ(run_flow_driver_status("sig_whole", kCavity, {}), ff::RunStatus::Finished);
+  ff::request_stop(15);  // SIGTERM before the run: stops at the first sample
+  const auto st = run_flow_driver_status("sig_cut", kCavity, {});
+  ff::clear_stop_request();
+  ASSERT_EQ(st, ff::RunStatus::Interrupted);
+  EXPECT_TRUE(std::filesystem::exists(flow_test_dir("sig_cut") / "checkpoint" / "state.ffcp"));
+  EXPECT_FALSE(std::filesystem::exists(flow_test_dir("sig_cut") / "summary.json"));
+  ASSERT_EQ(run_flow_driver_status("sig_cut", kCavity, {}, true), ff::RunStatus::Finished);
+  ff::test::expect_same_results(flow_test_dir("sig_whole"), flow_test_dir("sig_cut"), "stopped by SIGTERM");
 }
