@@ -1,5 +1,5 @@
-// Long (label long): `fracflow calibrate` on the built-in default sample (1,789 spheres) to the
-// seed 000 Table 5 averages, E = 2.37 GPa, nu = 0.35, UCS = 14.97 MPa; each UCS run ~15-40 s.
+// Long (label long): `fracflow calibrate` on the built-in default sample (1,727 spheres) to the
+// seed 000 Table 5 averages, E = 2.37 GPa, nu = 0.35, UCS = 14.97 MPa; 2 UCS runs of ~13 s each.
 #include <gtest/gtest.h>
 
 #include <cmath>
