@@ -37,6 +37,17 @@ inline std::string summary_without_timings(const std::filesystem::path& dir) {
   return j.dump(1);
 }
 
+// The first line where two texts differ, as "whole | resumed".
+inline std::string first_difference(const std::string& a, const std::string& b) {
+  std::istringstream sa(a), sb(b);
+  std::string la, lb;
+  while (true) {
+    const bool ga = static_cast<bool>(std::getline(sa, la)), gb = static_cast<bool>(std::getline(sb, lb));
+    if (!ga && !gb) return "(no difference)";
+    if (!ga || !gb || la != lb) return (ga ? la : "(end)") + " | " + (gb ? lb : "(end)");
+  }
+}
+
 // Every result file of `resumed` equals that of `whole` (cracks.csv where the driver writes one).
 inline void expect_same_results(const std::filesystem::path& whole, const std::filesystem::path& resumed,
                                 const std::string& what) {
@@ -45,7 +56,8 @@ inline void expect_same_results(const std::filesystem::path& whole, const std::f
   if (std::filesystem::exists(whole / "cracks.csv")) {
     EXPECT_TRUE(read_bytes(whole / "cracks.csv") == read_bytes(resumed / "cracks.csv")) << what << ": cracks.csv differs";
   }
-  EXPECT_EQ(summary_without_timings(whole), summary_without_timings(resumed)) << what << ": summary.json differs";
+  const std::string a = summary_without_timings(whole), b = summary_without_timings(resumed);
+  EXPECT_TRUE(a == b) << what << ": summary.json differs first at\n  " << first_difference(a, b);
 }
 
 }  // namespace ff::test
