@@ -89,6 +89,63 @@ TEST(RunResults, UcsWithoutFitWindowOrPeakReportsNullWithReason) {
   fs::remove_all(out);
 }
 
+// The same in the triaxial driver (rigid cylinder, ~150 spheres, under a second): stopped at
+// triaxial.max_strain = 0.03% of the deviatoric stage, the peak and E, nu are null with reasons.
+TEST(RunResults, TriaxialWithoutPeakReportsNullWithReasonAndUnitColumns) {
+  const auto out = scratch("triaxial");
+  const fs::path scenario = fs::temp_directory_path() / "fracflow_test_results_triaxial.toml";
+  std::ofstream(scenario) << R"(driver = "triaxial"
+[dem]
+dim = 3
+[dem.group.matrix]
+density = 1390
+[dem.contact.matrix-matrix]
+emod = 2.09e9
+kratio = 14.65
+friction = 0.4
+[dem.bond.matrix-matrix]
+emod = 2.09e9
+kratio = 14.65
+tensile_strength = 17.4e6
+cohesion = 4.35e6
+friction_angle = 4.0
+[sample]
+shape = "cylinder"
+diameter = 5e-3
+height = 8e-3
+radius_min = 0.4e-3
+radius_max = 0.6e-3
+porosity = 0.45
+bond_gap = 0.05e-3
+[triaxial]
+confining_pressure = 1e6
+lateral = "rigid_cylinder"
+max_strain = 3e-4
+[output]
+vtk = false
+plots = false
+progress_interval = 0
+)";
+  const auto r = run_cli("run " + scenario.string() + " --out " + out.string() + " --threads 1");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const auto j = read_json(out / "summary.json");
+  for (const char* key : {"peak_differential_stress_Pa", "peak_axial_stress_Pa", "confinement_at_peak_Pa", "strain_at_peak",
+                          "youngs_modulus_Pa", "poisson_ratio"})
+    EXPECT_TRUE(j[key].is_null()) << key << ": " << j.dump(2);
+  EXPECT_TRUE(has(j["peak"]["reason"].get<std::string>(), "triaxial.max_strain")) << j.dump(2);
+  EXPECT_TRUE(j["elastic_fit"]["reason"].is_string()) << j.dump(2);
+  EXPECT_TRUE(has(r.output, "warning: no peak differential stress")) << r.output;
+  EXPECT_TRUE(j["parameters"]["triaxial.confining_pressure"].is_number_float());
+  EXPECT_TRUE(j["parameters"]["triaxial.isotropic_max_steps"].is_number_integer());
+  EXPECT_EQ(first_line(out / "isotropic.csv"), "step,time_s,axial_stress_Pa,confinement_Pa,unbalanced_force_ratio");
+  EXPECT_EQ(first_line(out / "series.csv").rfind("step,time_s,axial_strain,axial_stress_Pa,differential_stress_Pa,"
+                                                 "confinement_Pa,",
+                                                 0),
+            0u);
+  fs::remove_all(out);
+  fs::remove(scenario);
+}
+
 // A full tiny run: numbers where they exist, parameters with their types, units in the columns.
 TEST(RunResults, UcsSummaryIsTypedAndColumnsCarryUnits) {
   const auto out = scratch("ucs");
