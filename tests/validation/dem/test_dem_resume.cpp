@@ -29,7 +29,8 @@ void expect_resume_chain_identical(const std::string& text, const std::vector<st
   std::string what = "interrupted at";
   for (std::size_t k = 0; k < stops.size(); ++k) {
     ASSERT_EQ(test::run_scenario(text, sets, cut, 1, stops[k], k > 0), RunStatus::Interrupted) << stops[k];
-    what += " " + std::to_string(stops[k]);
+    what += ' ';
+    what += std::to_string(stops[k]);
   }
   ASSERT_EQ(test::run_scenario(text, sets, cut, 1, 0, true), RunStatus::Finished);
   test::expect_same_results(whole, cut, what);
@@ -127,10 +128,50 @@ void triaxial_resume(const std::string& lateral) {
   ASSERT_LT(iso_end, n);
   const long mid_iso = iso_end / 2 / 50 * 50, mid_dev = (iso_end + n) / 2;
   expect_resume_chain_identical(text, sets, a, b, {mid_iso}, false);
+  // Checkpoints by wall clock are 60 s apart: a short run's older checkpoint is the one written
+  // at the end of the isotropic stage.
+  EXPECT_EQ(CheckpointReader(a / "checkpoint" / "state.prev.ffcp").get_value<long>("dem.step"), iso_end);
   expect_resume_chain_identical(text, sets, a, b, {iso_end - 100, mid_dev}, false);
   EXPECT_TRUE(test::slurp(a / "isotropic.csv") == test::slurp(b / "isotropic.csv"));
   std::filesystem::remove_all(a);
   std::filesystem::remove_all(b);
+}
+
+// The CLI's begin_output hook (it replaces an old run only once the new one is known to start)
+// is called once on a fresh run, after set-up and before any file is written into out_dir, and
+// never on resume.
+void expect_begin_output_first(const std::string& text, long max_steps) {
+  const Driver& d = find_driver(peek_driver(text, "test"));
+  const ParamTable table = parameter_table(d);
+  const Config cfg = load_scenario(table, "test.toml", text, {});
+  const auto out = test::scratch("begin_output");
+  std::filesystem::remove_all(out);
+  std::filesystem::create_directories(out);
+  RunOptions opt;
+  opt.out_dir = out;
+  opt.max_steps = max_steps;
+  opt.progress_interval_s = 0;
+  int calls = 0;
+  bool empty = false;
+  opt.begin_output = [&] {
+    ++calls;
+    empty = std::filesystem::is_empty(out);
+  };
+  ASSERT_EQ(d.run(cfg, opt), RunStatus::Interrupted);
+  EXPECT_EQ(calls, 1);
+  EXPECT_TRUE(empty) << "files were written before begin_output";
+  opt.resume = true;
+  opt.max_steps = 2 * max_steps;
+  calls = 0;
+  d.run(cfg, opt);
+  EXPECT_EQ(calls, 0);
+  std::filesystem::remove_all(out);
+}
+
+TEST(DemResume, BeginOutputComesAfterSetUpAndBeforeAnyFile) {
+  expect_begin_output_first(test::small_ucs_scenario(2), 200);
+  expect_begin_output_first(small_triaxial("rigid_cylinder"), 200);
+  expect_begin_output_first(small_triaxial("particle_membrane"), 200);
 }
 
 TEST(DemResume, TriaxialRigidCylinderBothStages) { triaxial_resume("rigid_cylinder"); }

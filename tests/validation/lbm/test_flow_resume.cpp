@@ -176,3 +176,31 @@ TEST(LbmFlowResume, StopRequestWritesACheckpointAndResumes) {
   ASSERT_EQ(run_flow_driver_status("sig_cut", kCavity, {}, true), ff::RunStatus::Finished);
   ff::test::expect_same_results(flow_test_dir("sig_whole"), flow_test_dir("sig_cut"), "stopped by SIGTERM");
 }
+
+TEST(LbmFlowResume, BeginOutputComesAfterSetUpAndBeforeAnyFile) {
+  // Called once on a fresh run before any file is written into out_dir; never on resume.
+  for (const char* text : {kPoiseuille, kCavity, kCylinder}) {
+    const ff::Driver& d = ff::find_driver(ff::peek_driver(text, "test"));
+    const ff::ParamTable table = ff::parameter_table(d);
+    const ff::Config cfg = ff::load_scenario(table, "test.toml", text, {});
+    ff::RunOptions opt;
+    opt.out_dir = ff::testing::flow_test_dir("begin_output");
+    std::filesystem::remove_all(opt.out_dir);
+    std::filesystem::create_directories(opt.out_dir);
+    opt.max_steps = 50;
+    opt.progress_interval_s = 0;
+    int calls = 0;
+    bool empty = false;
+    opt.begin_output = [&] {
+      ++calls;
+      empty = std::filesystem::is_empty(opt.out_dir);
+    };
+    ASSERT_EQ(d.run(cfg, opt), ff::RunStatus::Interrupted) << text;
+    EXPECT_EQ(calls, 1) << text;
+    EXPECT_TRUE(empty) << text;
+    opt.resume = true;
+    opt.max_steps = 100;
+    d.run(cfg, opt);
+    EXPECT_EQ(calls, 1) << text;
+  }
+}
