@@ -182,8 +182,9 @@ class CylinderCase : public FlowCase {
     // No shedding, no frequency: null with the reason rather than a Strouhal number of 0.
     res["strouhal"] = shedding ? nlohmann::json(lift.frequency * D_ / u_ref()) : nlohmann::json(nullptr);
     if (!shedding)
-      res["strouhal_reason"] = fmt::format("no vortex shedding: {} lift cycles after {:.4g} s (2 needed), Cl amplitude {:.3g}",
-                                           lift.cycles, t_from, 0.5 * (lift.max - lift.min));
+      res["strouhal_reason"] = fmt::format("no vortex shedding: {} lift cycles between {:.4g} s and the end at {:.4g} s "
+                                           "(2 needed), Cl amplitude {:.3g}",
+                                           lift.cycles, t_from, t.back(), 0.5 * (lift.max - lift.min));
     res["shedding_periods_averaged"] = shedding ? lift.cycles : 0;
     res["lambda_wall_factor"] = fx.back() / (rho_ * nu_ * u_max());  // [S003] Eq. 16
     res["wall_scheme"] = scheme_ == lbm::WallScheme::Bouzidi ? "bouzidi" : scheme_ == lbm::WallScheme::Yu ? "yu" : "halfway";

@@ -187,6 +187,23 @@ TEST(RunResults, FlowSummaryParametersKeepTheirTypes) {
   fs::remove_all(out);
 }
 
+// A cylinder run too short to shed vortices has no Strouhal number: null with the reason, not 0.
+TEST(RunResults, CylinderWithoutSheddingHasNullStrouhalWithReason) {
+  const auto out = scratch("cylinder");
+  const auto r = run_cli("run " + std::string(FRACFLOW_SOURCE_DIR) + "/examples/cylinder_channel.toml --out " +
+                         out.string() +
+                         " --set run.end_time=1 --set lbm.resolution=6 --set output.vtk=false --set output.plots=false "
+                         "--quiet --threads 1");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const auto j = read_json(out / "summary.json");
+  const auto& res = j["results"];
+  EXPECT_FALSE(res["shedding"].get<bool>());
+  EXPECT_TRUE(res["strouhal"].is_null()) << res.dump(2);
+  EXPECT_TRUE(has(res["strouhal_reason"].get<std::string>(), "no vortex shedding")) << res.dump(2);
+  EXPECT_EQ(first_line(out / "series.csv"), "step,time_s,Fx_N_per_m,Fy_N_per_m,Cd,Cl");
+  fs::remove_all(out);
+}
+
 // Platens at 10 um/s: ~2.7e8 steps to ucs.max_strain. The run says so, naming the keys, before
 // its first step; --max-steps stops it right after.
 TEST(RunResults, VeryLongRunPrintsItsEstimateFirst) {
