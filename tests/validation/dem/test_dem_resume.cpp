@@ -6,10 +6,12 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <csignal>
 #include <fstream>
 #include <thread>
 
 #include "core/interrupt.hpp"
+#include "drivers/run_control.hpp"
 #include "io/checkpoint.hpp"
 #include "resume_compare.hpp"
 #include "ucs_test_support.hpp"
@@ -177,3 +179,36 @@ TEST(DemResume, BeginOutputComesAfterSetUpAndBeforeAnyFile) {
 TEST(DemResume, TriaxialRigidCylinderBothStages) { triaxial_resume("rigid_cylinder"); }
 TEST(DemResume, TriaxialParticleMembraneBothStages) { triaxial_resume("particle_membrane"); }
 TEST(DemResume, TriaxialFlexibleMembraneBothStages) { triaxial_resume("membrane"); }
+
+TEST(DemResume, RunControlNamesWhyARunStopsAndWhenToCheckpoint) {
+  const Driver& d = find_driver("ucs");
+  const ParamTable table = parameter_table(d);
+  const Config cfg = load_scenario(table, "test.toml", "driver = \"ucs\"\n", {"output.checkpoint_wall_interval=0.05"});
+  const auto dir = test::scratch("run_control");
+  std::filesystem::create_directories(dir);
+  RunOptions opt;
+  opt.max_steps = 100;
+  opt.abort_file = dir / "ABORT";
+  drivers::RunControl c(cfg, opt);
+  EXPECT_EQ(c.stop_reason(50), "");
+  EXPECT_NE(c.stop_reason(100).find("--max-steps"), std::string::npos);
+  request_stop(SIGINT);
+  EXPECT_NE(c.stop_reason(50).find("SIGINT"), std::string::npos);
+  clear_stop_request();
+  request_stop(SIGTERM);
+  EXPECT_NE(c.stop_reason(50).find("SIGTERM"), std::string::npos);
+  clear_stop_request();
+  std::ofstream(opt.abort_file) << "";
+  EXPECT_NE(c.stop_reason(50).find("ABORT"), std::string::npos);
+  std::filesystem::remove(opt.abort_file);
+  // Wall-clock checkpoints: due once the interval has passed since the last one.
+  EXPECT_FALSE(c.checkpoint_due());
+  std::this_thread::sleep_for(std::chrono::milliseconds(60));
+  EXPECT_TRUE(c.checkpoint_due());
+  c.checkpoint_written();
+  EXPECT_FALSE(c.checkpoint_due());
+  RunOptions walled;
+  walled.max_wall_s = 1e-9;
+  EXPECT_NE(drivers::RunControl(cfg, walled).stop_reason(0).find("--max-wall"), std::string::npos);
+  std::filesystem::remove_all(dir);
+}
