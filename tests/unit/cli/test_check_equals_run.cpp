@@ -1,0 +1,210 @@
+// `fracflow check` refuses exactly what `fracflow run` refuses (issue 12, part 5): every bad
+// scenario below goes through both commands of the real program; both must exit with code 2,
+// both messages must name the key (or the file), and the run must leave no results folder.
+// Each of these was accepted by `check` before (and most were refused by `run` only after
+// the sample or lattice was being built). A valid scenario passes both.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <array>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int code;
+  std::string output;
+};
+
+Result run_program(const std::string& args) {
+  // A bounded wait: a scenario that slips through would start a whole run.
+  const std::string cmd = "timeout -s KILL 20 " + std::string(FRACFLOW_BIN) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 4096> buf;
+  while (std::fgets(buf.data(), buf.size(), p)) out += buf.data();
+  const int status = pclose(p);
+  return {WEXITSTATUS(status), out};
+}
+
+// A scratch folder per test process, removed at the end.
+struct Scratch {
+  fs::path dir = fs::temp_directory_path() / ("fracflow_check_run_" + std::to_string(::getpid()));
+  Scratch() { fs::create_directories(dir); }
+  ~Scratch() {
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+  }
+  fs::path write(const std::string& name, const std::string& text) const {
+    const fs::path p = dir / name;
+    std::ofstream(p, std::ios::binary) << text;
+    return p;
+  }
+};
+
+// Tiny valid samples: a failed check costs nothing, a missed one at most a small genesis.
+// Written with dotted keys only, so that a case appends its keys without repeating a table.
+const std::string kOutput = "output.vtk = false\noutput.plots = false\n";
+const std::string kContact = "dem.group.rock.density = 2600\ndem.contact.rock-rock.friction = 0.5\n";
+const std::string kRock = kContact + "dem.bond.rock-rock.cohesion = 5e6\n";
+const std::string kUcs2d = "driver = \"ucs\"\n" + kOutput + "dem.dim = 2\n" + kRock +
+                           "sample.shape = \"box\"\nsample.width = 6e-3\nsample.height = 12e-3\nsample.porosity = 0.25\n";
+const std::string kUcs3d = "driver = \"ucs\"\n" + kOutput + kRock + "sample.diameter = 5e-3\nsample.height = 10e-3\n";
+const std::string kTriaxial = "driver = \"triaxial\"\n" + kOutput + kRock + "sample.diameter = 5e-3\nsample.height = 10e-3\n";
+const std::string kCavity = "driver = \"flow/cavity\"\n" + kOutput + "lbm.resolution = 16\n";
+const std::string kCylinder = "driver = \"flow/cylinder\"\n" + kOutput;
+
+struct Bad {
+  std::string name;  // also the scenario file's name
+  std::string text;  // scenario (ignored when `folder`)
+  std::vector<std::string> expect;  // in both messages (the key, the file, the reason); "@" = the scenario path
+  bool folder = false;              // give a folder as the scenario
+};
+
+std::vector<Bad> bad_scenarios() {
+  const std::string vein = "dem.group.vein.density = 2000\nsample.default_group = \"rock\"\n";
+  return {
+      {"empty", "", {"@", "sets no key"}},
+      {"bom_only", "\xEF\xBB\xBF", {"@", "sets no key"}},
+      {"comments_only", "# a scenario\n\n# to be written\n", {"@", "sets no key"}},
+      {"a_folder", "", {"@", "is a folder"}, true},
+      // min > max pairs, sizes, porosity
+      {"radius_min_above_max", kUcs2d + "sample.radius_min = 0.7e-3\nsample.radius_max = 0.5e-3\n",
+       {"sample.radius_max", "radius_min"}},
+      {"window_min_above_max",
+       kUcs3d + "sample.voxels.folder = \"s\"\nsample.voxels.threshold.rock.min = 200\nsample.voxels.threshold.rock.max = 100\n",
+       {"sample.voxels.threshold.rock.max", "min = 200"}},
+      {"box_region_hi_below_lo",
+       kUcs3d + "[[sample.region]]\ngroup = \"rock\"\nshape = \"box\"\nlo = [0, 0, 0]\nhi = [1e-3, -1e-3, 1e-3]\n",
+       {"sample.region.0.hi"}},
+      {"porosity_below_packing_3d", kUcs3d + "sample.porosity = 0.2\n", {"sample.porosity", "0.35"}},
+      {"porosity_below_packing_2d",
+       "driver = \"ucs\"\n" + kOutput + "dem.dim = 2\n" + kRock +
+           "sample.shape = \"box\"\nsample.width = 6e-3\nsample.height = 12e-3\nsample.porosity = 0.1\n",
+       {"sample.porosity", "0.16"}},
+      {"too_many_particles", kUcs3d + "sample.radius_min = 2e-6\nsample.radius_max = 3e-6\n", {"sample.radius_min", "5e7"}},
+      {"sample_narrower_than_particles", kUcs3d + "sample.radius_min = 1e-3\nsample.radius_max = 2e-3\n",
+       {"sample.diameter", "4 particle radii"}},
+      {"2d_cylinder", "driver = \"ucs\"\n" + kOutput + "dem.dim = 2\n" + kRock, {"sample.shape", "box"}},
+      {"gravity_out_of_plane_2d", kUcs2d + "dem.gravity = [0, 0, -9.81]\n", {"dem.gravity", "z component"}},
+      // files
+      {"missing_stl", kUcs3d + "[[sample.region]]\ngroup = \"rock\"\nshape = \"stl\"\nfile = \"no_such_vein.stl\"\n",
+       {"sample.region.0.file", "no_such_vein.stl"}},
+      {"missing_voxels", kUcs3d + "sample.voxels.folder = \"no_such_slices\"\nsample.voxels.threshold.rock.min = 10\n",
+       {"sample.voxels.folder", "no_such_slices"}},
+      {"cylinder_missing_image", kCylinder + "obstacles.image = \"no_such_grains.pgm\"\n",
+       {"obstacles.image", "no_such_grains.pgm"}},
+      // groups used but not declared, pair tables
+      {"region_group_undeclared", kUcs3d + "[[sample.region]]\ngroup = \"ghost\"\nradius = 1e-3\n",
+       {"sample.region.0.group", "ghost"}},
+      {"window_group_undeclared", kUcs3d + "sample.voxels.folder = \"s\"\nsample.voxels.threshold.ghost.min = 10\n",
+       {"sample.voxels.threshold.ghost.min", "ghost"}},
+      {"default_group_undeclared", kUcs3d + "sample.default_group = \"ghost\"\n", {"sample.default_group", "ghost"}},
+      {"bond_pair_group_undeclared", kUcs3d + "dem.bond.rock-ghost.cohesion = 1e6\n", {"dem.bond.rock-ghost", "ghost"}},
+      {"contact_pair_missing", kUcs3d + vein, {"dem.contact.rock-vein"}},
+      {"pair_table_twice",
+       kUcs3d + vein + "dem.contact.rock-vein.friction = 0.3\ndem.contact.vein-rock.friction = 0.4\n",
+       {"dem.contact.rock-vein", "dem.contact.vein-rock"}},
+      {"too_many_groups",
+       [] {
+         std::string t = kUcs3d;
+         for (int g = 0; g < 65; ++g) t += "dem.group.g" + std::to_string(g) + ".density = 2600\n";
+         return t;
+       }(),
+       {"66 particle groups", "the limit is 64"}},
+      // keys of a law that is not the active one
+      {"rotational_key_with_parallel_law", kUcs3d + "dem.bond.rock-rock.youngs_modulus = 5e9\n",
+       {"dem.bond.rock-rock.youngs_modulus", "rotational", "dem.bond_law"}},
+      {"parallel_key_with_rotational_law",
+       kUcs3d + "dem.bond_law = \"rotational\"\ndem.bond.rock-rock.friction_angle = 30\n"
+                "dem.bond.rock-rock.tensile_strength = 5e6\n",
+       {"dem.bond.rock-rock.tensile_strength", "parallel"}},
+      {"hertz_key_with_linear_law", kUcs3d + "dem.contact.rock-rock.shear_modulus = 2e9\n",
+       {"dem.contact.rock-rock.shear_modulus", "hertz_mindlin"}},
+      {"bond_key_without_bonds", kUcs3d + "dem.bond_law = \"none\"\n", {"dem.bond.rock-rock.cohesion", "none"}},
+      {"rotational_bond_without_friction_angle", kUcs3d + "dem.bond_law = \"rotational\"\n",
+       {"dem.bond.rock-rock.friction_angle", "> 0"}},
+      // triaxial
+      {"triaxial_2d", kTriaxial + "dem.dim = 2\n", {"dem.dim", "3D"}},
+      {"triaxial_reserved_group",
+       kTriaxial + "triaxial.lateral = \"particle_membrane\"\ndem.group.membrane.density = 1000\n"
+                   "dem.contact.membrane-membrane.friction = 0.1\ndem.contact.membrane-rock.friction = 0.1\n"
+                   "dem.bond.membrane-membrane.cohesion = 1e6\ndem.bond.membrane-rock.cohesion = 1e6\n"
+                   "sample.default_group = \"rock\"\n",
+       {"triaxial.lateral", "'membrane'"}},
+      {"triaxial_bonded_membrane_without_bonds",
+       "driver = \"triaxial\"\n" + kOutput + kContact +
+           "dem.bond_law = \"none\"\nsample.diameter = 5e-3\nsample.height = 10e-3\ntriaxial.lateral = \"particle_membrane\"\n",
+       {"particle_membrane.bonded", "dem.bond_law"}},
+      // LBM limits
+      {"lbm_mach_too_high", kCavity + "cavity.lid_velocity = 1.0\n", {"lbm.tau", "Mach number"}},
+      {"lbm_tau_and_time_step", kCavity + "lbm.tau = 0.7\nlbm.time_step = 1e-3\n", {"lbm.tau", "lbm.time_step"}},
+      {"lbm_time_step_too_large", kCavity + "lbm.time_step = 10\n", {"lbm.time_step", "Mach number"}},
+      {"lbm_depth_without_d3q19", kCavity + "lbm.depth_cells = 4\n", {"lbm.depth_cells", "D3Q19"}},
+      {"cylinder_wider_than_channel", kCylinder + "cylinder.diameter = 0.2\n", {"cylinder.diameter"}},
+  };
+}
+
+}  // namespace
+
+TEST(CheckEqualsRun, EveryRefusedScenarioIsRefusedByCheckAndByRunAlike) {
+  const Scratch s;
+  for (const Bad& b : bad_scenarios()) {
+    SCOPED_TRACE(b.name);
+    ASSERT_FALSE(b.expect.empty());
+    fs::path file = b.folder ? s.dir / b.name : s.write(b.name + ".toml", b.text);
+    if (b.folder) fs::create_directories(file);
+    const fs::path out = s.dir / (b.name + "_out");
+    const auto start = std::chrono::steady_clock::now();
+    const Result check = run_program("check " + file.string());
+    const Result run = run_program("run " + file.string() + " --out " + out.string() + " --quiet");
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_EQ(check.code, 2) << check.output;
+    EXPECT_EQ(run.code, 2) << run.output;
+    for (std::string e : b.expect) {
+      if (e == "@") e = file.string();
+      EXPECT_NE(check.output.find(e), std::string::npos) << "check does not say '" << e << "':\n" << check.output;
+      EXPECT_NE(run.output.find(e), std::string::npos) << "run does not say '" << e << "':\n" << run.output;
+    }
+    EXPECT_FALSE(fs::exists(out)) << "the refused run left " << out;
+    EXPECT_LT(seconds, 5.0) << "refused before building anything";
+  }
+}
+
+TEST(CheckEqualsRun, ValidScenarioPassesCheckAndRuns) {
+  const Scratch s;
+  const fs::path file = s.write("valid.toml", kUcs2d);
+  const Result check = run_program("check " + file.string());
+  EXPECT_EQ(check.code, 0) << check.output;
+  const fs::path out = s.dir / "valid_out";
+  const Result run = run_program("run " + file.string() + " --out " + out.string() + " --quiet --max-steps 100");
+  EXPECT_EQ(run.code, 0) << run.output;
+  EXPECT_TRUE(fs::exists(out / "scenario.toml")) << run.output;
+}
+
+// The examples of `--set` errors name keys a user can actually set.
+TEST(CheckEqualsRun, SetErrorExamplesNameKeysThatExist) {
+  for (const char* bad : {"--set dem.local_damping", "--set dem.gravity={}"}) {
+    const Result r = run_program(std::string("check ") + bad);
+    ASSERT_EQ(r.code, 2) << r.output;
+    // Every "--set KEY=VALUE" the message gives as an example must be accepted by check.
+    std::size_t examples = 0;
+    for (std::size_t at = r.output.find("e.g. "); at != std::string::npos; at = r.output.find("--set ", at)) {
+      at = r.output.find("--set ", at);
+      if (at == std::string::npos) break;
+      at += 6;
+      const std::string assignment = r.output.substr(at, r.output.find_first_of(" \n", at) - at);
+      ++examples;
+      const Result ok = run_program("check --set '" + assignment + "'");
+      EXPECT_EQ(ok.code, 0) << assignment << ":\n" << ok.output.substr(0, 400);
+    }
+    EXPECT_GT(examples, 0u) << r.output;
+  }
+}
