@@ -208,3 +208,55 @@ TEST(CheckEqualsRun, SetErrorExamplesNameKeysThatExist) {
     EXPECT_GT(examples, 0u) << r.output;
   }
 }
+
+// Scale of input (issue 12, part 7): `fracflow check` used to cost O(keys^2) (40,000 groups
+// took 5 s, 40,000 regions 50 s); now a huge file is refused early with the limit that it
+// breaks, and a large valid one is checked in well under the bound.
+TEST(CheckScale, MillionKeysManyGroupsAndManyRegionsAreCheckedInSeconds) {
+  const Scratch s;
+  auto timed_check = [&](const fs::path& file) {
+    const auto start = std::chrono::steady_clock::now();
+    Result r = run_program("check " + file.string());
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_LT(seconds, 10.0) << file;
+    return r;
+  };
+  auto scenario = [&](const std::string& name, int n, const std::string& head, auto&& line) {
+    std::string text = head;
+    text.reserve(static_cast<std::size_t>(n) * 40);
+    for (int i = 0; i < n; ++i) text += line(i);
+    return s.write(name, text);
+  };
+  // A million groups (a million keys): refused before parsing, naming the limit.
+  auto r = timed_check(scenario("million_groups.toml", 1'000'000, "driver = \"ucs\"\n",
+                                [](int i) { return "dem.group.g" + std::to_string(i) + ".density = 2600\n"; }));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("has 1000001 keys; the limit is 200000"), std::string::npos) << r.output.substr(0, 400);
+  // 150,000 groups: within the key limit, refused by the group limit.
+  r = timed_check(scenario("many_groups.toml", 150'000, "driver = \"ucs\"\n",
+                           [](int i) { return "dem.group.g" + std::to_string(i) + ".density = 2600\n"; }));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("declares 150000 particle groups ([dem.group.NAME]); the limit is 64"), std::string::npos)
+      << r.output.substr(0, 400);
+  // 60,000 regions: refused by the region limit.
+  r = timed_check(scenario("many_regions.toml", 60'000, kUcs3d,
+                           [](int) { return std::string("[[sample.region]]\ngroup = \"rock\"\n"); }));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("60000 [[sample.region]] entries; the limit is 10000"), std::string::npos)
+      << r.output.substr(0, 400);
+  // 10,000 regions and 64 groups with every pair table: valid, every key listed.
+  std::string groups;
+  for (int a = 0; a < 64; ++a) {
+    groups += "dem.group.g" + std::to_string(a) + ".density = 2600\n";
+    for (int b = a; b < 64; ++b)
+      groups += "dem.contact.g" + std::to_string(a) + "-g" + std::to_string(b) + ".friction = 0.5\ndem.bond.g" +
+                std::to_string(a) + "-g" + std::to_string(b) + ".cohesion = 5e6\n";
+  }
+  r = timed_check(scenario("largest_valid.toml", 10'000,
+                           "driver = \"ucs\"\n" + groups +
+                               "sample.diameter = 5e-3\nsample.height = 10e-3\nsample.default_group = \"g0\"\n",
+                           [](int i) { return "[[sample.region]]\ngroup = \"g" + std::to_string(i % 64) + "\"\n"; }));
+  EXPECT_EQ(r.code, 0) << r.output.substr(0, 400);
+  EXPECT_NE(r.output.find("sample.region.9999.group"), std::string::npos);
+  EXPECT_NE(r.output.find("dem.bond.g62-g63.truncation"), std::string::npos);
+}
