@@ -87,7 +87,14 @@ TEST(UcsValidation, RotationalBondSampleAlsoFailsWithPeakAndCracks) {
   // the scenario runs through the same engine: the 2D sample must still show a peak, softening
   // and cracks.
   const auto out = test::scratch("rot");
-  ASSERT_EQ(test::run_scenario(test::small_ucs_scenario(2),
+  // Table 7's bond table holds parallel-bond keys, which a rotational run refuses (they would
+  // be ignored): the rotational bond gets its own keys below.
+  std::string text = test::small_ucs_scenario(2);
+  const std::string parallel_only = "emod = 2.09e9\nkratio = 14.65\ntensile_strength = 17.4e6\n";
+  const auto bond = text.find("[dem.bond.matrix-matrix]\n" + parallel_only);
+  ASSERT_NE(bond, std::string::npos);
+  text.erase(bond + 25, parallel_only.size());
+  ASSERT_EQ(test::run_scenario(text,
                                {"dem.bond_law=rotational", "dem.bond.matrix-matrix.youngs_modulus=2.09e9",
                                 "dem.bond.matrix-matrix.poisson_ratio=0.25", "dem.bond.matrix-matrix.cohesion=8e6",
                                 "dem.bond.matrix-matrix.friction_angle=30"},
