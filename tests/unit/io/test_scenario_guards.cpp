@@ -1,6 +1,10 @@
 // Guards in front of toml++ 3.3.0 and the resolved-TOML round trip (each case was a crash or
 // a failed round trip found by tests/fuzz/fuzz_scenario.cpp).
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
 
 #include "core/error.hpp"
 #include "io/scenario.hpp"
@@ -84,4 +88,32 @@ TEST(io_scenario, ResolvedTomlRoundTripsAnyString) {
   EXPECT_DOUBLE_EQ(back.real("dem.group.a b.density"), 2);
   EXPECT_EQ(back.resolved_toml(), resolved);
   EXPECT_NE(resolved.find("dem.group.\"rock/rock\".density = 1.0"), std::string::npos) << resolved;
+}
+
+// An ifstream opens a folder and reads it as empty text: it used to run the default scenario.
+TEST(io_scenario, FolderGivenAsScenarioIsRefusedWithItsPath) {
+  const auto dir = std::filesystem::temp_directory_path() / ("fracflow_guard_dir_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  try {
+    read_text_file(dir.string());
+    ADD_FAILURE() << "a folder was read as a scenario";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("'" + dir.string() + "' is a folder"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(dir);
+  EXPECT_THROW(read_text_file((dir / "missing.toml").string()), InputError);
+}
+
+// Scanning for the key count must not count '=' inside strings or comments.
+TEST(io_scenario, KeyLimitCountsOnlyKeyValuePairs) {
+  std::string text = "output.name = \"" + std::string(kMaxScenarioKeys + 10, '=') + "\"\n# " +
+                     std::string(kMaxScenarioKeys + 10, '=') + "\n";
+  EXPECT_EQ(error_of(text), "");
+  std::string many;
+  for (std::size_t i = 0; i <= kMaxScenarioKeys; ++i) {
+    many += 'x';
+    many += std::to_string(i);
+    many += " = 1\n";
+  }
+  EXPECT_NE(error_of(many).find("the limit is 200000"), std::string::npos);
 }
