@@ -324,6 +324,10 @@ RunStatus Runner<L, T>::run() {
                          fmt::format("run.end_time, a smaller {} or a larger {}", fc_.resolution_key(),
                                      tau_mode ? "lbm.tau" : "lbm.time_step"),
                          sol_->time_step());
+  if (!opt_.resume) {  // resumable from the start (kill -9 before the first interval)
+    write_checkpoint(cp_dir);
+    control.checkpoint_written();
+  }
   RunStatus status = RunStatus::Finished;
   std::string stop_reason = fmt::format("reached run.end_time = {} s", cfg_.real("run.end_time"));
   const auto loop_start = std::chrono::steady_clock::now();

@@ -176,6 +176,7 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
       l_hist = t.column("lateral_strain");
     }
   }
+  if (!opt.resume) checkpoint();  // resumable from the start (kill -9 before the first interval)
   RunStatus status = RunStatus::Finished;
   std::string stop_reason;
   try {

@@ -112,6 +112,27 @@ TEST(DemResume, DamagedNewestCheckpointFallsBackToThePreviousOne) {
   std::filesystem::remove_all(b);
 }
 
+TEST(DemResume, TheCheckpointAtTheStartResumesBitForBit) {
+  // Every run checkpoints once set up, so a kill before the first wall-clock checkpoint leaves a
+  // resumable folder too. Here the newest checkpoint (at the interruption) is damaged, so resume
+  // starts from the one written at step 0.
+  const std::vector<std::string> texts = {test::small_ucs_scenario(2), small_triaxial("rigid_cylinder")};
+  const std::vector<std::string> sets = {"triaxial.platen_velocity=0.2", "triaxial.stop_fraction=0.85"};
+  for (const std::string& text : texts) {
+    const auto a = test::scratch("start_whole"), b = test::scratch("start_cut");
+    const auto faster = text == texts[0] ? std::vector<std::string>{} : sets;
+    ASSERT_EQ(test::run_scenario(text, faster, a, 1), RunStatus::Finished);
+    ASSERT_EQ(test::run_scenario(text, faster, b, 1, 200), RunStatus::Interrupted);  // before any stage ends
+    const auto newest = b / "checkpoint" / "state.ffcp";
+    ASSERT_EQ(CheckpointReader(previous_checkpoint_path(newest)).get_value<long>("dem.step"), 0);
+    std::filesystem::remove(newest);
+    ASSERT_EQ(test::run_scenario(text, faster, b, 1, 0, true), RunStatus::Finished);
+    test::expect_same_results(a, b, "resumed from step 0");
+    std::filesystem::remove_all(a);
+    std::filesystem::remove_all(b);
+  }
+}
+
 // Triaxial: interrupted inside the isotropic stage, inside the deviatoric stage, and across the
 // stage change (isotropic -> deviatoric -> end), for each lateral boundary, made frictional
 // (membrane.friction = -1) so that its contacts' shear history matters. Was: the isotropic

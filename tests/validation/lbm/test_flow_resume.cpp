@@ -204,3 +204,16 @@ TEST(LbmFlowResume, BeginOutputComesAfterSetUpAndBeforeAnyFile) {
     EXPECT_EQ(calls, 1) << text;
   }
 }
+
+TEST(LbmFlowResume, TheCheckpointAtTheStartResumesBitForBit) {
+  // The run checkpoints once set up (a kill before the first wall-clock checkpoint leaves a
+  // resumable folder); with the newest checkpoint gone, resume starts from that one.
+  using namespace ff::testing;
+  ASSERT_EQ(run_flow_driver_status("start_whole", kCylinder, {}), ff::RunStatus::Finished);
+  ASSERT_EQ(run_flow_driver_status("start_cut", kCylinder, {"output.checkpoints=0"}, false, 0, 2000), ff::RunStatus::Interrupted);
+  std::filesystem::remove(flow_test_dir("start_cut") / "checkpoint" / "state.ffcp");
+  ASSERT_EQ(run_flow_driver_status("start_cut", kCylinder, {"output.checkpoints=0"}, true), ff::RunStatus::Finished);
+  EXPECT_EQ(slurp(flow_test_dir("start_whole") / "series.csv"), slurp(flow_test_dir("start_cut") / "series.csv"));
+  EXPECT_EQ(read_summary("start_whole")["results"], read_summary("start_cut")["results"]);
+  EXPECT_EQ(slurp(flow_test_dir("start_whole") / "vtk" / "flow.pvd"), slurp(flow_test_dir("start_cut") / "vtk" / "flow.pvd"));
+}
