@@ -253,10 +253,12 @@ int main(int argc, char** argv) {
       opt.out_dir = out_dir;
       opt.progress_interval_s = quiet ? 0 : l->config.real("output.progress_interval");
       opt.begin_output = [&folder, resolved = l->config.resolved_toml(), cmd = command_line(argc, argv)] {
+        // Until now a signal ends the process at once (nothing is written yet, an old run is
+        // untouched); from here on it asks the driver for a checkpoint.
+        install_stop_signal_handlers();
         folder.begin(resolved, cmd);
       };
       opt.abort_file = opt.out_dir / "ABORT";
-      install_stop_signal_handlers();
       return execute(*l, opt, &folder);
     }
     if (*resume) {

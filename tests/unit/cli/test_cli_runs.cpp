@@ -302,3 +302,24 @@ TEST(CliRuns, SigtermWritesACheckpoint) {
   Scratch s;
   stop_with_signal(s / "run", SIGTERM, "SIGTERM", true);
 }
+
+TEST(CliRuns, SignalDuringSetUpEndsAtOnceAndLeavesTheOldRun) {
+  // Nothing is written while the sample is built, so there is nothing to save: the default
+  // scenario's genesis (about a second) is stopped at once and the run it would replace stays.
+  Scratch s;
+  const fs::path dir = s / "run";
+  ASSERT_EQ(run("run --out " + dir.string() + kTiny).code, 0);
+  const std::string summary = slurp(dir / "summary.json");
+  const pid_t pid = start({"run", "--out", dir.string(), "--overwrite", "-j1"}, s / "log");
+  ASSERT_GT(pid, 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  ::kill(pid, SIGTERM);
+  const auto t0 = std::chrono::steady_clock::now();
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) << slurp(s / "log");
+  EXPECT_LT(waited, 1.0);
+  EXPECT_EQ(slurp(dir / "summary.json"), summary);
+  EXPECT_EQ(std::distance(fs::directory_iterator(s.path), fs::directory_iterator()), 2) << "only the run and the log";
+}
