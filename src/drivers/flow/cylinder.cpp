@@ -84,8 +84,6 @@ class CylinderCase : public FlowCase {
     }
   }
 
-
-
   double cell_size() const override { return D_ / n_; }
   int resolution() const override { return n_; }
   // The inflow speed (the maximum of a parabola) sets the Mach number, as usual for bluff bodies.
