@@ -14,9 +14,10 @@ configure: deps
 build: configure
 	@cmake --build $(BUILD) -j $(JOBS)
 
-# Set up, build, run the built-in default scenario.
+# Set up, build, run the built-in default scenario (again: it replaces the earlier runs/default,
+# never a folder fracflow did not make).
 run: build
-	@$(BUILD)/apps/cli/fracflow run --out $(OUT)
+	@$(BUILD)/apps/cli/fracflow run --out $(OUT) --overwrite
 
 # Set up, build, run the fast test suite.
 test: build

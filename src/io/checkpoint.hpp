@@ -35,7 +35,9 @@ struct Checksum {
 };
 }  // namespace detail
 
-inline constexpr std::uint32_t kCheckpointFormatVersion = 2;  // 2: parallel-bond state holds loads only
+// 2: parallel-bond state holds loads only; 3: the UCS lateral gauge, the triaxial isotropic-stage
+// counter and the flexible membrane's contact history are stored instead of re-derived at resume.
+inline constexpr std::uint32_t kCheckpointFormatVersion = 3;
 
 // Types stored as raw bytes: trivially copyable ones, plus Eigen fixed-size vectors/matrices and
 // quaternions of arithmetic scalars (memcpy-safe though Eigen declares copy constructors).

@@ -332,16 +332,39 @@ RunStatus Runner<L, T>::run() {
   std::string stop_reason = fmt::format("reached run.end_time = {} s", cfg_.real("run.end_time"));
   const auto loop_start = std::chrono::steady_clock::now();
   const long loop_first_step = sol_->time_step();
+  // Stop requests and wall-clock checkpoints are also honoured between samples (polled every
+  // kPollSteps steps), so a run whose samples lie minutes apart still stops within seconds of a
+  // SIGTERM. The populations and the step are the whole state, and samples fall on multiples of
+  // sample_every, so a checkpoint between two samples resumes bit for bit too.
+  constexpr long kPollSteps = 256;
+  auto stop_now = [&](long t) {
+    if (const std::string why = control.stop_reason(t); !why.empty()) {
+      write_checkpoint(cp_dir);
+      log_interruption(why, t);
+      status = RunStatus::Interrupted;
+      return true;
+    }
+    return false;
+  };
   while (sol_->time_step() < steps_total) {
-    const long n = std::min(sample_every, steps_total - sol_->time_step());
-    for (long i = 0; i < n; ++i) {
+    const long next_sample = std::min((sol_->time_step() / sample_every + 1) * sample_every, steps_total);
+    bool stopped = false;
+    while (sol_->time_step() < next_sample) {
       const long t = sol_->time_step();
       if (t <= ramp_steps && ramp_steps > 0) {
         const double a = std::sin(0.5 * M_PI * double(t) / double(ramp_steps));
         sol_->set_inflow_scale(a * a);
       }
-      sol_->step(i == n - 1);
+      sol_->step(t == next_sample - 1);
+      if (((t + 1) % kPollSteps == 0 || t + 1 == opt_.max_steps) && t + 1 < next_sample) {
+        if ((stopped = stop_now(t + 1))) break;
+        if (control.checkpoint_due()) {
+          write_checkpoint(cp_dir);
+          control.checkpoint_written();
+        }
+      }
     }
+    if (stopped) break;
     sample(s);
     if (!(s.max_mach == s.max_mach)) unstable("the velocity field holds NaN");
     if (s.max_mach > 0.3) unstable(fmt::format("the Mach number reached {:.3g} (limit 0.3)", s.max_mach));
@@ -366,12 +389,7 @@ RunStatus Runner<L, T>::run() {
     const bool done = last || steady;
     if (vtk_every > 0 && (k % vtk_every == 0 || done)) write_vtk(s);
     if (done) break;
-    if (const std::string why = control.stop_reason(sol_->time_step()); !why.empty()) {
-      write_checkpoint(cp_dir);
-      log_interruption(why, sol_->time_step());
-      status = RunStatus::Interrupted;
-      break;
-    }
+    if (stop_now(sol_->time_step())) break;
     if (control.checkpoint_due() || (cp_every > 0 && k % cp_every == 0)) {
       write_checkpoint(cp_dir);
       control.checkpoint_written();

@@ -8,6 +8,7 @@
 
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
+#include "io/checkpoint.hpp"
 #include "flow_driver_runner.hpp"
 #include "resume_compare.hpp"
 
@@ -162,6 +163,28 @@ TEST(LbmFlowResume, CavityResumedAtSeveralPointsIsBitForBit) { expect_every_resu
 TEST(LbmFlowResume, CylinderResumedInTheRampAndAfterIsBitForBit) {
   // The inflow ramp (20 domain lengths at the sound speed, ~2500 steps) covers the first stop.
   expect_every_resume_identical("every_cylinder", kCylinder, {"output.checkpoints=0"});
+}
+
+TEST(LbmFlowResume, StopBetweenTwoSamplesResumesBitForBit) {
+  // Stops are polled between samples too (every 256 steps and at --max-steps), so a run whose
+  // samples lie minutes apart still stops within seconds; such a checkpoint resumes bit for bit.
+  using namespace ff::testing;
+  const auto whole = flow_test_dir("between_whole"), cut = flow_test_dir("between_cut");
+  ASSERT_EQ(run_flow_driver_status("between_whole", kCavity, {}), ff::RunStatus::Finished);
+  const long n = read_summary("between_whole")["steps"];
+  const long every = n / 40;  // output.samples = 40
+  ASSERT_GT(every, 8);
+  const long stop = 3 * every + every / 2;
+  ASSERT_EQ(run_flow_driver_status("between_cut", kCavity, {}, false, 0, stop), ff::RunStatus::Interrupted);
+  const std::string partial = slurp(cut / "series.csv");
+  EXPECT_EQ(std::count(partial.begin(), partial.end(), '\n'), 1 + 3) << "header and three samples before the stop";
+  ff::CheckpointReader r(cut / "checkpoint" / "state.ffcp");
+  struct RunnerState {  // as flow_runner.cpp stores it
+    std::int64_t step, vtk_index, finished, columns;
+  };
+  EXPECT_EQ(r.get_value<RunnerState>("flow.state").step, stop) << "the checkpoint lies between two samples";
+  ASSERT_EQ(run_flow_driver_status("between_cut", kCavity, {}, true), ff::RunStatus::Finished);
+  ff::test::expect_same_results(whole, cut, "stopped between two samples");
 }
 
 TEST(LbmFlowResume, StopRequestWritesACheckpointAndResumes) {
