@@ -11,6 +11,8 @@
 #include <sstream>
 #include <string>
 
+#include "../program_runner.hpp"
+#include "dem/presets.hpp"
 namespace fs = std::filesystem;
 
 namespace {
@@ -20,32 +22,12 @@ const std::string kTiny =
     " --set sample.diameter=5e-3 --set sample.height=8e-3 --set sample.porosity=0.45 --set output.vtk=false"
     " --set output.plots=false --set output.progress_interval=0 --threads 1";
 
-fs::path scratch(const std::string& name) {
-  const auto p = fs::temp_directory_path() / ("fracflow_test_results_" + name);
-  fs::remove_all(p);
-  return p;
-}
+fs::path scratch(const std::string& name) { return ff::test::fresh_out_dir("test_results", name); }
 
-struct Result {
-  int code;
-  std::string output;
-};
-Result run_cli(const std::string& args) {
-  const std::string cmd = std::string(FRACFLOW_BIN) + " " + args + " 2>&1";
-  Result r{-1, {}};
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  while (std::fgets(buf, sizeof buf, p)) r.output += buf;
-  const int st = pclose(p);
-  r.code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
-}
+using Result = ff::test::ProgramResult;
+Result run_cli(const std::string& args) { return ff::test::run_program(args); }
 
-nlohmann::json read_json(const fs::path& p) {
-  std::ifstream f(p);
-  return nlohmann::json::parse(f);
-}
+using ff::test::read_json;
 
 std::string first_line(const fs::path& p) {
   std::ifstream f(p);
@@ -94,21 +76,7 @@ TEST(RunResults, UcsWithoutFitWindowOrPeakReportsNullWithReason) {
 TEST(RunResults, TriaxialWithoutPeakReportsNullWithReasonAndUnitColumns) {
   const auto out = scratch("triaxial");
   const fs::path scenario = fs::temp_directory_path() / "fracflow_test_results_triaxial.toml";
-  std::ofstream(scenario) << R"(driver = "triaxial"
-[dem]
-dim = 3
-[dem.group.matrix]
-density = 1390
-[dem.contact.matrix-matrix]
-emod = 2.09e9
-kratio = 14.65
-friction = 0.4
-[dem.bond.matrix-matrix]
-emod = 2.09e9
-kratio = 14.65
-tensile_strength = 17.4e6
-cohesion = 4.35e6
-friction_angle = 4.0
+  std::ofstream(scenario) << "driver = \"triaxial\"\n[dem]\ndim = 3\n" << ff::dem::kCoalMatrixTable7Toml << R"(
 [sample]
 shape = "cylinder"
 diameter = 5e-3

@@ -11,6 +11,7 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 
+#include "../program_runner.hpp"
 namespace fs = std::filesystem;
 using namespace ff::batch;
 
@@ -21,32 +22,12 @@ const std::vector<std::string> kTinySample = {
     "sample.diameter=5e-3", "sample.height=8e-3", "sample.porosity=0.45", "ucs.max_strain=0.02",
     "output.vtk=false",     "output.plots=false", "output.progress_interval=0"};
 
-fs::path scratch(const std::string& name) {
-  const auto p = fs::temp_directory_path() / ("fracflow_test_sweep_" + name);
-  fs::remove_all(p);
-  return p;
-}
+fs::path scratch(const std::string& name) { return ff::test::fresh_out_dir("test_sweep", name); }
 
-struct Result {
-  int code;
-  std::string output;
-};
-Result run_cli(const std::string& args) {
-  const std::string cmd = std::string(FRACFLOW_BIN) + " " + args + " 2>&1";
-  Result r{-1, {}};
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  while (std::fgets(buf, sizeof buf, p)) r.output += buf;
-  const int st = pclose(p);
-  r.code = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return r;
-}
+using Result = ff::test::ProgramResult;
+Result run_cli(const std::string& args) { return ff::test::run_program(args); }
 
-nlohmann::json read_json(const fs::path& p) {
-  std::ifstream f(p);
-  return nlohmann::json::parse(f);
-}
+using ff::test::read_json;
 
 }  // namespace
 

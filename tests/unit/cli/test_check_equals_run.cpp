@@ -14,25 +14,15 @@
 #include <string>
 #include <vector>
 
+#include "../program_runner.hpp"
+
 namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int code;
-  std::string output;
-};
-
-Result run_program(const std::string& args) {
-  // A bounded wait: a scenario that slips through would start a whole run.
-  const std::string cmd = "timeout -s KILL 20 " + std::string(FRACFLOW_BIN) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf;
-  while (std::fgets(buf.data(), buf.size(), p)) out += buf.data();
-  const int status = pclose(p);
-  return {WEXITSTATUS(status), out};
-}
+using Result = ff::test::ProgramResult;
+// A bounded wait: a scenario that slips through would start a whole run.
+Result run_program(const std::string& args) { return ff::test::run_program(args, "timeout -s KILL 20 "); }
 
 // A scratch folder per test process, removed at the end.
 struct Scratch {

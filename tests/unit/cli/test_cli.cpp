@@ -11,22 +11,13 @@
 #include <sstream>
 #include <string>
 
+#include "../program_runner.hpp"
+
 namespace fs = std::filesystem;
 
 namespace {
-struct Result {
-  int code;
-  std::string output;
-};
-Result run(const std::string& args) {
-  const std::string cmd = std::string(FRACFLOW_BIN) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf;
-  while (std::fgets(buf.data(), buf.size(), p)) out += buf.data();
-  const int status = pclose(p);
-  return {WEXITSTATUS(status), out};
-}
+using ff::test::ProgramResult;
+ProgramResult run(const std::string& args) { return ff::test::run_program(args); }
 fs::path scratch(const std::string& name) {
   return fs::temp_directory_path() / ("fracflow_cli_" + name + "_" + std::to_string(::getpid()));
 }

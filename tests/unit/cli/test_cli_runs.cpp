@@ -22,6 +22,7 @@
 #include <thread>
 
 #include "io/run_folder.hpp"
+#include "../program_runner.hpp"
 
 namespace fs = std::filesystem;
 
@@ -33,30 +34,10 @@ const std::string kTiny =
     " --set sample.diameter=5e-3 --set sample.height=8e-3 --set sample.porosity=0.45 --set ucs.max_strain=0.004"
     " --set output.vtk=false --set output.plots=false --set output.progress_interval=0 -j1";
 
-struct Result {
-  int code;
-  std::string output;
-};
-Result run(const std::string& args) {
-  const std::string cmd = std::string(FRACFLOW_BIN) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf;
-  while (std::fgets(buf.data(), buf.size(), p)) out += buf.data();
-  const int status = pclose(p);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
-
+using Result = ff::test::ProgramResult;
+Result run(const std::string& args) { return ff::test::run_program(args); }
 // Same, after `prefix` (e.g. "cd DIR && " or "HOME=DIR ").
-Result run_in(const std::string& prefix, const std::string& args) {
-  const std::string cmd = prefix + std::string(FRACFLOW_BIN) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf;
-  while (std::fgets(buf.data(), buf.size(), p)) out += buf.data();
-  const int status = pclose(p);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+Result run_in(const std::string& prefix, const std::string& args) { return ff::test::run_program(args, prefix); }
 
 // Starts fracflow in the background, stdout and stderr into `log`.
 pid_t start(const std::vector<std::string>& args, const fs::path& log) {
@@ -75,19 +56,8 @@ pid_t start(const std::vector<std::string>& args, const fs::path& log) {
   return pid;
 }
 
-struct Scratch {
-  fs::path path;
-  Scratch() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path = fs::temp_directory_path() / ("fracflow-cliruns-" + std::string(info->name()) + "-" + std::to_string(::getpid()));
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~Scratch() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-  fs::path operator/(const std::string& n) const { return path / n; }
+struct Scratch : ff::test::TestScratch {
+  Scratch() : TestScratch("cliruns") {}
 };
 
 std::string slurp(const fs::path& p) {

@@ -15,25 +15,15 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "../program_runner.hpp"
 
 namespace fs = std::filesystem;
 using namespace ff;
 
 namespace {
 
-struct Scratch {
-  fs::path path;
-  Scratch() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path = fs::temp_directory_path() / ("fracflow-runfolder-" + std::string(info->name()) + "-" + std::to_string(::getpid()));
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~Scratch() {
-    std::error_code ec;
-    fs::permissions(path, fs::perms::owner_all, fs::perm_options::add, ec);
-    fs::remove_all(path, ec);
-  }
+struct Scratch : ff::test::TestScratch {
+  Scratch() : TestScratch("runfolder") {}
 };
 
 void touch(const fs::path& p, const std::string& text = "x") {
