@@ -3,26 +3,21 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include <chrono>
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <iterator>
 
 #include "core/error.hpp"
 #include "core/log.hpp"
-#include "core/progress.hpp"
-#include "dem/dem_checkpoint.hpp"
-#include "dem/dem_output.hpp"
 #include "dem/dem_params.hpp"
 #include "dem/sample_builder.hpp"
 #include "drivers/dem_results.hpp"
-#include "drivers/run_control.hpp"
-#include "drivers/run_record.hpp"
-#include "drivers/run_estimate.hpp"
+#include "drivers/dem_run_loop.hpp"
 #include "drivers/triaxial/triaxial_boundary.hpp"
 #include "drivers/triaxial/triaxial_lateral_setup.hpp"
 #include "drivers/ucs/ucs_measure.hpp"
-#include "fracflow/version.hpp"
 #include "io/csv.hpp"
-#include "io/json_out.hpp"
 #include "io/plot.hpp"
 
 namespace fs = std::filesystem;
@@ -124,40 +119,8 @@ template <> struct is_checkpoint_pod<dem::ParticleMembraneLayout> : std::true_ty
 namespace ff::drivers {
 namespace {
 
-// `iso_ok_rows`: rows in a row the isotropic stage has met its criteria (it ends at 5).
-void write_checkpoint(const fs::path& dir, const dem::DemSystem& sys, const TriaxialState& st, const dem::SampleInfo& info,
-                      const Lateral& lat, int iso_ok_rows) {
-  fs::create_directories(dir);
-  CheckpointWriter w(dir / "state.ffcp", /*keep_previous=*/true);
-  w.put_value("triaxial.iso_ok_rows", iso_ok_rows);
-  if (sys.membrane) w.put_value("triaxial.membrane_settings", sys.membrane->settings());
-  if (lat.kind == LateralKind::ParticleMembrane) w.put_value("triaxial.particle_membrane", lat.particles);
-  dem::save_dem(w, sys);
-  w.put_value("triaxial.state", st);
-  w.put_value("triaxial.sample", sample_record(info));
-  w.commit();
-}
-
-void read_checkpoint(const Config& cfg, const fs::path& dir, dem::DemSystem& sys, TriaxialState& st, dem::SampleInfo& info,
-                     Lateral& lat, int& iso_ok_rows) {
-  CheckpointReader r = open_checkpoint(dir / "state.ffcp");
-  iso_ok_rows = r.get_value<int>("triaxial.iso_ok_rows");
-  if (r.has("triaxial.membrane_settings")) sys.membrane.emplace(r.get_value<dem::MembraneSettings>("triaxial.membrane_settings"));
-  if ((lat.kind == LateralKind::ParticleMembrane) != r.has("triaxial.particle_membrane"))
-    cfg.fail("triaxial.lateral", "the checkpoint was written with another lateral boundary; resume with the scenario it was "
-                                 "written with");
-  dem::load_dem(r, sys);
-  if (lat.kind == LateralKind::ParticleMembrane) {  // its group comes after the scenario's, as when it was built
-    lat.particles = r.get_value<dem::ParticleMembraneLayout>("triaxial.particle_membrane");
-    if (dem::add_particle_membrane_group(sys.materials, particle_membrane_material(cfg)) != lat.particles.group)
-      cfg.fail("triaxial.lateral", "the checkpoint's particle groups differ from the scenario's");
-  }
-  st = r.get_value<TriaxialState>("triaxial.state");
-  info = sample_info(r.get_value<SampleRecord>("triaxial.sample"));
-}
-
 // Series columns; crack counts by pair of the sample's groups (the first `groups`).
-std::vector<std::string> columns(const dem::Materials& mat, int groups) {
+std::vector<std::string> triaxial_columns(const dem::Materials& mat, int groups) {
   // Names end in their SI unit (_s, _Pa, _J); strains, counts and ratios have none.
   std::vector<std::string> c = {"step", "time_s", "axial_strain", "axial_stress_Pa", "differential_stress_Pa", "confinement_Pa",
                                 "lateral_strain", "volumetric_strain", "cracks_tensile", "cracks_shear", "cracks_total"};
@@ -209,298 +172,265 @@ void validate(const Config& cfg) {
   dem::validate_dem_sample(cfg);
 }
 
-RunStatus run(const Config& cfg, const RunOptions& opt) {
-  const auto wall_start = std::chrono::steady_clock::now();
-  RunControl control(cfg, opt);
-  const Real p = cfg.real("triaxial.confining_pressure");
-  const std::string lateral_name = cfg.string("triaxial.lateral");
-  Lateral lat;
-  lat.kind = lateral_name == "membrane"         ? LateralKind::Membrane
-             : lateral_name == "rigid_cylinder" ? LateralKind::RigidCylinder
-                                                : LateralKind::ParticleMembrane;
-  const LateralKind kind = lat.kind;
-  const ServoSettings servo{cfg.real("triaxial.servo_velocity"), cfg.real("triaxial.servo_relaxation")};
-  dem::DemSystem sys;
-  sys.settings = dem::build_settings(cfg);
-  sys.materials = dem::build_materials(cfg);
-  check_triaxial_keys(cfg);  // checked before anything is built
-  dem::SampleInfo info;
-  TriaxialState st;
-  int iso_ok_rows = 0;
-  const std::size_t cyl = lat.cylinder_wall;  // the rigid cylinder is wall 2 (after the platens)
-  const fs::path cp_dir = opt.out_dir / "checkpoint";
-  if (opt.resume) {
-    read_checkpoint(cfg, cp_dir, sys, st, info, lat, iso_ok_rows);
-    if (st.finished) {
-      log::info("this run had already finished; nothing to resume");
-      return RunStatus::Finished;
-    }
-    log::info("resuming at step {} (t = {:.6g} s), {} stage", sys.step_count, sys.time, st.stage ? "deviatoric" : "isotropic");
-  } else {
+// The triaxial test on the shared loop: an isotropic stage (platens and lateral boundary
+// servo-controlled to sigma3, isotropic.csv) until equilibrium, then the deviatoric stage
+// (platens at a constant speed, the lateral boundary holding sigma3), whose curve is the
+// differential stress against the axial strain.
+class TriaxialRun final : public DemRun {
+ public:
+  TriaxialRun(const Config& c, const RunOptions& o)
+      : DemRun(c, o,
+               {"triaxial", "differential stress", "differential_stress_Pa",
+                "triaxial.platen_velocity, triaxial.max_strain or triaxial.isotropic_max_steps"}),
+        p_(c.real("triaxial.confining_pressure")),
+        servo_{c.real("triaxial.servo_velocity"), c.real("triaxial.servo_relaxation")},
+        every_(c.integer("triaxial.series_interval")),
+        iso_max_(c.integer("triaxial.isotropic_max_steps")),
+        iso_tol_(c.real("triaxial.isotropic_tolerance")),
+        iso_ubf_(c.real("triaxial.isotropic_unbalanced_ratio")) {
+    const std::string lateral_name = cfg.string("triaxial.lateral");
+    lat_.kind = lateral_name == "membrane"         ? LateralKind::Membrane
+                : lateral_name == "rigid_cylinder" ? LateralKind::RigidCylinder
+                                                   : LateralKind::ParticleMembrane;
+    kind_ = lat_.kind;
+    check_triaxial_keys(cfg);  // checked before anything is built
+  }
+
+ private:
+  DemLoopCounters counters() override {
+    return {&st_.rows, &st_.peak_row, &st_.peak_diff, &st_.strain_at_peak, &st_.cracks_written, &st_.vtk_index,
+            &st_.next_vtk_strain, &st_.finished};
+  }
+  void set_up() override {
     info = dem::build_sample(cfg, sys);
     dem::add_platens(sys, info, cfg.real("triaxial.platen_friction"));
-    if (kind == LateralKind::Membrane) {
+    if (kind_ == LateralKind::Membrane) {
       sys.membrane.emplace(membrane_settings(cfg, sys, info));
       sys.rebuild_neighbors();
       log::info("flexible membrane: {} x {} units, {} triangles, sleeve radius {:.4g} m", sys.membrane->settings().n_theta,
                 sys.membrane->settings().n_z, sys.membrane->element_count(), sys.membrane->settings().radius);
-    } else if (kind == LateralKind::RigidCylinder) {
+    } else if (kind_ == LateralKind::RigidCylinder) {
       add_rigid_cylinder(sys, info, membrane_friction(cfg));
     }
     dem::choose_time_step(cfg, sys);
-    if (kind == LateralKind::ParticleMembrane) lat.particles = add_particle_membrane(cfg, sys, info);
-    begin_output(opt);  // sample and boundary are built: from here on files go into out_dir
+    if (kind_ == LateralKind::ParticleMembrane) lat_.particles = add_particle_membrane(cfg, sys, info);
   }
-  const Real area = info.area;  // initial cross-section (stresses on it, as the UCS test)
-  // The sample proper: a particle membrane's spheres and group come after the sample's.
-  const std::size_t n_sample = lat.sample_particles(sys);
-  const int sample_groups = sys.materials.groups() - (kind == LateralKind::ParticleMembrane ? 1 : 0);
-  auto is_sample = [n_sample](Index i) { return static_cast<std::size_t>(i) < n_sample; };
-
-  // Outputs. On resume, rows after the checkpoint are dropped (they are recomputed identically).
-  const auto cols = columns(sys.materials, sample_groups);
-  const std::vector<std::string> iso_cols = {"step", "time_s", "axial_stress_Pa", "confinement_Pa", "unbalanced_force_ratio"};
-  CsvWriter series, iso;
-  if (opt.resume) {
-    iso.reopen(opt.out_dir / "isotropic.csv", iso_cols, static_cast<std::size_t>(st.iso_rows));
-    if (st.stage == 1) series.reopen(opt.out_dir / "series.csv", cols, static_cast<std::size_t>(st.rows));
-  } else {
-    iso.open(opt.out_dir / "isotropic.csv", iso_cols);
+  // `iso_ok_rows_`: rows in a row the isotropic stage has met its criteria (it ends at 5).
+  void save_before_dem(CheckpointWriter& w) const override {
+    w.put_value("triaxial.iso_ok_rows", iso_ok_rows_);
+    if (sys.membrane) w.put_value("triaxial.membrane_settings", sys.membrane->settings());
+    if (kind_ == LateralKind::ParticleMembrane) w.put_value("triaxial.particle_membrane", lat_.particles);
   }
-  const fs::path cracks_csv = opt.out_dir / "cracks.csv";
-  {
-    dem::CrackLog head;
-    head.events.assign(sys.cracks.events.begin(), sys.cracks.events.begin() + st.cracks_written);
-    dem::append_cracks_csv(cracks_csv, head, sys.materials, 0);
+  void save_after_dem(CheckpointWriter& w) const override {
+    w.put_value("triaxial.state", st_);
+    w.put_value("triaxial.sample", sample_record(info));
   }
-  const bool vtk = cfg.boolean("output.vtk");
-  dem::DemVtkWriter writer;
-  const Real extent = 1.6 * std::max(info.width, info.height);
-  if (vtk) writer.open(opt.out_dir / "vtk", opt.resume, sys.time, kind == LateralKind::Membrane);
-  writer.set_sample_particles(n_sample);
-  if (vtk && !opt.resume) writer.write(sys, st.vtk_index++, extent);
-
-  const long every = cfg.integer("triaxial.series_interval");
-  const long cp_every = cfg.integer("triaxial.checkpoint_interval");
-  auto checkpoint = [&] {
-    write_checkpoint(cp_dir, sys, st, info, lat, iso_ok_rows);
-    control.checkpoint_written();
-  };
-  const long iso_max = cfg.integer("triaxial.isotropic_max_steps");
-  const Real iso_tol = cfg.real("triaxial.isotropic_tolerance");
-  const Real iso_ubf = cfg.real("triaxial.isotropic_unbalanced_ratio");
-  const Real stop_fraction = cfg.real("triaxial.stop_fraction"), max_strain = cfg.real("triaxial.max_strain");
-  const Real vtk_every = cfg.real("triaxial.vtk_strain_interval"), v_platen = cfg.real("triaxial.platen_velocity");
-  Progress progress("triaxial", opt.progress_interval_s);
-  // At most the isotropic cap, then the platens (v each) to the strain cap: max_strain h / (2 v dt).
-  LongRunNotice long_run(static_cast<double>(iso_max) + max_strain * info.height / (2 * v_platen * sys.settings.dt) -
-                             static_cast<double>(sys.step_count),
-                         "triaxial.platen_velocity, triaxial.max_strain or triaxial.isotropic_max_steps", sys.step_count);
-  std::vector<Real> e_hist, s_hist, l_hist;
-  if (opt.resume && st.stage == 1 && st.rows > 0) {  // the elastic fit needs the whole curve
-    const CsvTable t = read_csv(opt.out_dir / "series.csv");
-    e_hist = t.column("axial_strain");
-    s_hist = t.column("differential_stress_Pa");
-    l_hist = t.column("lateral_strain");
+  void load_before_dem(CheckpointReader& r) override {
+    iso_ok_rows_ = r.get_value<int>("triaxial.iso_ok_rows");
+    if (r.has("triaxial.membrane_settings"))
+      sys.membrane.emplace(r.get_value<dem::MembraneSettings>("triaxial.membrane_settings"));
+    if ((kind_ == LateralKind::ParticleMembrane) != r.has("triaxial.particle_membrane"))
+      cfg.fail("triaxial.lateral", "the checkpoint was written with another lateral boundary; resume with the scenario it "
+                                   "was written with");
   }
-  if (!opt.resume) checkpoint();  // resumable from the start (kill -9 before the first interval)
-  RunStatus status = RunStatus::Finished;
-  std::string stop_reason;
-
-  auto start_deviatoric = [&] {
-    st.stage = 1;
-    st.h_dev0 = sys.walls[1].point.z() - sys.walls[0].point.z();
-    st.v_dev0 = enclosed_volume(sys, lat);
-    sys.walls[0].velocity = Vec3(0, 0, v_platen);
-    sys.walls[1].velocity = Vec3(0, 0, -v_platen);
-    st.next_vtk_strain = vtk_every;
-    st.iso_cracks = static_cast<int>(sys.cracks.total());
-    series.open(opt.out_dir / "series.csv", cols);
-    if (vtk) writer.write(sys, st.vtk_index++, extent);
-    checkpoint();  // the end of a stage
-  };
-
-  try {
-    for (;;) {
-      for (long k = 0; k < every; ++k) {  // servos act every step
-        if (st.stage == 0) servo_platens(sys, p, area, servo, n_sample);
-        if (kind == LateralKind::RigidCylinder) servo_cylinder(sys, cyl, p, servo);
-        sys.step();
-        if (st.stage == 0 && kind == LateralKind::ParticleMembrane)
-          dem::limit_particle_membrane_speed(sys.particles, lat.particles, servo.v_max);
-      }
-      const Real axial = platen_stress(sys, area, n_sample);
-      const Real conf = applied_confinement(sys, lat);
-      if (st.stage == 0) {
-        st.iso_steps += every;
-        // A particle membrane's forces are constant, so there is no lateral servo to wait for,
-        // and its reported confinement follows its own radius. Its stage waits instead until its
-        // spheres have arrived and settled: the ratio over all particles, sample and spheres.
-        // That ratio levels off near 0.02 as the spheres keep creeping into the sample's surface
-        // hollows, so its limit stays at 0.05 (the sample-only ratio falls below 0.01 before
-        // the spheres even touch).
-        const bool pm = kind == LateralKind::ParticleMembrane;
-        const Real ubf = pm ? sys.max_unbalanced_force_ratio() : sys.max_unbalanced_force_ratio(n_sample);
-        const double row[] = {static_cast<double>(sys.step_count), sys.time, axial, conf, ubf};
-        iso.row(row);
-        ++st.iso_rows;
-        // Converged when both boundary stresses have stayed within the tolerance for 5 rows
-        // and the sample is in equilibrium (its measurement spheres then agree with the
-        // boundary).
-        const bool lateral_ok = pm || std::abs(conf - p) <= iso_tol * p;
-        const bool ok = std::abs(axial - p) <= iso_tol * p && lateral_ok && ubf < (pm ? std::max(iso_ubf, 0.05) : iso_ubf);
-        iso_ok_rows = ok ? iso_ok_rows + 1 : 0;
-        progress.update(sys.step_count, sys.time, std::min(1.0, static_cast<double>(st.iso_steps) / iso_max),
-                        fmt::format("isotropic: platens {:.3f} MPa, confinement {:.3f} MPa (target {:.3f})", 1e-6 * axial,
-                                    1e-6 * conf, 1e-6 * p));
-        if (iso_ok_rows >= 5 || st.iso_steps >= iso_max) {
-          st.iso_converged = iso_ok_rows >= 5;
-          if (!st.iso_converged)
-            log::warn("isotropic stage did not converge in {} steps (platens {:.3f} MPa, confinement {:.3f} MPa, target "
-                      "{:.3f} MPa); continuing. Raise triaxial.isotropic_max_steps or triaxial.servo_velocity",
-                      st.iso_steps, 1e-6 * axial, 1e-6 * conf, 1e-6 * p);
-          st.iso_axial = axial;
-          st.iso_conf = conf;
-          const auto spheres = measure_spheres(sys, info, sys.walls[0].point.z(), sys.walls[1].point.z(),
-                                               cfg.real("triaxial.measurement_sphere_radius"), n_sample);
-          st.iso_sphere_error = 0;
-          {  // By equilibrium the whole sample's average stress equals the boundary stresses.
-            const Mat3 w = sys.average_stress_of(is_sample, enclosed_volume(sys, lat));
-            st.whole_axial = -w(2, 2);
-            st.whole_lateral = -0.5 * (w(0, 0) + w(1, 1));
-          }
-          for (std::size_t s = 0; s < 3; ++s) {
-            st.sphere_axial[s] = spheres[s].axial;
-            st.sphere_lateral[s] = spheres[s].lateral;
-            st.sphere_particles[s] = spheres[s].particles;
-            st.sphere_porosity[s] = spheres[s].porosity;
-            st.iso_sphere_error = std::max({st.iso_sphere_error, std::abs(spheres[s].axial - axial) / axial,
-                                            std::abs(spheres[s].lateral - conf) / conf});
-          }
-          log::info("isotropic stage: {} steps; platens {:.3f} MPa, confinement {:.3f} MPa; measurement spheres: axial "
-                    "{:.3f}/{:.3f}/{:.3f} MPa, lateral {:.3f}/{:.3f}/{:.3f} MPa; largest deviation from the boundary {:.1f}% "
-                    "({} 5%)",
-                    st.iso_steps, 1e-6 * axial, 1e-6 * conf, 1e-6 * st.sphere_axial[0], 1e-6 * st.sphere_axial[1],
-                    1e-6 * st.sphere_axial[2], 1e-6 * st.sphere_lateral[0], 1e-6 * st.sphere_lateral[1],
-                    1e-6 * st.sphere_lateral[2], 100 * st.iso_sphere_error,
-                    st.iso_sphere_error <= 0.05 ? "within" : "NOT within");
-          if (kind == LateralKind::ParticleMembrane) {  // the estimate of add_particle_membrane(), now with contacts
-            const Real crit = sys.critical_time_step();
-            if (sys.settings.dt > crit)
-              log::warn("particle membrane: the time step {:.4g} s exceeds the critical step {:.4g} s with the membrane "
-                        "pressing; lower dem.time_step_safety", sys.settings.dt, crit);
-            else
-              log::info("particle membrane pressing: critical time step {:.4g} s (time step {:.4g} s)", crit, sys.settings.dt);
-          }
-          start_deviatoric();
-        }
-      } else {
-        const Real h = sys.walls[1].point.z() - sys.walls[0].point.z();
-        const Real ea = (st.h_dev0 - h) / st.h_dev0;
-        const Real ev = (st.v_dev0 - enclosed_volume(sys, lat)) / st.v_dev0;
-        const Real el = 0.5 * (ev - ea);
-        const Real diff = axial - p;
-        std::vector<double> row = {static_cast<double>(sys.step_count), sys.time, ea, axial, diff, conf, el, ev,
-                                   static_cast<double>(sys.cracks.tensile), static_cast<double>(sys.cracks.shear),
-                                   static_cast<double>(sys.cracks.total())};
-        for (int a = 0; a < sample_groups; ++a)
-          for (int b = a; b < sample_groups; ++b) {
-            row.push_back(static_cast<double>(sys.cracks.count(a, b, 1)));
-            row.push_back(static_cast<double>(sys.cracks.count(a, b, 2)));
-          }
-        std::size_t bonds = sys.intact_bonds();
-        if (kind == LateralKind::ParticleMembrane) bonds -= dem::particle_membrane_bonds(sys, lat.particles);
-        row.push_back(static_cast<double>(bonds));
-        row.push_back(sys.kinetic_energy());
-        row.push_back(sys.max_unbalanced_force_ratio());
-        series.row(row);
-        e_hist.push_back(ea);
-        s_hist.push_back(diff);
-        l_hist.push_back(el);  // negative when bulging, as fit_elastic expects
-        if (diff > st.peak_diff) {
-          st.peak_diff = diff;
-          st.strain_at_peak = ea;
-          st.conf_at_peak = conf;
-          st.peak_row = st.rows;
-        }
-        ++st.rows;
-        if (vtk && ea >= st.next_vtk_strain) {
-          writer.write(sys, st.vtk_index++, extent);
-          while (st.next_vtk_strain <= ea) st.next_vtk_strain += vtk_every;
-        }
-        if (st.peak_diff > 0 && st.rows > 10 && ea > st.strain_at_peak && diff < stop_fraction * st.peak_diff)
-          stop_reason = fmt::format("differential stress fell below {} of the peak", stop_fraction);
-        if (ea >= max_strain) stop_reason = fmt::format("axial strain reached triaxial.max_strain = {}", max_strain);
-        Real fraction = ea / max_strain;
-        if (st.peak_diff > 0 && ea > st.strain_at_peak)
-          fraction = std::max(fraction, (st.peak_diff - diff) / (st.peak_diff * (1 - stop_fraction)));
-        progress.update(sys.step_count, sys.time, std::min(fraction, 1.0),
-                        fmt::format("strain {:.3f}%  q {:.3f} MPa  confinement {:.3f} MPa  cracks {}", 100 * ea,
-                                    1e-6 * diff, 1e-6 * conf, sys.cracks.total()));
-      }
-      long_run.update(sys.step_count);
-      dem::append_cracks_csv(cracks_csv, sys.cracks, sys.materials, static_cast<std::size_t>(st.cracks_written));
-      st.cracks_written = static_cast<long>(sys.cracks.events.size());
-      if (!stop_reason.empty()) break;
-      if (const std::string why = control.stop_reason(sys.step_count); !why.empty()) {
-        checkpoint();
-        log_interruption(why, sys.step_count);
-        status = RunStatus::Interrupted;
-        break;
-      }
-      if (control.checkpoint_due() || (cp_every > 0 && (sys.step_count / every) % std::max(1L, cp_every / every) == 0))
-        checkpoint();
+  void load_after_dem(CheckpointReader& r) override {
+    if (kind_ == LateralKind::ParticleMembrane) {  // its group comes after the scenario's, as when it was built
+      lat_.particles = r.get_value<dem::ParticleMembraneLayout>("triaxial.particle_membrane");
+      if (dem::add_particle_membrane_group(sys.materials, particle_membrane_material(cfg)) != lat_.particles.group)
+        cfg.fail("triaxial.lateral", "the checkpoint's particle groups differ from the scenario's");
     }
-  } catch (const NumericalError&) {
-    write_checkpoint(opt.out_dir / "checkpoint_failed", sys, st, info, lat, iso_ok_rows);
-    series.close();
-    iso.close();
-    throw;
+    st_ = r.get_value<TriaxialState>("triaxial.state");
+    info = sample_info(r.get_value<SampleRecord>("triaxial.sample"));
   }
-  series.close();
-  iso.close();
-  if (status == RunStatus::Interrupted) return status;
+  std::string resume_note() const override { return st_.stage ? ", deviatoric stage" : ", isotropic stage"; }
+  void ready() override {
+    area_ = info.area;  // initial cross-section (stresses on it, as the UCS test)
+    // The sample proper: a particle membrane's spheres and group come after the sample's.
+    n_sample_ = lat_.sample_particles(sys);
+    sample_particles = n_sample_;
+    sample_groups = sys.materials.groups() - (kind_ == LateralKind::ParticleMembrane ? 1 : 0);
+    vtk_membrane = kind_ == LateralKind::Membrane;
+    columns = triaxial_columns(sys.materials, sample_groups);
+    const std::vector<std::string> iso_cols = {"step", "time_s", "axial_stress_Pa", "confinement_Pa", "unbalanced_force_ratio"};
+    if (opt.resume) iso_.reopen(opt.out_dir / "isotropic.csv", iso_cols, static_cast<std::size_t>(st_.iso_rows));
+    else iso_.open(opt.out_dir / "isotropic.csv", iso_cols);
+  }
+  bool on_curve() const override { return st_.stage == 1; }
+  // At most the isotropic cap, then the platens (v each) to the strain cap: max_strain h / (2 v dt).
+  double planned_steps() const override {
+    return static_cast<double>(iso_max_) + cfg.real("triaxial.max_strain") * info.height /
+                                               (2 * cfg.real("triaxial.platen_velocity") * sys.settings.dt);
+  }
+  void advance(long steps) override {
+    const std::size_t cyl = lat_.cylinder_wall;  // the rigid cylinder is wall 2 (after the platens)
+    // The stage changes only in measure(): fixed for these steps (kept in registers).
+    const bool iso = st_.stage == 0, cylinder = kind_ == LateralKind::RigidCylinder;
+    const bool pm_limit = iso && kind_ == LateralKind::ParticleMembrane;
+    for (long k = 0; k < steps; ++k) {  // servos act every step
+      if (iso) servo_platens(sys, p_, area_, servo_, n_sample_);
+      if (cylinder) servo_cylinder(sys, cyl, p_, servo_);
+      sys.step();
+      if (pm_limit) dem::limit_particle_membrane_speed(sys.particles, lat_.particles, servo_.v_max);
+    }
+  }
+  DemRowReport measure() override {
+    const Real axial = platen_stress(sys, area_, n_sample_);
+    const Real conf = applied_confinement(sys, lat_);
+    status.clear();
+    if (st_.stage == 0) return isotropic_row(axial, conf);
+    const Real h = sys.walls[1].point.z() - sys.walls[0].point.z();
+    const Real ea = (st_.h_dev0 - h) / st_.h_dev0;
+    const Real ev = (st_.v_dev0 - enclosed_volume(sys, lat_)) / st_.v_dev0;
+    const Real el = 0.5 * (ev - ea);  // negative when bulging, as fit_elastic expects
+    const Real diff = axial - p_;
+    row = {static_cast<double>(sys.step_count), sys.time, ea, axial, diff, conf, el, ev,
+           static_cast<double>(sys.cracks.tensile), static_cast<double>(sys.cracks.shear),
+           static_cast<double>(sys.cracks.total())};
+    for (int a = 0; a < sample_groups; ++a)
+      for (int b = a; b < sample_groups; ++b) {
+        row.push_back(static_cast<double>(sys.cracks.count(a, b, 1)));
+        row.push_back(static_cast<double>(sys.cracks.count(a, b, 2)));
+      }
+    std::size_t bonds = sys.intact_bonds();
+    if (kind_ == LateralKind::ParticleMembrane) bonds -= dem::particle_membrane_bonds(sys, lat_.particles);
+    row.push_back(static_cast<double>(bonds));
+    row.push_back(sys.kinetic_energy());
+    row.push_back(sys.max_unbalanced_force_ratio());
+    if (diff > st_.peak_diff) st_.conf_at_peak = conf;  // the loop records the peak itself
+    fmt::format_to(std::back_inserter(status), "strain {:.3f}%  q {:.3f} MPa  confinement {:.3f} MPa  cracks {}", 100 * ea,
+                   1e-6 * diff, 1e-6 * conf, sys.cracks.total());
+    return {true, ea, diff, el};
+  }
+  DemRowReport isotropic_row(Real axial, Real conf);
+  void end_isotropic(Real axial, Real conf);
+  void close_files() override { iso_.close(); }
+  void summarize(nlohmann::json& j, const DemOutcome& out) override;
+  void plots() override { make_plots(opt.out_dir, cfg); }
+  void report(const DemOutcome& out) override {
+    log::info("triaxial sigma3 = {:.3f} MPa: {}, {}, cracks {} ({} tensile, {} shear); {}", 1e-6 * p_,
+              out.no_peak.empty() ? fmt::format("peak differential stress {:.3f} MPa at axial strain {:.3f}%",
+                                                1e-6 * st_.peak_diff, 100 * st_.strain_at_peak)
+                                  : std::string("no peak"),
+              out.fit.ok() ? fmt::format("E = {:.3f} GPa, nu = {:.3f}", 1e-9 * out.fit.youngs_modulus, out.fit.poisson_ratio)
+                           : std::string("no E or nu"),
+              sys.cracks.total(), sys.cracks.tensile, sys.cracks.shear, out.stop_reason);
+  }
 
-  if (vtk) writer.write(sys, st.vtk_index++, extent);
-  const ElasticFit fit = fit_elastic(e_hist, s_hist, l_hist, static_cast<std::size_t>(st.peak_row));
-  nlohmann::json j;
-  j["fracflow_version"] = kVersion;
-  j["driver"] = "triaxial";
-  j["title"] = cfg.string("title");
-  j["lateral"] = cfg.string("triaxial.lateral");
-  j["stop_reason"] = stop_reason;
-  j["confining_pressure_Pa"] = p;
-  // No peak (still rising at triaxial.max_strain) or no fit: null with the reason, never a number.
-  const std::string no_peak = peak_problem(st.peak_diff, st.peak_row, st.rows,
-                                           stop_reason.find("triaxial.max_strain") != std::string::npos, "triaxial.max_strain");
-  auto at_peak = [&](Real v) { return no_peak.empty() ? nlohmann::json(v) : nlohmann::json(nullptr); };
-  j["peak_differential_stress_Pa"] = at_peak(st.peak_diff);
-  j["peak_axial_stress_Pa"] = at_peak(st.peak_diff + p);
-  j["confinement_at_peak_Pa"] = at_peak(st.conf_at_peak);
-  j["strain_at_peak"] = at_peak(st.strain_at_peak);
-  j["peak"] = {{"reached", no_peak.empty()}};
-  if (!no_peak.empty()) {
-    j["peak"]["reason"] = no_peak;
-    j["peak"]["largest_differential_stress_Pa"] = st.peak_diff;
-    log::warn("no peak differential stress (null in summary.json): {}", no_peak);
+  const Real p_;
+  const ServoSettings servo_;
+  const long every_, iso_max_;
+  const Real iso_tol_, iso_ubf_;
+  Lateral lat_;
+  LateralKind kind_;
+  TriaxialState st_;
+  int iso_ok_rows_ = 0;
+  Real area_ = 0;
+  std::size_t n_sample_ = 0;
+  CsvWriter iso_;
+};
+
+DemRowReport TriaxialRun::isotropic_row(Real axial, Real conf) {
+  st_.iso_steps += every_;
+  // A particle membrane's forces are constant, so there is no lateral servo to wait for, and
+  // its reported confinement follows its own radius. Its stage waits instead until its spheres
+  // have arrived and settled: the ratio over all particles, sample and spheres. That ratio
+  // levels off near 0.02 as the spheres keep creeping into the sample's surface hollows, so its
+  // limit stays at 0.05 (the sample-only ratio falls below 0.01 before the spheres even touch).
+  const bool pm = kind_ == LateralKind::ParticleMembrane;
+  const Real ubf = pm ? sys.max_unbalanced_force_ratio() : sys.max_unbalanced_force_ratio(n_sample_);
+  iso_.row({static_cast<double>(sys.step_count), sys.time, axial, conf, ubf});
+  ++st_.iso_rows;
+  // Converged when both boundary stresses have stayed within the tolerance for 5 rows and the
+  // sample is in equilibrium (its measurement spheres then agree with the boundary).
+  const bool lateral_ok = pm || std::abs(conf - p_) <= iso_tol_ * p_;
+  const bool ok = std::abs(axial - p_) <= iso_tol_ * p_ && lateral_ok && ubf < (pm ? std::max(iso_ubf_, 0.05) : iso_ubf_);
+  iso_ok_rows_ = ok ? iso_ok_rows_ + 1 : 0;
+  fmt::format_to(std::back_inserter(status), "isotropic: platens {:.3f} MPa, confinement {:.3f} MPa (target {:.3f})",
+                 1e-6 * axial, 1e-6 * conf, 1e-6 * p_);
+  DemRowReport r;
+  r.fraction = std::min(1.0, static_cast<double>(st_.iso_steps) / iso_max_);
+  if (iso_ok_rows_ >= 5 || st_.iso_steps >= iso_max_) end_isotropic(axial, conf);
+  return r;
+}
+
+// The isotropic stage's record (boundary, measurement spheres, whole sample), then the
+// deviatoric stage starts.
+void TriaxialRun::end_isotropic(Real axial, Real conf) {
+  st_.iso_converged = iso_ok_rows_ >= 5;
+  if (!st_.iso_converged)
+    log::warn("isotropic stage did not converge in {} steps (platens {:.3f} MPa, confinement {:.3f} MPa, target "
+              "{:.3f} MPa); continuing. Raise triaxial.isotropic_max_steps or triaxial.servo_velocity",
+              st_.iso_steps, 1e-6 * axial, 1e-6 * conf, 1e-6 * p_);
+  st_.iso_axial = axial;
+  st_.iso_conf = conf;
+  const auto spheres = measure_spheres(sys, info, sys.walls[0].point.z(), sys.walls[1].point.z(),
+                                       cfg.real("triaxial.measurement_sphere_radius"), n_sample_);
+  st_.iso_sphere_error = 0;
+  {  // By equilibrium the whole sample's average stress equals the boundary stresses.
+    const std::size_t n = n_sample_;
+    const Mat3 w = sys.average_stress_of([n](Index i) { return static_cast<std::size_t>(i) < n; }, enclosed_volume(sys, lat_));
+    st_.whole_axial = -w(2, 2);
+    st_.whole_lateral = -0.5 * (w(0, 0) + w(1, 1));
   }
-  put_elastic_fit(j, fit, "least squares on the pre-peak differential stress between 20% and 50% of its peak");
+  for (std::size_t s = 0; s < 3; ++s) {
+    st_.sphere_axial[s] = spheres[s].axial;
+    st_.sphere_lateral[s] = spheres[s].lateral;
+    st_.sphere_particles[s] = spheres[s].particles;
+    st_.sphere_porosity[s] = spheres[s].porosity;
+    st_.iso_sphere_error = std::max({st_.iso_sphere_error, std::abs(spheres[s].axial - axial) / axial,
+                                     std::abs(spheres[s].lateral - conf) / conf});
+  }
+  log::info("isotropic stage: {} steps; platens {:.3f} MPa, confinement {:.3f} MPa; measurement spheres: axial "
+            "{:.3f}/{:.3f}/{:.3f} MPa, lateral {:.3f}/{:.3f}/{:.3f} MPa; largest deviation from the boundary {:.1f}% "
+            "({} 5%)",
+            st_.iso_steps, 1e-6 * axial, 1e-6 * conf, 1e-6 * st_.sphere_axial[0], 1e-6 * st_.sphere_axial[1],
+            1e-6 * st_.sphere_axial[2], 1e-6 * st_.sphere_lateral[0], 1e-6 * st_.sphere_lateral[1],
+            1e-6 * st_.sphere_lateral[2], 100 * st_.iso_sphere_error, st_.iso_sphere_error <= 0.05 ? "within" : "NOT within");
+  if (kind_ == LateralKind::ParticleMembrane) {  // the estimate of add_particle_membrane(), now with contacts
+    const Real crit = sys.critical_time_step();
+    if (sys.settings.dt > crit)
+      log::warn("particle membrane: the time step {:.4g} s exceeds the critical step {:.4g} s with the membrane "
+                "pressing; lower dem.time_step_safety", sys.settings.dt, crit);
+    else
+      log::info("particle membrane pressing: critical time step {:.4g} s (time step {:.4g} s)", crit, sys.settings.dt);
+  }
+  const Real v_platen = cfg.real("triaxial.platen_velocity");
+  st_.stage = 1;
+  st_.h_dev0 = sys.walls[1].point.z() - sys.walls[0].point.z();
+  st_.v_dev0 = enclosed_volume(sys, lat_);
+  sys.walls[0].velocity = Vec3(0, 0, v_platen);
+  sys.walls[1].velocity = Vec3(0, 0, -v_platen);
+  st_.iso_cracks = static_cast<int>(sys.cracks.total());
+  begin_curve();  // series.csv, VTK cadence, snapshot, checkpoint
+}
+
+void TriaxialRun::summarize(nlohmann::json& j, const DemOutcome& out) {
+  j["lateral"] = cfg.string("triaxial.lateral");
+  j["confining_pressure_Pa"] = p_;
+  auto at_peak = [&](Real v) { return out.no_peak.empty() ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  j["peak_differential_stress_Pa"] = at_peak(st_.peak_diff);
+  j["peak_axial_stress_Pa"] = at_peak(st_.peak_diff + p_);
+  j["confinement_at_peak_Pa"] = at_peak(st_.conf_at_peak);
+  if (!out.no_peak.empty()) {
+    j["peak"]["largest_differential_stress_Pa"] = st_.peak_diff;
+    log::warn("no peak differential stress (null in summary.json): {}", out.no_peak);
+  }
+  put_elastic_fit(j, out.fit, "least squares on the pre-peak differential stress between 20% and 50% of its peak");
   nlohmann::json spheres = nlohmann::json::array();
   for (int s = 0; s < 3; ++s)
-    spheres.push_back({{"axial_Pa", st.sphere_axial[s]}, {"lateral_Pa", st.sphere_lateral[s]}, {"particles", st.sphere_particles[s]},
-                       {"porosity", st.sphere_porosity[s]}});
-  j["isotropic_stage"] = {{"steps", st.iso_steps},
-                          {"converged", st.iso_converged != 0},
-                          {"platen_stress_Pa", st.iso_axial},
-                          {"confinement_Pa", st.iso_conf},
-                          {"cracks", st.iso_cracks},
+    spheres.push_back({{"axial_Pa", st_.sphere_axial[s]}, {"lateral_Pa", st_.sphere_lateral[s]},
+                       {"particles", st_.sphere_particles[s]}, {"porosity", st_.sphere_porosity[s]}});
+  j["isotropic_stage"] = {{"steps", st_.iso_steps},
+                          {"converged", st_.iso_converged != 0},
+                          {"platen_stress_Pa", st_.iso_axial},
+                          {"confinement_Pa", st_.iso_conf},
+                          {"cracks", st_.iso_cracks},
                           {"measurement_spheres", spheres},
-                          {"whole_sample_axial_Pa", st.whole_axial},
-                          {"whole_sample_lateral_Pa", st.whole_lateral},
+                          {"whole_sample_axial_Pa", st_.whole_axial},
+                          {"whole_sample_lateral_Pa", st_.whole_lateral},
                           {"sphere_radius_fraction", cfg.real("triaxial.measurement_sphere_radius")},
-                          {"largest_sphere_deviation", st.iso_sphere_error},
-                          {"spheres_within_5_percent", st.iso_sphere_error <= 0.05}};
-  j["cracks"] = cracks_json(sys, sample_groups);
+                          {"largest_sphere_deviation", st_.iso_sphere_error},
+                          {"spheres_within_5_percent", st_.iso_sphere_error <= 0.05}};
   if (sys.membrane) {
     const auto& m = *sys.membrane;
     std::vector<Real> rad(m.settings().n_z + 1), z(m.settings().n_z + 1);
@@ -508,8 +438,8 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
     j["membrane"] = {{"elements", m.element_count()}, {"n_theta", m.settings().n_theta}, {"n_z", m.settings().n_z},
                      {"ring_radius_m", rad}, {"ring_z_m", z}};
   }
-  if (kind == LateralKind::ParticleMembrane) {
-    const auto& l = lat.particles;
+  if (kind_ == LateralKind::ParticleMembrane) {
+    const auto& l = lat_.particles;
     std::vector<Real> rad(static_cast<std::size_t>(l.n_z)), z(rad.size());
     dem::particle_membrane_profile(sys.particles, l, rad, z);
     j["particle_membrane"] = {{"particles", l.count()},
@@ -525,27 +455,9 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
                               {"ring_centre_radius_m", rad},
                               {"ring_z_m", z}};
   }
-  j["sample"] = sample_json(sys, info, static_cast<long>(n_sample));
-  j["time_step_s"] = sys.settings.dt;
-  j["steps"] = sys.step_count;
-  j["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  j["threads"] = opt.threads;
-  j["parameters"] = params_json(cfg);
-  add_run_record(j, opt);
-  write_json_atomic(opt.out_dir / "summary.json", j);
-  make_plots(opt.out_dir, cfg);
-  // Marked finished only once summary.json exists (a run killed before resumes and writes it).
-  st.finished = 1;
-  checkpoint();
-  log::info("triaxial sigma3 = {:.3f} MPa: {}, {}, cracks {} ({} tensile, {} shear); {}", 1e-6 * p,
-            no_peak.empty() ? fmt::format("peak differential stress {:.3f} MPa at axial strain {:.3f}%", 1e-6 * st.peak_diff,
-                                          100 * st.strain_at_peak)
-                            : std::string("no peak"),
-            fit.ok() ? fmt::format("E = {:.3f} GPa, nu = {:.3f}", 1e-9 * fit.youngs_modulus, fit.poisson_ratio)
-                     : std::string("no E or nu"),
-            sys.cracks.total(), sys.cracks.tensile, sys.cracks.shear, stop_reason);
-  return RunStatus::Finished;
 }
+
+RunStatus run(const Config& cfg, const RunOptions& opt) { return TriaxialRun(cfg, opt).run(); }
 
 }  // namespace
 

@@ -1,0 +1,206 @@
+#include "drivers/dem_run_loop.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "core/progress.hpp"
+#include "dem/dem_checkpoint.hpp"
+#include "dem/dem_params.hpp"
+#include "drivers/dem_results.hpp"
+#include "drivers/run_estimate.hpp"
+#include "drivers/run_record.hpp"
+#include "fracflow/version.hpp"
+#include "io/json_out.hpp"
+
+namespace fs = std::filesystem;
+
+namespace ff::drivers {
+
+DemRun::DemRun(const Config& config, const RunOptions& options, DemRunSpec s)
+    : cfg(config), opt(options), spec(std::move(s)), control_(config, options) {
+  sys.settings = dem::build_settings(cfg);
+  sys.materials = dem::build_materials(cfg);
+  cp_dir_ = opt.out_dir / "checkpoint";
+  cracks_csv_ = opt.out_dir / "cracks.csv";
+}
+
+void DemRun::write_checkpoint(const fs::path& dir) {
+  fs::create_directories(dir);
+  CheckpointWriter w(dir / "state.ffcp", /*keep_previous=*/true);
+  save_before_dem(w);
+  dem::save_dem(w, sys);
+  save_after_dem(w);
+  w.commit();
+}
+
+void DemRun::checkpoint() {
+  write_checkpoint(cp_dir_);
+  control_.checkpoint_written();
+}
+
+void DemRun::begin_curve() {
+  *c_.next_vtk_strain = vtk_every_;
+  series_.open(opt.out_dir / "series.csv", columns);
+  if (vtk_) vtk_writer_.write(sys, (*c_.vtk_index)++, extent_);
+  checkpoint();  // the end of a stage
+}
+
+// Outputs. On resume, rows, crack lines and snapshots after the checkpoint are dropped: the
+// run recomputes them identically.
+void DemRun::open_outputs() {
+  row.reserve(columns.size());
+  if (on_curve()) {
+    if (opt.resume) series_.reopen(opt.out_dir / "series.csv", columns, static_cast<std::size_t>(*c_.rows));
+    else series_.open(opt.out_dir / "series.csv", columns);
+  }
+  {
+    dem::CrackLog head;
+    head.events.assign(sys.cracks.events.begin(), sys.cracks.events.begin() + *c_.cracks_written);
+    dem::append_cracks_csv(cracks_csv_, head, sys.materials, 0);
+  }
+  vtk_ = cfg.boolean("output.vtk");
+  extent_ = 1.6 * std::max(info.width, info.height);
+  if (vtk_) vtk_writer_.open(opt.out_dir / "vtk", opt.resume, sys.time, vtk_membrane);
+  if (sample_particles > 0) vtk_writer_.set_sample_particles(sample_particles);
+  if (vtk_ && !opt.resume) {
+    vtk_writer_.write(sys, (*c_.vtk_index)++, extent_);
+    if (on_curve()) *c_.next_vtk_strain = vtk_every_;
+  }
+  if (opt.resume && on_curve() && *c_.rows > 0) {  // the elastic fit needs the whole curve
+    const CsvTable t = read_csv(opt.out_dir / "series.csv");
+    e_hist_ = t.column("axial_strain");
+    s_hist_ = t.column(spec.stress_column);
+    l_hist_ = t.column("lateral_strain");
+  }
+}
+
+// One point of the loading curve: its row, the peak, the VTK cadence and the stop criteria.
+// Returns why the run ends here (empty: go on); `fraction` gets the progress.
+std::string DemRun::curve_row(const DemRowReport& r, double& fraction) {
+  series_.row(row);
+  e_hist_.push_back(r.strain);
+  s_hist_.push_back(r.stress);
+  l_hist_.push_back(r.lateral);
+  Real& peak = *c_.peak;
+  if (r.stress > peak) {
+    peak = r.stress;
+    *c_.strain_at_peak = r.strain;
+    *c_.peak_row = *c_.rows;
+  }
+  ++*c_.rows;
+  if (vtk_ && r.strain >= *c_.next_vtk_strain) {
+    vtk_writer_.write(sys, (*c_.vtk_index)++, extent_);
+    while (*c_.next_vtk_strain <= r.strain) *c_.next_vtk_strain += vtk_every_;
+  }
+  std::string stop;
+  const bool past_peak = peak > 0 && *c_.rows > 10 && r.strain > *c_.strain_at_peak && r.stress < stop_fraction_ * peak;
+  if (past_peak) stop = fmt::format("{} fell below {} of the peak", spec.stress_name, stop_fraction_);
+  if (r.strain >= max_strain_) stop = fmt::format("axial strain reached {}.max_strain = {}", spec.name, max_strain_);
+  Real f = r.strain / max_strain_;
+  if (peak > 0 && r.strain > *c_.strain_at_peak) f = std::max(f, (peak - r.stress) / (peak * (1 - stop_fraction_)));
+  fraction = std::min(f, 1.0);
+  return stop;
+}
+
+RunStatus DemRun::run() {
+  c_ = counters();
+  const std::string& p = spec.name;
+  vtk_every_ = cfg.real(p + ".vtk_strain_interval");
+  stop_fraction_ = cfg.real(p + ".stop_fraction");
+  max_strain_ = cfg.real(p + ".max_strain");
+  if (opt.resume) {
+    CheckpointReader r = open_checkpoint(cp_dir_ / "state.ffcp");
+    load_before_dem(r);
+    dem::load_dem(r, sys);
+    load_after_dem(r);
+    if (*c_.finished) {
+      log::info("this run had already finished; nothing to resume");
+      return RunStatus::Finished;
+    }
+    log::info("resuming at step {} (t = {:.6g} s){}", sys.step_count, sys.time, resume_note());
+  } else {
+    set_up();
+    begin_output(opt);  // the sample is built: from here on files go into out_dir
+  }
+  ready();
+  open_outputs();
+
+  const long every = cfg.integer(p + ".series_interval");
+  const long cp_every = cfg.integer(p + ".checkpoint_interval");
+  Progress progress(p, opt.progress_interval_s);
+  LongRunNotice long_run(planned_steps() - static_cast<double>(sys.step_count), spec.long_run_keys, sys.step_count);
+  if (!opt.resume) checkpoint();  // resumable from the start (kill -9 before the first interval)
+  RunStatus run_status = RunStatus::Finished;
+  std::string stop_reason;
+  try {
+    for (;;) {
+      advance(every);
+      const DemRowReport r = measure();
+      double fraction = r.fraction;
+      if (r.on_curve) stop_reason = curve_row(r, fraction);
+      progress.update(sys.step_count, sys.time, fraction, status);
+      long_run.update(sys.step_count);
+      dem::append_cracks_csv(cracks_csv_, sys.cracks, sys.materials, static_cast<std::size_t>(*c_.cracks_written));
+      *c_.cracks_written = static_cast<long>(sys.cracks.events.size());
+      if (!stop_reason.empty()) break;
+      if (const std::string why = control_.stop_reason(sys.step_count); !why.empty()) {
+        checkpoint();
+        log_interruption(why, sys.step_count);
+        run_status = RunStatus::Interrupted;
+        break;
+      }
+      if (control_.checkpoint_due() || (cp_every > 0 && (sys.step_count / every) % std::max(1L, cp_every / every) == 0))
+        checkpoint();
+    }
+  } catch (const NumericalError&) {
+    // Keep the last good checkpoint; save the failing state beside it for inspection.
+    write_checkpoint(opt.out_dir / "checkpoint_failed");
+    series_.close();
+    close_files();
+    throw;
+  }
+  series_.close();
+  close_files();
+  if (run_status == RunStatus::Interrupted) return run_status;
+  finish(stop_reason);
+  return RunStatus::Finished;
+}
+
+void DemRun::finish(const std::string& stop_reason) {
+  if (vtk_) vtk_writer_.write(sys, (*c_.vtk_index)++, extent_);
+  DemOutcome out;
+  out.stop_reason = stop_reason;
+  out.fit = fit_elastic(e_hist_, s_hist_, l_hist_, static_cast<std::size_t>(*c_.peak_row));
+  // No peak (still rising at the strain cap): null with the reason, never a number.
+  const std::string cap_key = spec.name + ".max_strain";
+  out.no_peak = peak_problem(*c_.peak, *c_.peak_row, *c_.rows, stop_reason.find(cap_key) != std::string::npos, cap_key);
+  nlohmann::json j;
+  j["fracflow_version"] = kVersion;
+  j["driver"] = spec.name;
+  j["title"] = cfg.string("title");
+  j["stop_reason"] = stop_reason;
+  j["strain_at_peak"] = out.no_peak.empty() ? nlohmann::json(*c_.strain_at_peak) : nlohmann::json(nullptr);
+  j["peak"] = {{"reached", out.no_peak.empty()}};
+  if (!out.no_peak.empty()) j["peak"]["reason"] = out.no_peak;
+  summarize(j, out);
+  j["cracks"] = cracks_json(sys, sample_groups);
+  j["sample"] = sample_json(sys, info, sample_particles > 0 ? static_cast<long>(sample_particles) : -1L);
+  j["time_step_s"] = sys.settings.dt;
+  j["steps"] = sys.step_count;
+  j["wall_time_s"] = control_.elapsed_s();
+  j["threads"] = opt.threads;
+  j["parameters"] = params_json(cfg);
+  add_run_record(j, opt);
+  write_json_atomic(opt.out_dir / "summary.json", j);
+  plots();
+  // Marked finished only once summary.json exists: a run killed before this point resumes from
+  // the last checkpoint and writes it again.
+  *c_.finished = 1;
+  checkpoint();
+  report(out);
+}
+
+}  // namespace ff::drivers

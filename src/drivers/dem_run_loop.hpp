@@ -1,0 +1,132 @@
+// The one time loop of the bonded-particle drivers (ucs, triaxial, ...). It owns what every
+// such driver does the same way: checkpoint and resume, --max-steps, --max-wall, ABORT and
+// signals (RunControl), progress with ETA, the long-run notice, the numerical-error path with
+// its last checkpoint (checkpoint_failed/), series.csv, cracks.csv and the VTK cadence, the
+// loading curve (peak, stop criteria, elastic fit), summary.json and the plots. A driver derives
+// from DemRun and supplies its set-up, its per-step control (advance) and its measurements
+// (measure); the hooks are called once per series row, never per step or contact.
+#pragma once
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "dem/dem_output.hpp"
+#include "dem/dem_system.hpp"
+#include "dem/sample_builder.hpp"
+#include "drivers/driver.hpp"
+#include "drivers/run_control.hpp"
+#include "drivers/ucs/ucs_measure.hpp"
+#include "io/checkpoint.hpp"
+#include "io/csv.hpp"
+#include "io/params.hpp"
+
+namespace ff::drivers {
+
+// The loop's counters. They live in each driver's checkpointed state struct (stored as raw
+// bytes, so its layout is the checkpoint format and old checkpoints keep loading); the loop
+// reaches them through these pointers, bound once by the driver.
+struct DemLoopCounters {
+  long* rows = nullptr;            // rows of the loading curve (series.csv)
+  long* peak_row = nullptr;        // row of the largest stress
+  Real* peak = nullptr;            // largest stress of the curve
+  Real* strain_at_peak = nullptr;  // axial strain at that row
+  long* cracks_written = nullptr;  // crack events already in cracks.csv
+  long* vtk_index = nullptr;       // next VTK snapshot number
+  Real* next_vtk_strain = nullptr; // axial strain of the next cadence snapshot
+  int* finished = nullptr;         // 1 once summary.json is written
+};
+
+// What a driver's measure() reports for one row.
+struct DemRowReport {
+  bool on_curve = false;   // a point of the loading curve: `row` goes to series.csv
+  Real strain = 0, stress = 0, lateral = 0;  // the point (axial strain, stress, lateral strain)
+  double fraction = -1;    // of the run done, for the ETA; ignored on the curve (from the stop criteria)
+};
+
+// What the loop found, for the driver's part of summary.json and its closing line.
+struct DemOutcome {
+  std::string stop_reason;
+  std::string no_peak;  // why there is no peak (empty: the peak is one)
+  ElasticFit fit;
+};
+
+// Fixed per driver: its key prefix and the words its messages use.
+struct DemRunSpec {
+  std::string name;         // driver name and key prefix: NAME.series_interval, NAME.max_strain, ...
+  std::string stress_name;  // "stress", "differential stress" (stop reason)
+  std::string stress_column;  // series.csv column of the curve's stress (re-read on resume)
+  std::string long_run_keys;  // keys that shorten a long run
+};
+
+class DemRun {
+ public:
+  DemRun(const Config& cfg, const RunOptions& opt, DemRunSpec spec);
+  virtual ~DemRun() = default;
+  DemRun(const DemRun&) = delete;
+  DemRun& operator=(const DemRun&) = delete;
+  RunStatus run();  // the loop
+
+ protected:
+  // --- hooks ---
+  virtual DemLoopCounters counters() = 0;
+  // Fresh run: sample, boundaries, time step, loading velocities (nothing written yet).
+  virtual void set_up() = 0;
+  // The driver's checkpoint sections, before and after the DEM system's (restoring what
+  // load_dem needs first, e.g. a membrane).
+  virtual void save_before_dem(CheckpointWriter&) const {}
+  virtual void save_after_dem(CheckpointWriter&) const = 0;
+  virtual void load_before_dem(CheckpointReader&) {}
+  virtual void load_after_dem(CheckpointReader&) = 0;
+  // After set-up or load: series columns, sample particles/groups, the driver's own files.
+  virtual void ready() {}
+  virtual std::string resume_note() const { return {}; }  // appended to "resuming at step ..."
+  // Whether series.csv is being written (false before a driver's loading stage).
+  virtual bool on_curve() const { return true; }
+  virtual double planned_steps() const = 0;  // upper bound of the run's steps from step 0 (long-run notice)
+  // Per-step control for `steps` steps (servos...); the default just steps.
+  virtual void advance(long steps) { sys.run(steps); }
+  // One row: measure, fill `row` (on the curve) and `status` (the progress text).
+  virtual DemRowReport measure() = 0;
+  virtual void close_files() {}
+  // summary.json's driver part, its plots and its closing line.
+  virtual void summarize(nlohmann::json& j, const DemOutcome& out) = 0;
+  virtual void plots() {}
+  virtual void report(const DemOutcome& out) = 0;
+
+  // --- services for the hooks ---
+  // Starts the loading curve: series.csv, the VTK cadence, a snapshot and a checkpoint (the end
+  // of a stage).
+  void begin_curve();
+  void checkpoint();
+
+  const Config& cfg;
+  const RunOptions& opt;
+  const DemRunSpec spec;
+  dem::DemSystem sys;
+  dem::SampleInfo info;
+  std::vector<std::string> columns;   // of series.csv, set by ready() at the latest
+  std::vector<double> row;            // filled by measure(): one row of series.csv
+  std::string status;                 // filled by measure(): the progress text
+  std::size_t sample_particles = 0;   // 0: all (the rest is a boundary, e.g. a particle membrane)
+  int sample_groups = -1;             // crack counts by pair of the first groups (-1: all)
+  bool vtk_membrane = false;          // a membrane.pvd series
+
+ private:
+  void write_checkpoint(const std::filesystem::path& dir);
+  void open_outputs();
+  std::string curve_row(const DemRowReport& r, double& fraction);
+  void finish(const std::string& stop_reason);
+
+  RunControl control_;
+  std::filesystem::path cp_dir_, cracks_csv_;
+  DemLoopCounters c_;
+  CsvWriter series_;
+  dem::DemVtkWriter vtk_writer_;
+  bool vtk_ = false;
+  Real extent_ = 0, vtk_every_ = 0, stop_fraction_ = 0, max_strain_ = 0;
+  std::vector<Real> e_hist_, s_hist_, l_hist_;  // the curve, for the elastic fit
+};
+
+}  // namespace ff::drivers
