@@ -19,6 +19,7 @@
 #include <string_view>
 
 #include "core/error.hpp"
+#include "dem/sample_builder.hpp"
 
 namespace ff::dem {
 
@@ -139,18 +140,7 @@ SampleInfo place_packing(const PackingFile& p, const Config& cfg, DemSystem& sys
   const std::size_t n = p.pos.size();
   std::vector<std::size_t> order(n);  // order[new] = old
   std::iota(order.begin(), order.end(), 0);
-  if (reorder) {  // cells of two max radii, raster z-y-x, as genesis (sample_builder.cpp)
-    const Real h = 2 * *std::max_element(p.radius.begin(), p.radius.end());
-    Vec3 lo = p.pos[0];
-    for (const auto& x : p.pos) lo = lo.cwiseMin(x);
-    std::vector<std::int64_t> key(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const Vec3 c = (p.pos[i] - lo) / h;
-      key[i] = (static_cast<std::int64_t>(c.z()) << 40) + (static_cast<std::int64_t>(c.y()) << 20) +
-               static_cast<std::int64_t>(c.x());
-    }
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key[a] < key[b]; });
-  }
+  if (reorder) order = spatial_order(p.pos, p.radius);  // as genesis orders its particles
   std::vector<Index> new_index(n);
   for (std::size_t k = 0; k < n; ++k) new_index[order[k]] = static_cast<Index>(k);
 

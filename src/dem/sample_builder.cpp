@@ -198,10 +198,7 @@ VoxelGroups read_voxel_groups(const Config& cfg, const Materials& mat) {
   return vg;
 }
 
-namespace {
-
-// Spatial order (cells of two max radii, raster z-y-x) so neighbours sit close in memory.
-void sort_spatially(std::vector<Vec3>& pos, std::vector<Real>& rad) {
+std::vector<std::size_t> spatial_order(const std::vector<Vec3>& pos, const std::vector<Real>& rad) {
   const Real h = 2 * *std::max_element(rad.begin(), rad.end());
   Vec3 lo = pos[0];
   for (auto& p : pos) lo = lo.cwiseMin(p);
@@ -213,6 +210,13 @@ void sort_spatially(std::vector<Vec3>& pos, std::vector<Real>& rad) {
   std::vector<std::size_t> order(pos.size());
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key[a] < key[b]; });
+  return order;
+}
+
+namespace {
+
+void sort_spatially(std::vector<Vec3>& pos, std::vector<Real>& rad) {
+  const std::vector<std::size_t> order = spatial_order(pos, rad);
   std::vector<Vec3> p2(pos.size());
   std::vector<Real> r2(pos.size());
   for (std::size_t i = 0; i < order.size(); ++i) {

@@ -61,4 +61,8 @@ SampleInfo build_sample(const Config& cfg, DemSystem& sys);
 // Adds two platens touching the sample's ends along info.axis (bottom first), with friction.
 void add_platens(DemSystem& sys, const SampleInfo& info, Real friction);
 
+// Spatial order of particles (cells of two max radii, raster z-y-x) so neighbours sit close in
+// memory: order[new] = old. Genesis and loaded packings use it.
+std::vector<std::size_t> spatial_order(const std::vector<Vec3>& pos, const std::vector<Real>& rad);
+
 }  // namespace ff::dem
