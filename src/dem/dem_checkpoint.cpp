@@ -86,7 +86,7 @@ void save_dem(CheckpointWriter& w, const DemSystem& s) {
     w.put("dem.membrane.v", std::vector<Vec3>(v.begin(), v.end()));
     w.put_value("dem.membrane.pressure", s.membrane->settings().pressure);
     // Shear history of the element contacts (frictional membranes depend on it).
-    auto& m = const_cast<FlexibleMembrane&>(*s.membrane);
+    const FlexibleMembrane& m = *s.membrane;
     const auto cp = m.candidate_particles(), ce = m.candidate_elements();
     const auto cs = m.contact_states();
     w.put("dem.membrane.cand_p", std::vector<Index>(cp.begin(), cp.end()));

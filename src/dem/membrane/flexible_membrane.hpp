@@ -158,6 +158,7 @@ class FlexibleMembrane {
   // Normal stiffness of each candidate's contact, 0 when it carries no force (time step) [N/m].
   std::span<const Real> candidate_stiffness() const { return kn_; }
   std::span<ContactState> contact_states() { return state_; }  // shear history per candidate
+  std::span<const ContactState> contact_states() const { return state_; }
   void add_loads_to(std::span<Vec3> force, std::span<Vec3> moment) const;
   // Servo + vertex update from the last compute_forces(); z of the platen planes [m].
   void move(Real dt, Real z_bottom, Real z_top);
