@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <charconv>
 #include <chrono>
-#include <csignal>
 #include <filesystem>
 
 #include "batch/run_case.hpp"
@@ -91,14 +90,7 @@ std::string command_line(int argc, char** argv) {
 
 // Why a driver returned RunStatus::Interrupted.
 std::string stop_reason(const RunOptions& opt, double elapsed_s) {
-  if (stop_requested()) {
-    switch (stop_signal()) {
-      case SIGINT: return "SIGINT (Ctrl-C)";
-      case SIGTERM: return "SIGTERM";
-      case 0: return "a stop request";
-      default: return fmt::format("signal {}", stop_signal());
-    }
-  }
+  if (stop_requested()) return stop_signal_name();
   if (!opt.abort_file.empty() && fs::exists(opt.abort_file)) return fmt::format("the file {}", opt.abort_file.string());
   if (opt.max_wall_s > 0 && elapsed_s >= 0.99 * opt.max_wall_s) return fmt::format("--max-wall {:g}", opt.max_wall_s);
   if (opt.max_steps > 0) return fmt::format("--max-steps {}", opt.max_steps);

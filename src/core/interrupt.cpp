@@ -1,7 +1,7 @@
 #include "core/interrupt.hpp"
 
-#include <atomic>
 #include <algorithm>
+#include <atomic>
 #include <csignal>
 #include <signal.h>
 
@@ -33,6 +33,15 @@ void install_stop_signal_handlers() {
 
 bool stop_requested() { return g_signal.load(std::memory_order_relaxed) >= 0; }
 int stop_signal() { return std::max(0, g_signal.load(std::memory_order_relaxed)); }
+std::string stop_signal_name() {
+  switch (const int sig = stop_signal()) {
+    case SIGINT: return "SIGINT (Ctrl-C)";
+    case SIGTERM: return "SIGTERM";
+    case 0: return "a stop request";
+    default: return "signal " + std::to_string(sig);
+  }
+}
+
 void request_stop(int signal) { g_signal.store(signal); }
 void clear_stop_request() { g_signal.store(-1); }
 

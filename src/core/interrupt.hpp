@@ -4,6 +4,7 @@
 // same kind while the first is being handled ends the process at once (the previous
 // checkpoint stays valid: checkpoints are replaced atomically).
 #pragma once
+#include <string>
 
 namespace ff {
 
@@ -14,6 +15,9 @@ void install_stop_signal_handlers();
 bool stop_requested();
 // The signal that asked to stop (0: none, or request_stop()).
 int stop_signal();
+// What asked to stop, for messages: "SIGINT (Ctrl-C)", "SIGTERM", "signal N", or "a stop
+// request" (request_stop() without a signal, or no request).
+std::string stop_signal_name();
 // Sets the flag from code (tests); `signal` is what stop_signal() then reports.
 void request_stop(int signal = 0);
 // Clears the flag (tests that run several drivers in one process).

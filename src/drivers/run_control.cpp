@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <csignal>
 #include <filesystem>
 
 #include "core/interrupt.hpp"
@@ -23,12 +22,7 @@ bool RunControl::checkpoint_due() const {
 void RunControl::checkpoint_written() { last_checkpoint_ = Clock::now(); }
 
 std::string RunControl::stop_reason(long step) const {
-  if (stop_requested()) {
-    const int sig = stop_signal();
-    if (sig == SIGINT) return "SIGINT (Ctrl-C) received";
-    if (sig == SIGTERM) return "SIGTERM received";
-    return sig > 0 ? fmt::format("signal {} received", sig) : std::string("stop requested");
-  }
+  if (stop_requested()) return fmt::format("{} received", stop_signal_name());
   if (!opt_.abort_file.empty() && std::filesystem::exists(opt_.abort_file))
     return fmt::format("the file {} appeared", opt_.abort_file.string());
   if (opt_.max_steps > 0 && step >= opt_.max_steps) return fmt::format("step {} reached (--max-steps)", opt_.max_steps);
