@@ -98,7 +98,8 @@ std::string DemRun::curve_row(const DemRowReport& r, double& fraction) {
   std::string stop;
   const bool past_peak = peak > 0 && *c_.rows > 10 && r.strain > *c_.strain_at_peak && r.stress < stop_fraction_ * peak;
   if (past_peak) stop = fmt::format("{} fell below {} of the peak", spec.stress_name, stop_fraction_);
-  if (r.strain >= max_strain_) stop = fmt::format("axial strain reached {}.max_strain = {}", spec.name, max_strain_);
+  stopped_at_strain_cap_ = r.strain >= max_strain_;
+  if (stopped_at_strain_cap_) stop = fmt::format("axial strain reached {}.max_strain = {}", spec.name, max_strain_);
   Real f = r.strain / max_strain_;
   if (peak > 0 && r.strain > *c_.strain_at_peak) f = std::max(f, (peak - r.stress) / (peak * (1 - stop_fraction_)));
   fraction = std::min(f, 1.0);
@@ -176,7 +177,7 @@ void DemRun::finish(const std::string& stop_reason) {
   out.fit = fit_elastic(e_hist_, s_hist_, l_hist_, static_cast<std::size_t>(*c_.peak_row));
   // No peak (still rising at the strain cap): null with the reason, never a number.
   const std::string cap_key = spec.name + ".max_strain";
-  out.no_peak = peak_problem(*c_.peak, *c_.peak_row, *c_.rows, stop_reason.find(cap_key) != std::string::npos, cap_key);
+  out.no_peak = peak_problem(*c_.peak, *c_.peak_row, *c_.rows, stopped_at_strain_cap_, cap_key);
   nlohmann::json j;
   j["fracflow_version"] = kVersion;
   j["driver"] = spec.name;
