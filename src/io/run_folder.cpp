@@ -86,6 +86,34 @@ bool is_empty_dir(const fs::path& dir) {
   return fs::is_empty(dir, ec) && !ec;
 }
 
+// What an --out folder holds, once it has passed the refusals every new folder meets (protected
+// folders, a file in the way). The callers word the refusals of the other cases.
+enum class Existing { Nothing, OurRun, Foreign };
+Existing existing_folder(const fs::path& dir, const fs::path& scenario_file) {
+  refuse_protected_out_dir(dir, scenario_file);
+  std::error_code ec;
+  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+    throw InputError(fmt::format("--out '{}' is a file, not a folder; choose another folder with --out", dir.string()));
+  if (!fs::exists(dir, ec) || is_empty_dir(dir)) return Existing::Nothing;
+  return is_fracflow_run(dir) ? Existing::OurRun : Existing::Foreign;
+}
+
+// The lock of an old folder of ours that is to be replaced (refused while another process writes
+// it), after checking that its parent, where the replacement happens, can be written.
+FolderLock lock_for_replacement(const fs::path& dir) {
+  probe_writable(dir.parent_path().empty() ? fs::path(".") : dir.parent_path());
+  return FolderLock::acquire(dir);
+}
+
+// DIR/.fracflow/run.json: `fields` plus what every marker says.
+void write_marker(const fs::path& dir, nlohmann::json fields) {
+  fields["fracflow_run"] = 1;
+  fields["version"] = kVersion;
+  fields["created_utc"] = utc_now();
+  fields["pid"] = static_cast<long>(::getpid());
+  write_file_atomic(run_marker_file(dir), fields.dump(2) + "\n");
+}
+
 }  // namespace
 
 void refuse_protected_out_dir(const fs::path& dir, const fs::path& scenario_file, const std::string& flag) {
@@ -171,12 +199,9 @@ FolderLock FolderLock::acquire(const fs::path& dir) {
 }
 
 NewRunFolder::NewRunFolder(fs::path dir, bool overwrite, const fs::path& scenario_file) : dir_(std::move(dir)) {
-  refuse_protected_out_dir(dir_, scenario_file);
-  std::error_code ec;
-  if (fs::exists(dir_, ec) && !fs::is_directory(dir_, ec))
-    throw InputError(fmt::format("--out '{}' is a file, not a folder; choose another folder with --out", dir_.string()));
-  if (fs::exists(dir_, ec) && !is_empty_dir(dir_)) {
-    if (!is_fracflow_run(dir_))
+  const Existing existing = existing_folder(dir_, scenario_file);
+  if (existing != Existing::Nothing) {
+    if (existing == Existing::Foreign)
       throw InputError(fmt::format(
           "results folder '{}' is not empty and holds no fracflow run (no {}), so fracflow neither writes into it nor "
           "deletes it, with or without --overwrite; choose a new or empty folder with --out (a run made by an older "
@@ -186,8 +211,7 @@ NewRunFolder::NewRunFolder(fs::path dir, bool overwrite, const fs::path& scenari
       throw InputError(fmt::format("results folder '{}' already holds a run; pass --overwrite to replace it, --out to "
                                    "choose another folder, or `fracflow resume {}` to continue it",
                                    dir_.string(), dir_.string()));
-    probe_writable(dir_.parent_path().empty() ? fs::path(".") : dir_.parent_path());  // the swap renames in the parent
-    old_lock_ = FolderLock::acquire(dir_);  // refused now if the old run is still being written
+    old_lock_ = lock_for_replacement(dir_);  // the swap renames in the parent
     replace_ = true;
   }
   probe_writable(dir_);
@@ -212,12 +236,7 @@ void NewRunFolder::begin(const std::string& resolved_toml, const std::string& co
   try {
     fs::create_directories(dir_);
     lock_ = FolderLock::acquire(dir_);
-    nlohmann::json marker = {{"fracflow_run", 1},
-                             {"version", kVersion},
-                             {"created_utc", utc_now()},
-                             {"command", command},
-                             {"pid", static_cast<long>(::getpid())}};
-    write_file_atomic(run_marker_file(dir_), marker.dump(2) + "\n");
+    write_marker(dir_, {{"command", command}});
     write_file_atomic(original_scenario_file(dir_), resolved_toml);
     write_file_atomic(dir_ / "scenario.toml", resolved_toml);
   } catch (...) {
@@ -248,12 +267,9 @@ void NewRunFolder::discard_if_empty() {
 }
 
 FolderLock prepare_batch_folder(const fs::path& dir, bool overwrite, const std::string& what) {
-  refuse_protected_out_dir(dir, {});
-  std::error_code ec;
-  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
-    throw InputError(fmt::format("--out '{}' is a file, not a folder; choose another folder with --out", dir.string()));
-  if (fs::exists(dir, ec) && !is_empty_dir(dir)) {
-    if (!is_fracflow_run(dir))
+  const Existing existing = existing_folder(dir, {});
+  if (existing != Existing::Nothing) {
+    if (existing == Existing::Foreign)
       throw InputError(fmt::format("{} '{}' is not empty and holds no fracflow results (no {}), so fracflow neither "
                                    "writes into it nor deletes it, with or without --overwrite; choose a new or empty "
                                    "folder with --out",
@@ -262,20 +278,13 @@ FolderLock prepare_batch_folder(const fs::path& dir, bool overwrite, const std::
       throw InputError(fmt::format("{} '{}' already holds results; pass --overwrite to replace it or --out to choose "
                                    "another folder",
                                    what, dir.string()));
-    probe_writable(dir.parent_path().empty() ? fs::path(".") : dir.parent_path());
-    FolderLock old = FolderLock::acquire(dir);  // refused while another process writes it
+    FolderLock old = lock_for_replacement(dir);
     fs::remove_all(dir);
   }
   probe_writable(dir);
   fs::create_directories(dir);
   FolderLock lock = FolderLock::acquire(dir);
-  nlohmann::json marker = {{"fracflow_run", 1},
-                           {"kind", what},
-                           {"version", kVersion},
-                           {"created_utc", utc_now()},
-                           {"command", process_command_line()},
-                           {"pid", static_cast<long>(::getpid())}};
-  write_file_atomic(run_marker_file(dir), marker.dump(2) + "\n");
+  write_marker(dir, {{"kind", what}, {"command", process_command_line()}});
   return lock;
 }
 
