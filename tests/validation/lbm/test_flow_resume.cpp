@@ -1,6 +1,7 @@
 // Runs of the flow drivers that are interrupted (wall-clock limit, checkpoint) and resumed give
 // bit-identical series, results and final populations, on both lattices and precisions; and
 // unstable numerics stop the run with a message that says what to change.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -142,7 +143,7 @@ void expect_every_resume_identical(const std::string& name, const std::string& t
     std::string what = name + " interrupted at";
     for (std::size_t k = 0; k < stops.size(); ++k) {
       ASSERT_EQ(run_flow_driver_status(name + "_cut", text, sets, k > 0, 0, stops[k]), ff::RunStatus::Interrupted);
-      what += " " + std::to_string(stops[k]);
+      what += fmt::format(" {}", stops[k]);  // (" " + std::to_string trips GCC 12's -Wrestrict)
     }
     ASSERT_EQ(run_flow_driver_status(name + "_cut", text, sets, true), ff::RunStatus::Finished) << what;
     ff::test::expect_same_results(whole, cut, what);
