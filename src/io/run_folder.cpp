@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
@@ -143,7 +144,10 @@ void probe_writable(const fs::path& dir, const std::string& flag) {
     throw InputError(fmt::format("{} '{}': '{}' is a file, not a folder; choose another folder with {}", flag,
                                  dir.string(), at.string(), flag));
   // access(2) is not enough: root passes it on folders it may not write (e.g. under /proc).
-  const fs::path probe = at / fmt::format(".fracflow-probe-{}", static_cast<long>(::getpid()));
+  // One name per call: threads of one process (calibrate's UCS run beside its triaxial sweep)
+  // probe the same parent at once.
+  static std::atomic<unsigned long> probes{0};
+  const fs::path probe = at / fmt::format(".fracflow-probe-{}-{}", static_cast<long>(::getpid()), probes++);
   if (::mkdir(probe.c_str(), 0700) != 0) {
     const int err = errno;
     throw InputError(fmt::format("{} '{}' cannot be written: cannot create anything in '{}' ({}); choose a folder you "

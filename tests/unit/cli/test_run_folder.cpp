@@ -7,12 +7,14 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <string>
+#include <thread>
 
 #include "core/error.hpp"
 #include "../program_runner.hpp"
@@ -208,4 +210,23 @@ TEST(RunFolder, BatchFolderReplacesOnlyAFolderOfOurs) {
   EXPECT_TRUE(is_fracflow_run(dir));
   EXPECT_NE(message_of([&] { prepare_batch_folder(".", true, "sweep folder"); }).find("current directory"),
             std::string::npos);
+}
+
+TEST(RunFolder, ThreadsOfOneProcessProbeTheSameFolderAtOnce) {
+  // `fracflow calibrate` starts a UCS run beside its triaxial sweep in one process: both probe
+  // the calibration folder at the same moment, and neither may be refused for the other's probe.
+  Scratch s;
+  std::atomic<int> failures{0};
+  auto probe_many = [&] {
+    for (int i = 0; i < 2000; ++i) try {
+        probe_writable(s.path);
+      } catch (const InputError&) {
+        ++failures;
+      }
+  };
+  std::thread a(probe_many), b(probe_many);
+  a.join();
+  b.join();
+  EXPECT_EQ(failures.load(), 0);
+  EXPECT_TRUE(fs::is_empty(s.path)) << "every probe folder is removed again";
 }
