@@ -48,6 +48,8 @@
 #include "dem/sample_builder.hpp"
 #include "drivers/driver.hpp"
 #include "io/scenario.hpp"
+#include "dem/diagnostics.hpp"
+#include "dem/membrane/membrane_boundary.hpp"
 
 using namespace ff;
 
@@ -247,20 +249,20 @@ int run(const Options& o) {
     out.pos = base.particles.pos;
     out.radius = base.particles.radius;
     out.has_bond_list = true;
-    for (std::size_t b = 0; b < base.bond_i.size(); ++b)
-      if (!base.bond_broken[b]) out.bonds.emplace_back(base.bond_i[b], base.bond_j[b]);
+    for (std::size_t b = 0; b < base.bonds.i.size(); ++b)
+      if (!base.bonds.broken[b]) out.bonds.emplace_back(base.bonds.i[b], base.bonds.j[b]);
     dem::write_packing_file(o.write_packing, out,
                             fmt::format("fracflow benchmarks/dem_ucs sample: {} particles, {} bonds\nfrom {}",
                                         out.pos.size(), out.bonds.size(), origin));
     fmt::print("wrote {} ({} particles, {} bonds)\n", o.write_packing, out.pos.size(), out.bonds.size());
   }
   dem::add_platens(base, info, 0.1);
-  base.settings.dt = 0.8 * base.critical_time_step();
+  base.settings.dt = 0.8 * critical_time_step(base);
   base.walls[0].velocity.z() = 0.05;
   base.walls[1].velocity.z() = -0.05;
   base.run(200);  // load the sample a little so every contact and bond is active
   fmt::print("{}: {} particles, {} bonds, {} contacts touching; {}\n", o.packing.empty() ? "ucs-cylinder benchmark" : "packing benchmark",
-             base.particles.size(), base.intact_bonds(), base.contacts_touching(), origin);
+             base.particles.size(), intact_bonds(base), contacts_touching(base), origin);
   if (base.particles.size() < base.settings.parallel_min)
     fmt::print("note: fewer particles than DemSettings::parallel_min = {}: the engine's loops run on one thread "
                "whatever the thread count\n",
@@ -314,7 +316,7 @@ int run(const Options& o) {
     m.pressure = 5e6;
     m.v_max = 1.0;
     m.r_min = 0.9 * R;
-    wrapped.membrane.emplace(m);
+    dem::attach_membrane(wrapped, m);
     wrapped.rebuild_neighbors();
     plain.run(20);
     wrapped.run(400);  // the membrane closes its clearance and touches the sample
@@ -322,7 +324,7 @@ int run(const Options& o) {
     double best_plain = 1e300, best_wrapped = 1e300, total_plain = 0, total_wrapped = 0;
     std::vector<double> ratios;
     const long nb_plain = plain.neighbor_builds(), nb_wrapped = wrapped.neighbor_builds();
-    const long mb_wrapped = wrapped.membrane_builds();
+    const long mb_wrapped = dem::membrane_boundary(wrapped)->builds();
     wrapped.stage_times = {};
     for (long done = 0; done < steps;) {
       const long n = std::min(kBlock, steps - done);
@@ -340,7 +342,7 @@ int run(const Options& o) {
       done += n;
     }
     int touching = 0;
-    for (std::size_t k = 0; k < wrapped.membrane->element_count(); ++k) touching += wrapped.membrane->contacts(k) > 0;
+    for (std::size_t k = 0; k < dem::membrane_of(wrapped)->element_count(); ++k) touching += dem::membrane_of(wrapped)->contacts(k) > 0;
     // The membrane's own stage (its candidate searches, contact forces, servo and vertex update)
     // against the rest of the same steps: what it adds to a step of the same confined sample,
     // free of the A/B difference that the confined sample has more contacts than the free one.
@@ -349,12 +351,12 @@ int run(const Options& o) {
     fmt::print("membrane: {} triangles ({} touching the sample), {} candidates; step time +{:.1f}% on 1 thread "
                "(median of {} interleaved block pairs; best blocks +{:.1f}%), +{:.1f}% in total over the {} steps "
                "(neighbour rebuilds: {} without, {} with the membrane; membrane candidate rebuilds {})\n",
-               wrapped.membrane->element_count(), touching, wrapped.membrane->candidate_particles().size(),
+               dem::membrane_of(wrapped)->element_count(), touching, dem::membrane_of(wrapped)->candidate_particles().size(),
                100 * (median(ratios) - 1), ratios.size(), 100 * (best_wrapped / best_plain - 1),
                100 * (total_wrapped / total_plain - 1), steps, plain.neighbor_builds() - nb_plain,
-               wrapped.neighbor_builds() - nb_wrapped, wrapped.membrane_builds() - mb_wrapped);
+               wrapped.neighbor_builds() - nb_wrapped, dem::membrane_boundary(wrapped)->builds() - mb_wrapped);
     fmt::print("membrane stage: {:.1f}% of the wrapped sample's step time, i.e. +{:.1f}% over the rest of its step\n",
-               100 * t.membrane / (rest + t.membrane), 100 * t.membrane / rest);
+               100 * t.boundaries / (rest + t.boundaries), 100 * t.boundaries / rest);
   }
   return 0;
 }

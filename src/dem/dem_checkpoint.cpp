@@ -46,12 +46,12 @@ void save_dem(CheckpointWriter& w, const DemSystem& s) {
   w.put("dem.inv_inertia", P.inv_inertia);
   w.put("dem.group", P.group);
   w.put("dem.inward_force", P.inward_force);
-  w.put("dem.bond_i", s.bond_i);
-  w.put("dem.bond_j", s.bond_j);
-  w.put("dem.bond_pair", s.bond_pair);
-  w.put("dem.bond_broken", s.bond_broken);
-  w.put("dem.pbond", s.pbond);
-  w.put("dem.rbond", s.rbond);
+  w.put("dem.bond_i", s.bonds.i);
+  w.put("dem.bond_j", s.bonds.j);
+  w.put("dem.bond_pair", s.bonds.pair);
+  w.put("dem.bond_broken", s.bonds.broken);
+  w.put("dem.pbond", s.bonds.parallel);
+  w.put("dem.rbond", s.bonds.rotational);
   w.put_value("dem.time", s.time);
   w.put_value("dem.step", s.step_count);
   w.put_value("dem.dt", s.settings.dt);
@@ -80,19 +80,7 @@ void save_dem(CheckpointWriter& w, const DemSystem& s) {
   }
   w.put("dem.cracks", s.cracks.events);
   w.put_value("dem.wall_motion", s.wall_motion_since_build());
-  if (s.membrane) {
-    const auto x = s.membrane->vertices(), v = s.membrane->vertex_velocities();
-    w.put("dem.membrane.x", std::vector<Vec3>(x.begin(), x.end()));
-    w.put("dem.membrane.v", std::vector<Vec3>(v.begin(), v.end()));
-    w.put_value("dem.membrane.pressure", s.membrane->settings().pressure);
-    // Shear history of the element contacts (frictional membranes depend on it).
-    const FlexibleMembrane& m = *s.membrane;
-    const auto cp = m.candidate_particles(), ce = m.candidate_elements();
-    const auto cs = m.contact_states();
-    w.put("dem.membrane.cand_p", std::vector<Index>(cp.begin(), cp.end()));
-    w.put("dem.membrane.cand_e", std::vector<Index>(ce.begin(), ce.end()));
-    w.put("dem.membrane.state", std::vector<ContactState>(cs.begin(), cs.end()));
-  }
+  for (const auto& b : s.boundaries()) b->save(w, s);
 }
 
 void load_dem(CheckpointReader& r, DemSystem& s) {
@@ -111,12 +99,12 @@ void load_dem(CheckpointReader& r, DemSystem& s) {
   r.get("dem.inv_inertia", P.inv_inertia);
   r.get("dem.group", P.group);
   if (r.has("dem.inward_force")) r.get("dem.inward_force", P.inward_force);  // older checkpoints: none
-  r.get("dem.bond_i", s.bond_i);
-  r.get("dem.bond_j", s.bond_j);
-  r.get("dem.bond_pair", s.bond_pair);
-  r.get("dem.bond_broken", s.bond_broken);
-  r.get("dem.pbond", s.pbond);
-  r.get("dem.rbond", s.rbond);
+  r.get("dem.bond_i", s.bonds.i);
+  r.get("dem.bond_j", s.bonds.j);
+  r.get("dem.bond_pair", s.bonds.pair);
+  r.get("dem.bond_broken", s.bonds.broken);
+  r.get("dem.pbond", s.bonds.parallel);
+  r.get("dem.rbond", s.bonds.rotational);
   s.time = r.get_value<Real>("dem.time");
   s.step_count = r.get_value<long>("dem.step");
   s.settings.dt = r.get_value<Real>("dem.dt");
@@ -167,33 +155,9 @@ void load_dem(CheckpointReader& r, DemSystem& s) {
     r.get(fmt::format("dem.wall{}.load", k), wc[k].load);
   }
   s.wall_motion_since_build() = r.get_value<Real>("dem.wall_motion");
-  // A membrane is built by the driver from its settings before load_dem(); its vertices come
-  // back here, its candidates are searched again and every candidate found again gets its
-  // contact history back (both lists are sorted by particle, then element).
-  if (s.membrane) {
-    if (!r.has("dem.membrane.x"))
-      throw InputError("checkpoint holds no flexible membrane, but the scenario has one; resume with the scenario it was written with");
-    std::vector<Vec3> x, v;
-    r.get("dem.membrane.x", x);
-    r.get("dem.membrane.v", v);
-    s.membrane->restore_vertices(x, v);
-    s.membrane->set_pressure(r.get_value<Real>("dem.membrane.pressure"));
-    s.rebuild_membrane_candidates();
-    if (r.has("dem.membrane.state")) {
-      std::vector<Index> op, oe;
-      std::vector<ContactState> os;
-      r.get("dem.membrane.cand_p", op);
-      r.get("dem.membrane.cand_e", oe);
-      r.get("dem.membrane.state", os);
-      const auto np = s.membrane->candidate_particles(), ne = s.membrane->candidate_elements();
-      const auto ns = s.membrane->contact_states();
-      std::size_t k = 0;
-      for (std::size_t c = 0; c < np.size(); ++c) {
-        while (k < op.size() && (op[k] < np[c] || (op[k] == np[c] && oe[k] < ne[c]))) ++k;
-        if (k < op.size() && op[k] == np[c] && oe[k] == ne[c]) ns[c] = os[k];
-      }
-    }
-  }
+  // Boundaries (the flexible membrane) are attached by the driver from its settings before
+  // load_dem(); their state comes back here.
+  for (const auto& b : s.boundaries()) b->load(r, s);
 }
 
 }  // namespace ff::dem

@@ -7,6 +7,7 @@
 
 #include "core/error.hpp"
 #include "io/vtk.hpp"
+#include "dem/membrane/membrane_boundary.hpp"
 
 namespace ff::dem {
 
@@ -83,15 +84,15 @@ void DemVtkWriter::write(const DemSystem& sys, long index, Real wall_extent) {
     std::vector<double> fn, fs;
     std::vector<std::int32_t> pair;
     const auto& bl = sys.bond_loads();
-    for (std::size_t b = 0; b < sys.bond_i.size(); ++b) {
-      if (sys.bond_broken[b]) continue;
-      conn.push_back(sys.bond_i[b]);
-      conn.push_back(sys.bond_j[b]);
-      const Vec3 d = (P.pos[sys.bond_j[b]] - P.pos[sys.bond_i[b]]).normalized();
+    for (std::size_t b = 0; b < sys.bonds.i.size(); ++b) {
+      if (sys.bonds.broken[b]) continue;
+      conn.push_back(sys.bonds.i[b]);
+      conn.push_back(sys.bonds.j[b]);
+      const Vec3 d = (P.pos[sys.bonds.j[b]] - P.pos[sys.bonds.i[b]]).normalized();
       const Vec3& f = bl[b].f;
       fn.push_back(-f.dot(d));
       fs.push_back((f - f.dot(d) * d).norm());
-      pair.push_back(sys.bond_pair[b]);
+      pair.push_back(sys.bonds.pair[b]);
     }
     const VtkArray cd[] = {vtk_array("normal_force", std::span<const double>(fn)),
                            vtk_array("shear_force", std::span<const double>(fs)),
@@ -163,9 +164,9 @@ void DemVtkWriter::write(const DemSystem& sys, long index, Real wall_extent) {
     write_vtp(dir_ / f, pts, VtpCells{VtpCells::Triangles, tri}, {}, cd);
     walls_.add(sys.time, f);
   }
-  if (with_membrane_ && sys.membrane) {
+  if (const auto* mem = membrane_of(sys); with_membrane_ && mem) {
     const std::string f = "membrane_" + tag + ".vtp";
-    sys.membrane->write_vtk(dir_ / f);
+    mem->write_vtk(dir_ / f);
     membrane_.add(sys.time, f);
   }
 }

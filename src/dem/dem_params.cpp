@@ -7,6 +7,7 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "dem/diagnostics.hpp"
 
 namespace ff::dem {
 
@@ -204,11 +205,11 @@ DemSettings build_settings(const Config& cfg) {
 void choose_time_step(const Config& cfg, DemSystem& sys) {
   const Real safety = cfg.real("dem.time_step_safety");
   const Real dt_user = cfg.real("dem.time_step");
-  const Real crit = sys.critical_time_step();
+  const Real crit = critical_time_step(sys);
   if (dt_user <= 0) {
     sys.settings.dt = safety * crit;
   } else if (cfg.boolean("dem.mass_scaling")) {
-    sys.scale_masses_for(dt_user, safety);
+    scale_masses_for(sys, dt_user, safety);
     sys.settings.dt = dt_user;
   } else {
     if (dt_user > safety * crit)

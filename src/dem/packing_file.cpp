@@ -157,12 +157,12 @@ SampleInfo place_packing(const PackingFile& p, const Config& cfg, DemSystem& sys
     rsum += P.radius[k];
   }
   sys.walls.clear();
-  sys.bond_i.clear();
-  sys.bond_j.clear();
-  sys.bond_pair.clear();
-  sys.bond_broken.clear();
-  sys.pbond.clear();
-  sys.rbond.clear();
+  sys.bonds.i.clear();
+  sys.bonds.j.clear();
+  sys.bonds.pair.clear();
+  sys.bonds.broken.clear();
+  sys.bonds.parallel.clear();
+  sys.bonds.rotational.clear();
   sys.settings.skin = cfg.real("dem.skin_ratio") * rsum / static_cast<Real>(n);
   SampleInfo info;
   info.dim = dim;
@@ -181,9 +181,9 @@ SampleInfo place_packing(const PackingFile& p, const Config& cfg, DemSystem& sys
     }
   }
   std::vector<int> degree(n, 0);
-  for (std::size_t b = 0; b < sys.bond_i.size(); ++b) {
-    ++degree[sys.bond_i[b]];
-    ++degree[sys.bond_j[b]];
+  for (std::size_t b = 0; b < sys.bonds.i.size(); ++b) {
+    ++degree[sys.bonds.i[b]];
+    ++degree[sys.bonds.j[b]];
   }
   for (int d : degree) info.floaters += d < (dim == 3 ? 3 : 2);
   Vec3 lo = P.pos[0], hi = P.pos[0];

@@ -13,6 +13,7 @@
 #include "geometry/packing.hpp"
 #include "geometry/point_in_mesh.hpp"
 #include "geometry/shapes.hpp"
+#include "dem/diagnostics.hpp"
 
 namespace ff::dem {
 
@@ -232,14 +233,14 @@ long equilibrate(DemSystem& sys, Real tol, long max_steps) {
   long s = 0;
   for (; s < max_steps; s += 50) {
     sys.run(50);
-    if (sys.max_unbalanced_force_ratio() < tol) break;
+    if (max_unbalanced_force_ratio(sys) < tol) break;
   }
   return s;
 }
 
 // Mean stress (compression > 0) of all particles, over the container volume.
 Real mean_stress(const DemSystem& sys, Real volume, int dim) {
-  const Mat3 s = sys.average_stress([](const Vec3&) { return true; }, volume);
+  const Mat3 s = average_stress(sys, [](const Vec3&) { return true; }, volume);
   return dim == 3 ? -s.trace() / 3.0 : -(s(0, 0) + s(1, 1)) / 2.0;
 }
 
@@ -448,7 +449,7 @@ SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
   rmean /= static_cast<Real>(P.size());
   sys.settings.skin = cfg.real("sample.genesis_tolerance") > 0 ? cfg.real("dem.skin_ratio") * rmean : 0;
   sys.initialise();
-  sys.settings.dt = 0.8 * sys.critical_time_step();
+  sys.settings.dt = 0.8 * critical_time_step(sys);
   const Real tol = cfg.real("sample.genesis_tolerance");
   const long max_steps = cfg.integer("sample.genesis_max_steps");
   long steps = equilibrate(sys, tol, max_steps);
@@ -464,7 +465,7 @@ SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
       P.set_mass_from_density(i, sys.materials.density[P.group[i]], dim);
     }
     sys.rebuild_neighbors();
-    sys.settings.dt = 0.8 * sys.critical_time_step();
+    sys.settings.dt = 0.8 * critical_time_step(sys);
     steps += equilibrate(sys, tol, max_steps);
     p = mean_stress(sys, info.volume, dim);
   }
@@ -492,9 +493,9 @@ SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
   if (bond_law != BondLaw::None) info.bonds = sys.install_bonds(cfg.real("sample.bond_gap"));
   {  // Floaters: particles held by fewer than 3 (2D: 2) bonds (PFC counts contacts; we report them).
     std::vector<int> degree(P.size(), 0);
-    for (std::size_t b = 0; b < sys.bond_i.size(); ++b) {
-      ++degree[sys.bond_i[b]];
-      ++degree[sys.bond_j[b]];
+    for (std::size_t b = 0; b < sys.bonds.i.size(); ++b) {
+      ++degree[sys.bonds.i[b]];
+      ++degree[sys.bonds.j[b]];
     }
     for (int d : degree) info.floaters += d < (dim == 3 ? 3 : 2);
   }

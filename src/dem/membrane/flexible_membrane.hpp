@@ -10,7 +10,8 @@
 // Unit (i,j) holds T1 = (P(i,j), P(i+1,j), P(i,j+1)) (element 2u) and T2 = (P(i+1,j), P(i+1,j+1),
 // P(i,j+1)) (element 2u+1), u = j N_theta + i. The axis is parallel to z.
 //
-// One step, called by the engine (order as for rigid walls, see dem_system.cpp):
+// One step, called by the engine through MembraneBoundary (membrane_boundary.hpp; order as for
+// rigid walls, see dem_system.cpp):
 //   1. if the neighbour list is rebuilt: find_candidates(pos, radius, skin). The engine's rebuild
 //      test must include motion_since_build() (+ max_step_motion(dt)), as for walls;
 //   2. compute_forces<Law>(...) with the particle positions of this step;
@@ -44,6 +45,7 @@
 #include <span>
 #include <vector>
 
+#include "dem/boundary.hpp"
 #include "dem/contact/boundary_friction.hpp"
 #include "dem/contact/contact_geometry.hpp"
 #include "dem/membrane/triangle_contact.hpp"
@@ -110,12 +112,9 @@ struct MembraneParticles {
   std::span<const std::int32_t> group;
 };
 
-// Result of one (particle, element) candidate.
-struct MembraneLoad {
-  Vec3 f = Vec3::Zero();   // force ON THE ELEMENT [N]; the particle receives -f
-  Vec3 m = Vec3::Zero();   // moment on the particle [N m]
-  Vec3 xc = Vec3::Zero();  // contact point (Love-Weber stress: branch xc - x_particle) [m]
-};
+// Result of one (particle, element) candidate: f = force ON THE ELEMENT [N] (the particle
+// receives -f), m = moment on the particle [N m], xc = contact point [m].
+using MembraneLoad = BoundaryLoad;
 
 class FlexibleMembrane {
  public:

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "core/error.hpp"
+#include "dem/diagnostics.hpp"
 
 namespace ff::dem {
 
@@ -122,7 +123,7 @@ ParticleMembraneLayout add_particle_membrane(DemSystem& sys, const ParticleMembr
   ParticleMembraneLayout l = particle_membrane_layout(spec);
   const int n_old = sys.materials.groups();
   l.group = add_particle_membrane_group(sys.materials, pm);
-  remap_pair_indices(sys.bond_pair, n_old, sys.materials.groups());
+  remap_pair_indices(sys.bonds.pair, n_old, sys.materials.groups());
   auto& P = sys.particles;
   l.first = static_cast<std::int64_t>(P.size());
   P.resize(P.size() + static_cast<std::size_t>(l.count()));
@@ -162,7 +163,7 @@ Real stabilise_particle_membrane(DemSystem& sys, ParticleMembraneLayout& l, Real
   const Real rs = std::clamp(r, rs_lo, rs_hi);
   Real kc = 0;
   for (int g = 0; g < mat.groups(); ++g)
-    if (g != l.group) kc = std::max(kc, sys.pair_stiffness(mat.pair(l.group, g), r, rs, 0.01 * std::min(r, rs)));
+    if (g != l.group) kc = std::max(kc, pair_stiffness(sys, mat.pair(l.group, g), r, rs, 0.01 * std::min(r, rs)));
   // Four bonds and four soft contacts with its ring and row neighbours.
   const int pm = mat.pair(l.group, l.group);
   Real kb = 0, kb_rot = 0;
@@ -176,7 +177,7 @@ Real stabilise_particle_membrane(DemSystem& sys, ParticleMembraneLayout& l, Real
     kb = std::max(st.kr, st.ks);
     kb_rot = std::max(st.kt, st.kb);
   }
-  const Real kmm = sys.pair_stiffness(pm, r, r, 0.01 * r);
+  const Real kmm = pair_stiffness(sys, pm, r, r, 0.01 * r);
   const Real kt = assumed_contacts * kc + 4 * (kb + kmm);
   const Real kr = assumed_contacts * kc * r * r + 4 * (kb_rot + (kb + kmm) * r * r);
   if (l.count() == 0) return 1;
@@ -237,7 +238,7 @@ void particle_membrane_profile(const ParticleStore& p, const ParticleMembraneLay
 std::size_t particle_membrane_bonds(const DemSystem& sys, const ParticleMembraneLayout& l) {
   const int pm = sys.materials.pair(l.group, l.group);
   std::size_t n = 0;
-  for (std::size_t b = 0; b < sys.bond_i.size(); ++b) n += sys.bond_pair[b] == pm && !sys.bond_broken[b];
+  for (std::size_t b = 0; b < sys.bonds.i.size(); ++b) n += sys.bonds.pair[b] == pm && !sys.bonds.broken[b];
   return n;
 }
 

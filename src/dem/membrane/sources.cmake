@@ -1,1 +1,2 @@
-target_sources(fracflow_dem PRIVATE ${CMAKE_CURRENT_LIST_DIR}/flexible_membrane.cpp ${CMAKE_CURRENT_LIST_DIR}/particle_membrane.cpp)
+target_sources(fracflow_dem PRIVATE ${CMAKE_CURRENT_LIST_DIR}/flexible_membrane.cpp ${CMAKE_CURRENT_LIST_DIR}/particle_membrane.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/membrane_boundary.cpp)

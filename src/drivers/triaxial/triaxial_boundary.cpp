@@ -4,6 +4,8 @@
 #include <cmath>
 
 #include "geometry/shapes.hpp"
+#include "dem/diagnostics.hpp"
+#include "dem/membrane/membrane_boundary.hpp"
 
 namespace ff::drivers {
 
@@ -74,7 +76,7 @@ void servo_cylinder(dem::DemSystem& sys, std::size_t w, Real target, const Servo
 }
 
 Real applied_confinement(dem::DemSystem& sys, const Lateral& lat) {
-  if (lat.kind == LateralKind::Membrane) return sys.membrane->mean_confinement();
+  if (lat.kind == LateralKind::Membrane) return dem::membrane_of(sys)->mean_confinement();
   if (lat.kind == LateralKind::ParticleMembrane)
     return dem::particle_membrane_confinement(sys.particles, lat.particles, sys.walls[0].point.z(), sys.walls[1].point.z());
   const Real r = sys.walls[lat.cylinder_wall].radius;
@@ -83,7 +85,7 @@ Real applied_confinement(dem::DemSystem& sys, const Lateral& lat) {
 
 Real enclosed_volume(const dem::DemSystem& sys, const Lateral& lat) {
   const Real z0 = sys.walls[0].point.z(), z1 = sys.walls[1].point.z();
-  if (lat.kind == LateralKind::Membrane) return sys.membrane->enclosed_volume(z0, z1);
+  if (lat.kind == LateralKind::Membrane) return dem::membrane_of(sys)->enclosed_volume(z0, z1);
   if (lat.kind == LateralKind::ParticleMembrane) return dem::particle_membrane_volume(sys.particles, lat.particles, z0, z1);
   const Real r = sys.walls[lat.cylinder_wall].radius;
   return kPi * r * r * (z1 - z0);
@@ -115,7 +117,7 @@ std::vector<SphereStress> measure_spheres(const dem::DemSystem& sys, const dem::
     m.porosity = 1 - solid / sphere_volume;
     // (1 - n) / sum(V_p) = 1 / volume: the particles' volume spread at the region's own solid fraction.
     const Real volume = vp > 0 && solid > 0 ? vp * sphere_volume / solid : 1;
-    const Mat3 s = sys.average_stress_of(inside, volume);
+    const Mat3 s = average_stress_of(sys, inside, volume);
     m.axial = -s(2, 2);
     m.lateral = -0.5 * (s(0, 0) + s(1, 1));
     out.push_back(m);

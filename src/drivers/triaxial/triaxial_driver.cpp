@@ -19,6 +19,8 @@
 #include "drivers/ucs/ucs_measure.hpp"
 #include "io/csv.hpp"
 #include "io/plot.hpp"
+#include "dem/diagnostics.hpp"
+#include "dem/membrane/membrane_boundary.hpp"
 
 namespace fs = std::filesystem;
 
@@ -205,10 +207,10 @@ class TriaxialRun final : public DemRun {
     info = dem::build_sample(cfg, sys);
     dem::add_platens(sys, info, cfg.real("triaxial.platen_friction"));
     if (kind_ == LateralKind::Membrane) {
-      sys.membrane.emplace(membrane_settings(cfg, sys, info));
+      const auto& mem = dem::attach_membrane(sys, membrane_settings(cfg, sys, info));
       sys.rebuild_neighbors();
-      log::info("flexible membrane: {} x {} units, {} triangles, sleeve radius {:.4g} m", sys.membrane->settings().n_theta,
-                sys.membrane->settings().n_z, sys.membrane->element_count(), sys.membrane->settings().radius);
+      log::info("flexible membrane: {} x {} units, {} triangles, sleeve radius {:.4g} m", mem.settings().n_theta,
+                mem.settings().n_z, mem.element_count(), mem.settings().radius);
     } else if (kind_ == LateralKind::RigidCylinder) {
       add_rigid_cylinder(sys, info, membrane_friction(cfg));
     }
@@ -218,7 +220,7 @@ class TriaxialRun final : public DemRun {
   // `iso_ok_rows_`: rows in a row the isotropic stage has met its criteria (it ends at 5).
   void save_before_dem(CheckpointWriter& w) const override {
     w.put_value("triaxial.iso_ok_rows", iso_ok_rows_);
-    if (sys.membrane) w.put_value("triaxial.membrane_settings", sys.membrane->settings());
+    if (auto* m = dem::membrane_of(sys)) w.put_value("triaxial.membrane_settings", m->settings());
     if (kind_ == LateralKind::ParticleMembrane) w.put_value("triaxial.particle_membrane", lat_.particles);
   }
   void save_after_dem(CheckpointWriter& w) const override {
@@ -228,7 +230,7 @@ class TriaxialRun final : public DemRun {
   void load_before_dem(CheckpointReader& r) override {
     iso_ok_rows_ = r.get_value<int>("triaxial.iso_ok_rows");
     if (r.has("triaxial.membrane_settings"))
-      sys.membrane.emplace(r.get_value<dem::MembraneSettings>("triaxial.membrane_settings"));
+      dem::attach_membrane(sys, r.get_value<dem::MembraneSettings>("triaxial.membrane_settings"));
     if ((kind_ == LateralKind::ParticleMembrane) != r.has("triaxial.particle_membrane"))
       cfg.fail("triaxial.lateral", "the checkpoint was written with another lateral boundary; resume with the scenario it "
                                    "was written with");
@@ -291,11 +293,11 @@ class TriaxialRun final : public DemRun {
         row.push_back(static_cast<double>(sys.cracks.count(a, b, 1)));
         row.push_back(static_cast<double>(sys.cracks.count(a, b, 2)));
       }
-    std::size_t bonds = sys.intact_bonds();
+    std::size_t bonds = intact_bonds(sys);
     if (kind_ == LateralKind::ParticleMembrane) bonds -= dem::particle_membrane_bonds(sys, lat_.particles);
     row.push_back(static_cast<double>(bonds));
-    row.push_back(sys.kinetic_energy());
-    row.push_back(sys.max_unbalanced_force_ratio());
+    row.push_back(kinetic_energy(sys));
+    row.push_back(max_unbalanced_force_ratio(sys));
     if (diff > st_.peak_diff) st_.conf_at_peak = conf;  // the loop records the peak itself
     fmt::format_to(std::back_inserter(status), "strain {:.3f}%  q {:.3f} MPa  confinement {:.3f} MPa  cracks {}", 100 * ea,
                    1e-6 * diff, 1e-6 * conf, sys.cracks.total());
@@ -337,7 +339,7 @@ DemRowReport TriaxialRun::isotropic_row(Real axial, Real conf) {
   // levels off near 0.02 as the spheres keep creeping into the sample's surface hollows, so its
   // limit stays at 0.05 (the sample-only ratio falls below 0.01 before the spheres even touch).
   const bool pm = kind_ == LateralKind::ParticleMembrane;
-  const Real ubf = pm ? sys.max_unbalanced_force_ratio() : sys.max_unbalanced_force_ratio(n_sample_);
+  const Real ubf = pm ? max_unbalanced_force_ratio(sys) : max_unbalanced_force_ratio(sys, n_sample_);
   iso_.row({static_cast<double>(sys.step_count), sys.time, axial, conf, ubf});
   ++st_.iso_rows;
   // Converged when both boundary stresses have stayed within the tolerance for 5 rows and the
@@ -368,7 +370,7 @@ void TriaxialRun::end_isotropic(Real axial, Real conf) {
   st_.iso_sphere_error = 0;
   {  // By equilibrium the whole sample's average stress equals the boundary stresses.
     const std::size_t n = n_sample_;
-    const Mat3 w = sys.average_stress_of([n](Index i) { return static_cast<std::size_t>(i) < n; }, enclosed_volume(sys, lat_));
+    const Mat3 w = average_stress_of(sys, [n](Index i) { return static_cast<std::size_t>(i) < n; }, enclosed_volume(sys, lat_));
     st_.whole_axial = -w(2, 2);
     st_.whole_lateral = -0.5 * (w(0, 0) + w(1, 1));
   }
@@ -387,7 +389,7 @@ void TriaxialRun::end_isotropic(Real axial, Real conf) {
             1e-6 * st_.sphere_axial[2], 1e-6 * st_.sphere_lateral[0], 1e-6 * st_.sphere_lateral[1],
             1e-6 * st_.sphere_lateral[2], 100 * st_.iso_sphere_error, st_.iso_sphere_error <= 0.05 ? "within" : "NOT within");
   if (kind_ == LateralKind::ParticleMembrane) {  // the estimate of add_particle_membrane(), now with contacts
-    const Real crit = sys.critical_time_step();
+    const Real crit = critical_time_step(sys);
     if (sys.settings.dt > crit)
       log::warn("particle membrane: the time step {:.4g} s exceeds the critical step {:.4g} s with the membrane "
                 "pressing; lower dem.time_step_safety", sys.settings.dt, crit);
@@ -431,8 +433,8 @@ void TriaxialRun::summarize(nlohmann::json& j, const DemOutcome& out) {
                           {"sphere_radius_fraction", cfg.real("triaxial.measurement_sphere_radius")},
                           {"largest_sphere_deviation", st_.iso_sphere_error},
                           {"spheres_within_5_percent", st_.iso_sphere_error <= 0.05}};
-  if (sys.membrane) {
-    const auto& m = *sys.membrane;
+  if (dem::membrane_of(sys)) {
+    const auto& m = *dem::membrane_of(sys);
     std::vector<Real> rad(m.settings().n_z + 1), z(m.settings().n_z + 1);
     m.radial_profile(rad, z);
     j["membrane"] = {{"elements", m.element_count()}, {"n_theta", m.settings().n_theta}, {"n_z", m.settings().n_z},

@@ -13,6 +13,7 @@
 #include "drivers/dem_run_loop.hpp"
 #include "drivers/ucs/ucs_measure.hpp"
 #include "io/plot.hpp"
+#include "dem/diagnostics.hpp"
 
 namespace fs = std::filesystem;
 
@@ -115,8 +116,8 @@ class UcsRun final : public DemRun {
     const CompressionState m = gauge_.measure(sys, info);
     row = {static_cast<double>(sys.step_count), sys.time, m.axial_strain, m.axial_stress, m.lateral_strain,
            m.volumetric_strain, static_cast<double>(sys.cracks.tensile), static_cast<double>(sys.cracks.shear),
-           static_cast<double>(sys.cracks.total()), static_cast<double>(sys.intact_bonds()), sys.kinetic_energy(),
-           sys.max_unbalanced_force_ratio()};
+           static_cast<double>(sys.cracks.total()), static_cast<double>(intact_bonds(sys)), kinetic_energy(sys),
+           max_unbalanced_force_ratio(sys)};
     status.clear();
     fmt::format_to(std::back_inserter(status), "strain {:.3f}%  stress {:.3f} MPa  cracks {}", 100 * m.axial_strain,
                    1e-6 * m.axial_stress, sys.cracks.total());

@@ -17,6 +17,8 @@
 #include "dem/dem_system.hpp"
 #include "dem/sample_builder.hpp"
 #include "single_threaded.hpp"
+#include "dem/diagnostics.hpp"
+#include "dem/membrane/membrane_boundary.hpp"
 
 using namespace ff;
 using namespace ff::dem;
@@ -143,16 +145,16 @@ EnergyRun run_energy(DemSystem& s, long steps) {
     v_old = s.particles.vel;
     w_old = s.particles.omega;
     s.step();
-    const Real u = s.strain_energy();
+    const Real u = strain_energy(s);
     e = cross_kinetic(s.particles, v_old, w_old) + u;
-    const Real e_naive = s.kinetic_energy() + u;  // half-step KE: O(omega dt) fluctuation
+    const Real e_naive = kinetic_energy(s) + u;  // half-step KE: O(omega dt) fluctuation
     if (k == 0) {
       e0 = e;
       e0_naive = e_naive;
     }
     out.max_dev = std::max(out.max_dev, std::abs(e - e0) / e0);
     out.max_dev_naive = std::max(out.max_dev_naive, std::abs(e_naive - e0_naive) / e0_naive);
-    out.touching += s.contacts_touching();
+    out.touching += contacts_touching(s);
   }
   out.drift = (e - e0) / e0;
   return out;
@@ -201,8 +203,8 @@ TEST(DemEnergy, UndampedBondedAssemblyConservesEnergy3D2D) {
   Rng g(21);
   for (int dim : {3, 2}) {
     DemSystem s = bonded_lattice(dim, dim == 3 ? 4 : 8, 0.01, 0.002 * kRadius, g);
-    EXPECT_EQ(s.bond_i.size(), dim == 3 ? 144u : 112u);
-    s.settings.dt = 0.1 * s.critical_time_step();
+    EXPECT_EQ(s.bonds.i.size(), dim == 3 ? 144u : 112u);
+    s.settings.dt = 0.1 * critical_time_step(s);
     random_velocities(s, g, 0.01);
     remove_rigid_motion(s.particles);
     const EnergyRun r = run_energy(s, 10000);
@@ -210,7 +212,7 @@ TEST(DemEnergy, UndampedBondedAssemblyConservesEnergy3D2D) {
                 "half-step KE + U max |dE|/E = %.3e\n", dim, r.max_dev, r.drift, r.max_dev_naive);
     EXPECT_LT(r.max_dev, 1e-3) << "dim " << dim;
     EXPECT_EQ(r.touching, 0) << "a contact closed: the test meant bonds only";
-    EXPECT_EQ(s.intact_bonds(), s.bond_i.size());
+    EXPECT_EQ(intact_bonds(s), s.bonds.i.size());
   }
 }
 
@@ -227,7 +229,7 @@ TEST(DemMomentum, FreeClusterConservesLinearAndAngularMomentum) {
   for (int dim : {3, 2}) {
     DemSystem s = bonded_lattice(dim, dim == 3 ? 5 : 10, -0.002, 0.002 * kRadius, g);
     s.materials.linear[0].fric = 0.05;  // low friction: contacts may slide
-    s.settings.dt = 0.2 * s.critical_time_step();
+    s.settings.dt = 0.2 * critical_time_step(s);
     random_velocities(s, g, 0.2);
     const Vec3 P0 = linear_momentum(s.particles), L0 = angular_momentum(s.particles);
     Real p_scale = 0, l_scale = 0;
@@ -237,7 +239,7 @@ TEST(DemMomentum, FreeClusterConservesLinearAndAngularMomentum) {
                  s.particles.inertia[i] * s.particles.omega[i].norm();
     }
     s.run(1000);
-    EXPECT_GT(s.contacts_touching(), 10);
+    EXPECT_GT(contacts_touching(s), 10);
     const Real dP = (linear_momentum(s.particles) - P0).norm() / p_scale;
     const Real dL = (angular_momentum(s.particles) - L0).norm() / l_scale;
     std::printf("[ measured ] dim %d: relative momentum error %.3e, angular momentum error %.3e\n", dim, dP, dL);
@@ -270,7 +272,7 @@ TEST(DemTimeStep, CriticalStepOfTwoBondedBodies) {
         want = std::min({want, std::sqrt(s.particles.mass[i] / (k + kc)),
                          std::sqrt(s.particles.inertia[i] / (krot + (k + kc) * r * r))});
       }
-      EXPECT_NEAR(s.critical_time_step(), want, 1e-12 * want) << "dim " << dim << " gap " << gap;
+      EXPECT_NEAR(critical_time_step(s), want, 1e-12 * want) << "dim " << dim << " gap " << gap;
     }
   }
 }
@@ -282,14 +284,14 @@ TEST(DemTimeStep, MassScalingReachesTheTargetStep) {
   // already allowed changes nothing.
   Rng g(51);
   DemSystem s = bonded_lattice(3, 3, 0.0, 0.001 * kRadius, g);
-  const Real safety = 0.2, dt0 = s.critical_time_step();
+  const Real safety = 0.2, dt0 = critical_time_step(s);
   const std::vector<Real> m0 = s.particles.mass, inv0 = s.particles.inv_mass;
-  s.scale_masses_for(0.1 * safety * dt0, safety);
+  scale_masses_for(s, 0.1 * safety * dt0, safety);
   EXPECT_EQ(s.particles.inv_mass, inv0);
   const Real dt = 50 * safety * dt0;
-  s.scale_masses_for(dt, safety);
-  EXPECT_NEAR(safety * s.critical_time_step(), dt, 1e-12 * dt);
-  EXPECT_GE(safety * s.critical_time_step() * (1 + 1e-12), dt);
+  scale_masses_for(s, dt, safety);
+  EXPECT_NEAR(safety * critical_time_step(s), dt, 1e-12 * dt);
+  EXPECT_GE(safety * critical_time_step(s) * (1 + 1e-12), dt);
   EXPECT_EQ(s.particles.mass, m0);
 }
 
@@ -309,7 +311,7 @@ TEST(DemTimeStep, AxialBondOscillatorStableBelowTwoOverOmega) {
     const Real m = s.particles.mass[0], k = ParallelBond::section(s.materials.parallel[0], kRadius, kRadius, 3).kn *
                                          ParallelBond::section(s.materials.parallel[0], kRadius, kRadius, 3).A;
     const Real dt_lim = std::sqrt(2 * m / k);
-    EXPECT_LT(s.critical_time_step(), dt_lim);
+    EXPECT_LT(critical_time_step(s), dt_lim);
     s.settings.dt = f * dt_lim;
     s.particles.vel[0] = Vec3(-1e-3, 0, 0);
     s.particles.vel[1] = Vec3(1e-3, 0, 0);
@@ -318,12 +320,12 @@ TEST(DemTimeStep, AxialBondOscillatorStableBelowTwoOverOmega) {
       EXPECT_LT(r.max_dev, 1e-9);
       EXPECT_EQ(r.touching, 0);
     } else {
-      const Real e0 = s.kinetic_energy();
+      const Real e0 = kinetic_energy(s);
       bool blew_up = false;
       try {
         for (int q = 0; q < 300 && !blew_up; ++q) {
           s.step();
-          blew_up = s.kinetic_energy() > 1e6 * e0;
+          blew_up = kinetic_energy(s) > 1e6 * e0;
         }
       } catch (const NumericalError&) {
         blew_up = true;
@@ -417,7 +419,7 @@ TEST(DemWalls, SphereInsideCylinderWall) {
   EXPECT_EQ(s.walls[0].contacts, 1);
   // The wall is the body's only stiffness: dt = sqrt(I/(kn R^2)) (rotational bound, METHODS 1.6).
   const Real dt_want = std::sqrt(s.particles.inertia[0] / (kn * kRadius * kRadius));
-  EXPECT_NEAR(s.critical_time_step(), dt_want, 1e-9 * dt_want);
+  EXPECT_NEAR(critical_time_step(s), dt_want, 1e-9 * dt_want);
 }
 
 // --- Thread independence -------------------------------------------------------------------
@@ -445,7 +447,7 @@ TEST(DemThreads, BitIdenticalOnOneAndThreeThreads) {
     w.velocity = Vec3(0, 0, 0.5);
     s.walls.push_back(w);
     s.initialise();
-    s.settings.dt = 0.2 * s.critical_time_step();
+    s.settings.dt = 0.2 * critical_time_step(s);
     random_velocities(s, g, 0.3);
     s.run(200);
     return s;
@@ -484,7 +486,7 @@ TEST(DemMembrane, OwnCandidateSearchesMissNoContact) {
     s.settings.local_damping = 0.7;
     SampleInfo info;
     add_platens(s, info, 0.1);
-    s.settings.dt = 0.5 * s.critical_time_step();
+    s.settings.dt = 0.5 * critical_time_step(s);
     s.walls[0].velocity.z() = 0.05;
     s.walls[1].velocity.z() = -0.05;
     Real R = 0;
@@ -494,7 +496,7 @@ TEST(DemMembrane, OwnCandidateSearchesMissNoContact) {
     m.pressure = 2e6;
     m.v_max = 2.0;
     m.r_min = 0.5 * R;
-    s.membrane.emplace(m);
+    attach_membrane(s, m);
     s.rebuild_neighbors();
     return s;
   };
@@ -502,15 +504,15 @@ TEST(DemMembrane, OwnCandidateSearchesMissNoContact) {
   const int steps = 3000;
   a.run(steps);
   for (int k = 0; k < steps; ++k) {
-    b.rebuild_membrane_candidates();
+    membrane_boundary(b)->rebuild_candidates(b);
     b.step();
   }
   int touching = 0;
-  for (std::size_t k = 0; k < a.membrane->element_count(); ++k) touching += a.membrane->contacts(k) > 0;
+  for (std::size_t k = 0; k < membrane_of(a)->element_count(); ++k) touching += membrane_of(a)->contacts(k) > 0;
   EXPECT_GT(touching, 16);  // the sleeve reached the lattice's edges
-  EXPECT_GT(a.membrane_builds(), a.neighbor_builds());  // searched again on its own
+  EXPECT_GT(membrane_boundary(a)->builds(), a.neighbor_builds());  // searched again on its own
   ASSERT_EQ(a.particles.size(), b.particles.size());
   EXPECT_EQ(std::memcmp(a.particles.pos.data(), b.particles.pos.data(), a.particles.size() * sizeof(Vec3)), 0);
-  const auto va = a.membrane->vertices(), vb = b.membrane->vertices();
+  const auto va = membrane_of(a)->vertices(), vb = membrane_of(b)->vertices();
   EXPECT_EQ(std::memcmp(va.data(), vb.data(), va.size() * sizeof(Vec3)), 0);
 }

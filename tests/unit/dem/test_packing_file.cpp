@@ -17,6 +17,7 @@
 #include "dem/packing_file.hpp"
 #include "dem/sample_builder.hpp"
 #include "io/scenario.hpp"
+#include "dem/diagnostics.hpp"
 
 namespace ff::dem {
 namespace {
@@ -166,8 +167,8 @@ std::unique_ptr<Placed> system_for(const std::string& bond_law) {
 // The bonds as pairs of centres, independent of the particle order.
 std::set<std::pair<std::array<Real, 3>, std::array<Real, 3>>> bond_centres(const DemSystem& sys) {
   std::set<std::pair<std::array<Real, 3>, std::array<Real, 3>>> out;
-  for (std::size_t b = 0; b < sys.bond_i.size(); ++b) {
-    const Vec3 a = sys.particles.pos[sys.bond_i[b]], c = sys.particles.pos[sys.bond_j[b]];
+  for (std::size_t b = 0; b < sys.bonds.i.size(); ++b) {
+    const Vec3 a = sys.particles.pos[sys.bonds.i[b]], c = sys.particles.pos[sys.bonds.j[b]];
     std::array<Real, 3> x{a.x(), a.y(), a.z()}, y{c.x(), c.y(), c.z()};
     out.insert(std::minmax(x, y));
   }
@@ -179,7 +180,7 @@ TEST(PackingFile, PlacedByTheBondGapRuleWithoutAList) {
   const SampleInfo info = place_packing(lattice(), s->cfg, s->sys, 0, false);
   EXPECT_EQ(s->sys.particles.size(), 24u);
   EXPECT_EQ(info.bonds, kLatticeBonds);
-  EXPECT_EQ(s->sys.intact_bonds(), kLatticeBonds);
+  EXPECT_EQ(intact_bonds(s->sys), kLatticeBonds);
   EXPECT_EQ(info.floaters, 0u);  // corners have 3 bonds
   EXPECT_EQ(info.axis, 2);
   EXPECT_DOUBLE_EQ(info.height, 4e-3);
@@ -207,7 +208,7 @@ TEST(PackingFile, BondListIsInstalledAsGivenAndFollowsTheSpatialOrder) {
   EXPECT_EQ(sorted->sys.particles.pos[7], Vec3(6e-3, 2e-3, 0));
   EXPECT_EQ(sorted->sys.particles.pos[23], Vec3(6e-3, 4e-3, 2e-3));
   EXPECT_EQ(bond_centres(plain->sys), bond_centres(sorted->sys));
-  for (std::size_t b = 0; b < sorted->sys.bond_i.size(); ++b) EXPECT_LT(sorted->sys.bond_i[b], sorted->sys.bond_j[b]);
+  for (std::size_t b = 0; b < sorted->sys.bonds.i.size(); ++b) EXPECT_LT(sorted->sys.bonds.i[b], sorted->sys.bonds.j[b]);
 
   auto gap_rule = system_for("parallel");
   const SampleInfo all = place_packing(lattice(), gap_rule->cfg, gap_rule->sys, 0, true);

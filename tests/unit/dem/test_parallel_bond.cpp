@@ -11,6 +11,7 @@
 #include "dem/bond/parallel_bond.hpp"
 #include "dem/dem_system.hpp"
 #include "single_threaded.hpp"
+#include "dem/diagnostics.hpp"
 
 using namespace ff;
 using namespace ff::dem;
@@ -272,7 +273,7 @@ long run_until_break(DemSystem& s, const Vec3& v, long max_steps) {
   s.particles.vel[1] = v;
   for (long k = 1; k <= max_steps; ++k) {
     s.step();
-    if (s.bond_broken[0]) return k;
+    if (s.bonds.broken[0]) return k;
   }
   return max_steps + 1;
 }
@@ -324,9 +325,9 @@ TEST(ParallelBondInSystem, BreaksInPureTensionAtTensileStrength) {
     EXPECT_GE(sigma_break, pb.ten * (1 - 1e-12));
     EXPECT_LT(sigma_break - st0.kn * du, pb.ten);
     EXPECT_NEAR(sigma_break, pb.ten, 0.01 * pb.ten);
-    EXPECT_NEAR(s.pbond[0].Fn, sigma_break * st0.A, 1e-9 * sigma_break * st0.A);
-    EXPECT_EQ(s.bond_broken[0], 1);
-    EXPECT_EQ(s.intact_bonds(), 0u);
+    EXPECT_NEAR(s.bonds.parallel[0].Fn, sigma_break * st0.A, 1e-9 * sigma_break * st0.A);
+    EXPECT_EQ(s.bonds.broken[0], 1);
+    EXPECT_EQ(intact_bonds(s), 0u);
     ASSERT_EQ(s.cracks.events.size(), 1u);
     const CrackEvent& e = s.cracks.events[0];
     EXPECT_EQ(e.mode, 1);
@@ -377,12 +378,12 @@ TEST(ParallelBondInSystem, BreaksInPureShearAtCohesion) {
     const long k = run_until_break(s, Vec3(0, du / s.settings.dt, 0), 2000);
     ASSERT_LE(k, 2000) << "dim " << dim << ": bond never broke";
     const Real tau_closed = st0.ks * du * static_cast<Real>(k);
-    EXPECT_NEAR(PB::stress(PB::coeffs(pb), st0, s.pbond[0]).tau, tau_closed, 1e-3 * tau_closed);
-    EXPECT_GE(PB::stress(PB::coeffs(pb), st0, s.pbond[0]).tau, pb.coh);
-    EXPECT_NEAR(PB::stress(PB::coeffs(pb), st0, s.pbond[0]).tau, pb.coh, 0.01 * pb.coh);
-    EXPECT_EQ(s.pbond[0].Mb.norm() + std::abs(s.pbond[0].Mt), 0.0);
-    EXPECT_LT(PB::stress(PB::coeffs(pb), st0, s.pbond[0]).sigma, 0.01 * pb.coh);  // the small geometric opening, far from ten
-    EXPECT_EQ(s.bond_broken[0], 2);
+    EXPECT_NEAR(PB::stress(PB::coeffs(pb), st0, s.bonds.parallel[0]).tau, tau_closed, 1e-3 * tau_closed);
+    EXPECT_GE(PB::stress(PB::coeffs(pb), st0, s.bonds.parallel[0]).tau, pb.coh);
+    EXPECT_NEAR(PB::stress(PB::coeffs(pb), st0, s.bonds.parallel[0]).tau, pb.coh, 0.01 * pb.coh);
+    EXPECT_EQ(s.bonds.parallel[0].Mb.norm() + std::abs(s.bonds.parallel[0].Mt), 0.0);
+    EXPECT_LT(PB::stress(PB::coeffs(pb), st0, s.bonds.parallel[0]).sigma, 0.01 * pb.coh);  // the small geometric opening, far from ten
+    EXPECT_EQ(s.bonds.broken[0], 2);
     ASSERT_EQ(s.cracks.events.size(), 1u);
     EXPECT_EQ(s.cracks.events[0].mode, 2);
     EXPECT_EQ(s.cracks.shear, 1);
@@ -409,16 +410,16 @@ TEST(ParallelBondInSystem, ShearStrengthFollowsFrictionAngle) {
     const long kn_steps = 400;
     s.particles.vel[1] = Vec3(sigma0 / st0.kn / (kn_steps * dt), 0, 0);
     s.run(kn_steps);
-    ASSERT_EQ(s.bond_broken[0], 0);
-    EXPECT_NEAR(s.pbond[0].Fn / st0.A, sigma0, 1e-9 * pb.ten);
+    ASSERT_EQ(s.bonds.broken[0], 0);
+    EXPECT_NEAR(s.bonds.parallel[0].Fn / st0.A, sigma0, 1e-9 * pb.ten);
     const Real tau_c = pb.coh - sigma0 * tanp;
     const Real du = 1e-3 * tau_c / st0.ks;
     const long k = run_until_break(s, Vec3(0, du / dt, 0), 3000);
     ASSERT_LE(k, 3000) << "sigma0 " << sigma0 << ": bond never broke";
-    EXPECT_EQ(s.bond_broken[0], 2) << "sigma0 " << sigma0;
-    EXPECT_NEAR(PB::stress(PB::coeffs(pb), st0, s.pbond[0]).tau, tau_c, 0.01 * tau_c) << "sigma0 " << sigma0;
-    const Real tau_c_now = pb.coh - s.pbond[0].Fn / st0.A * tanp;
-    EXPECT_GE(PB::stress(PB::coeffs(pb), st0, s.pbond[0]).tau, tau_c_now);
-    EXPECT_NEAR(PB::stress(PB::coeffs(pb), st0, s.pbond[0]).tau, tau_c_now, 0.002 * tau_c_now);
+    EXPECT_EQ(s.bonds.broken[0], 2) << "sigma0 " << sigma0;
+    EXPECT_NEAR(PB::stress(PB::coeffs(pb), st0, s.bonds.parallel[0]).tau, tau_c, 0.01 * tau_c) << "sigma0 " << sigma0;
+    const Real tau_c_now = pb.coh - s.bonds.parallel[0].Fn / st0.A * tanp;
+    EXPECT_GE(PB::stress(PB::coeffs(pb), st0, s.bonds.parallel[0]).tau, tau_c_now);
+    EXPECT_NEAR(PB::stress(PB::coeffs(pb), st0, s.bonds.parallel[0]).tau, tau_c_now, 0.002 * tau_c_now);
   }
 }

@@ -156,7 +156,7 @@ TEST(ParticleMembrane, AddedAsItsOwnBondedGroupWithInwardConstantForces) {
   s.particles.pos[3].x() = spec.sample_radius - 0.5e-3;  // a sample sphere touching the sample radius
   s.settings.skin = 0.1e-3;
   ASSERT_EQ(s.install_bonds(0.01e-3), 2u);  // (0, 1), (1, 2): a matrix-vein pair each
-  const std::vector<std::int32_t> old_pairs = s.bond_pair;
+  const std::vector<std::int32_t> old_pairs = s.bonds.pair;
   const auto old_linear = s.materials.linear;
   s.initialise();
   const auto l = add_particle_membrane(s, spec, ParticleMembraneMaterial{1e7, 1000, 0.2});
@@ -176,14 +176,14 @@ TEST(ParticleMembrane, AddedAsItsOwnBondedGroupWithInwardConstantForces) {
   EXPECT_GE(s.materials.parallel[2 * n + 2].ten, 1e90);
   for (std::size_t b = 0; b < old_pairs.size(); ++b) {
     const int a = old_pairs[b] / 2, c = old_pairs[b] % 2;
-    EXPECT_EQ(s.bond_pair[b], a * n + c);
+    EXPECT_EQ(s.bonds.pair[b], a * n + c);
   }
-  ASSERT_EQ(s.bond_i.size(), old_pairs.size() + static_cast<std::size_t>(l.n_theta * (2 * l.n_z - 1)));
+  ASSERT_EQ(s.bonds.i.size(), old_pairs.size() + static_cast<std::size_t>(l.n_theta * (2 * l.n_z - 1)));
   EXPECT_EQ(particle_membrane_bonds(s, l), static_cast<std::size_t>(l.n_theta * (2 * l.n_z - 1)));
-  for (std::size_t b = old_pairs.size(); b < s.bond_i.size(); ++b) {
-    EXPECT_GE(s.bond_i[b], l.first);
-    EXPECT_GE(s.bond_j[b], l.first);
-    EXPECT_NEAR((s.particles.pos[s.bond_j[b]] - s.particles.pos[s.bond_i[b]]).norm(), 2 * l.particle_radius,
+  for (std::size_t b = old_pairs.size(); b < s.bonds.i.size(); ++b) {
+    EXPECT_GE(s.bonds.i[b], l.first);
+    EXPECT_GE(s.bonds.j[b], l.first);
+    EXPECT_NEAR((s.particles.pos[s.bonds.j[b]] - s.particles.pos[s.bonds.i[b]]).norm(), 2 * l.particle_radius,
                 1e-12 * l.particle_radius);
   }
   Real sum = 0;
@@ -279,7 +279,7 @@ TEST(ParticleMembrane, UnbondedSpheresPressOnARigidCoreThroughTheirContactsOnly)
   ParticleMembraneMaterial pm{E, 1000, 0.3};
   pm.bonded = false;
   const auto l = add_particle_membrane(s, spec, pm);
-  EXPECT_EQ(s.bond_i.size(), 0u);
+  EXPECT_EQ(s.bonds.i.size(), 0u);
   EXPECT_EQ(particle_membrane_bonds(s, l), 0u);
   const Real kc = LinearContact::normal_stiffness(s.materials.linear[0], r, rk, 3);
   const Real sn = std::sin(kPi / static_cast<Real>(l.n_theta));

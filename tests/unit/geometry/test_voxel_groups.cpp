@@ -221,9 +221,9 @@ TEST(VoxelGroups, PoreVoxelsRemoveParticlesBeforeBonding) {
     }
   }
   EXPECT_GT(in_inclusion_voxel, 0u);
-  for (std::size_t n = 0; n < holed.bond_i.size(); ++n) {  // bonds only between kept particles
-    ASSERT_LT(holed.bond_i[n], static_cast<Index>(holed.particles.size()));
-    ASSERT_LT(holed.bond_j[n], static_cast<Index>(holed.particles.size()));
+  for (std::size_t n = 0; n < holed.bonds.i.size(); ++n) {  // bonds only between kept particles
+    ASSERT_LT(holed.bonds.i[n], static_cast<Index>(holed.particles.size()));
+    ASSERT_LT(holed.bonds.j[n], static_cast<Index>(holed.particles.size()));
   }
 }
 

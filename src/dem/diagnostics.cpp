@@ -1,0 +1,183 @@
+#include "dem/diagnostics.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace ff::dem {
+
+namespace {
+// Sums f(i) for i in [0, n) in fixed blocks, so the result does not depend on the thread count.
+template <class F>
+Real deterministic_sum(std::size_t n, std::size_t parallel_min, F f) {
+  constexpr std::size_t kBlock = 4096;
+  const std::size_t nb = (n + kBlock - 1) / kBlock;
+  std::vector<Real> part(nb, 0.0);
+#pragma omp parallel for schedule(static) if (n > parallel_min)
+  for (std::size_t b = 0; b < nb; ++b) {
+    Real s = 0;
+    const std::size_t end = std::min(n, (b + 1) * kBlock);
+    for (std::size_t i = b * kBlock; i < end; ++i) s += f(i);
+    part[b] = s;
+  }
+  Real s = 0;
+  for (Real v : part) s += v;
+  return s;
+}
+}  // namespace
+
+std::size_t intact_bonds(const DemSystem& s) { return s.bonds.intact(); }
+
+long contacts_touching(const DemSystem& s) {
+  long c = 0;
+  for (auto& L : s.pair_loads()) c += L.f.squaredNorm() > 0;
+  return c;
+}
+
+Real kinetic_energy(const DemSystem& s) {
+  const auto& p = s.particles;
+  return deterministic_sum(p.size(), s.settings.parallel_min, [&](std::size_t i) {
+    return 0.5 * p.mass[i] * p.vel[i].squaredNorm() + 0.5 * p.inertia[i] * p.omega[i].squaredNorm();
+  });
+}
+
+Real strain_energy(const DemSystem& s) {
+  const auto& x = s.particles.pos;
+  const auto& r = s.particles.radius;
+  const auto& materials = s.materials;
+  const auto pi = s.neighbors().first(), pj = s.neighbors().second();
+  const auto& cstate = s.contact_state();
+  Real e = 0;
+  for (std::size_t p = 0; p < pi.size(); ++p) {
+    const Index a = pi[p], b = pj[p];
+    const Real gap = (x[b] - x[a]).norm() - r[a] - r[b];
+    if (gap >= 0) continue;
+    const int pt = materials.pair(s.particles.group[a], s.particles.group[b]);
+    if (materials.contact_law == ContactLaw::Linear) {
+      const Real kn = LinearContact::normal_stiffness(materials.linear[pt], r[a], r[b], s.settings.dim);
+      const Real ks = kn / materials.linear[pt].kratio;
+      e += 0.5 * kn * gap * gap + 0.5 * cstate[p].fs.squaredNorm() / ks;
+    } else {
+      Real es, gs;
+      HertzMindlinContact::moduli(materials.hertz[pt], false, es, gs);
+      const Real d = -gap;
+      e += 8.0 / 15.0 * es * std::sqrt(HertzMindlinContact::reduced_radius(r[a], r[b])) * std::pow(d, 2.5);
+    }
+  }
+  const BondSet& bs = s.bonds;
+  if (materials.bond_law == BondLaw::Parallel) {
+    for (std::size_t b = 0; b < bs.size(); ++b) {
+      if (bs.broken[b]) continue;
+      const auto& st = bs.parallel[b];
+      const auto c = ParallelBond::section(materials.parallel[bs.pair[b]], r[bs.i[b]], r[bs.j[b]], s.settings.dim);
+      e += 0.5 * st.Fn * st.Fn / (c.kn * c.A) + 0.5 * st.Fs.squaredNorm() / (c.ks * c.A) +
+           0.5 * st.Mb.squaredNorm() / (c.kn * c.I) + (c.J > 0 ? 0.5 * st.Mt * st.Mt / (c.ks * c.J) : 0.0);
+    }
+  }
+  return e;
+}
+
+Real max_unbalanced_force_ratio(const DemSystem& s, std::size_t first) {
+  const std::size_t n = std::min(first, s.particles.size());
+  const Real unbalanced =
+      deterministic_sum(n, s.settings.parallel_min, [&](std::size_t i) { return s.particles.force[i].norm(); });
+  // Mean over the interactions that carry load (PFC's "average ratio").
+  Real contact = 0;
+  std::size_t loaded = 0;
+  auto add = [&](const PairLoad& L) {
+    const Real f = L.f.norm();
+    if (f > 0) { contact += f; ++loaded; }
+  };
+  for (auto& L : s.pair_loads()) add(L);
+  for (auto& L : s.bonds.loads()) add(L);
+  for (auto& wc : s.wall_contacts())
+    for (auto& L : wc.load) add(L);
+  if (loaded == 0 || n == 0) return 0;
+  return (unbalanced / static_cast<Real>(n)) / (contact / static_cast<Real>(loaded));
+}
+
+Real pair_stiffness(const DemSystem& s, int pt, Real rA, Real rB, Real overlap) {
+  const auto& m = s.materials;
+  if (m.contact_law == ContactLaw::Linear) return LinearContact::normal_stiffness(m.linear[pt], rA, rB, s.settings.dim);
+  return HertzMindlinContact::normal_stiffness(m.hertz[pt], rA, rB, std::max(overlap, 0.01 * std::min(rA, rB > 0 ? rB : rA)));
+}
+
+Real critical_time_step(const DemSystem& s) {
+  const auto& particles = s.particles;
+  const auto& materials = s.materials;
+  const std::size_t n = particles.size();
+  std::vector<Real> kt(n, 0.0), kr(n, 0.0);
+  const auto& x = particles.pos;
+  const auto& r = particles.radius;
+  const auto& grp = particles.group;
+  const auto pi = s.neighbors().first(), pj = s.neighbors().second();
+  for (std::size_t p = 0; p < pi.size(); ++p) {
+    const Index a = pi[p], b = pj[p];
+    const Real gap = (x[b] - x[a]).norm() - r[a] - r[b];
+    if (gap >= 0) continue;
+    const int pt = materials.pair(grp[a], grp[b]);
+    const Real k = pair_stiffness(s, pt, r[a], r[b], -gap);
+    kt[a] += k; kt[b] += k;
+    kr[a] += k * r[a] * r[a]; kr[b] += k * r[b] * r[b];  // shear springs' lever arms (ks <= kn)
+  }
+  const BondSet& bs = s.bonds;
+  for (std::size_t b = 0; b < bs.size(); ++b) {
+    if (bs.broken[b]) continue;
+    const Index i = bs.i[b], j = bs.j[b];
+    Real k = 0, krot = 0;
+    if (materials.bond_law == BondLaw::Parallel) {
+      const auto sec = ParallelBond::section(materials.parallel[bs.pair[b]], r[i], r[j], s.settings.dim);
+      k = ParallelBond::translational_stiffness(sec);
+      krot = ParallelBond::rotational_stiffness(sec);
+    } else if (materials.bond_law == BondLaw::Rotational) {
+      k = std::max(bs.rotational[b].kr, bs.rotational[b].ks);
+      krot = std::max(bs.rotational[b].kt, bs.rotational[b].kb);
+    }
+    kt[i] += k; kt[j] += k;
+    kr[i] += krot + k * r[i] * r[i];
+    kr[j] += krot + k * r[j] * r[j];
+  }
+  for (std::size_t w = 0; w < s.walls.size(); ++w) {
+    const auto& wc = s.wall_contacts()[w];
+    for (std::size_t k = 0; k < wc.particle.size(); ++k) {
+      const Index i = wc.particle[k];
+      ContactGeom g;
+      if (!s.walls[w].geometry(g, x[i], r[i]) || g.gap >= 0) continue;
+      const Real kw = pair_stiffness(s, materials.pair(grp[i], grp[i]), r[i], 0, -g.gap);
+      kt[i] += kw;
+      kr[i] += kw * r[i] * r[i];
+    }
+  }
+  for (const auto& bnd : s.boundaries()) {
+    const auto cp = bnd->contact_particles();
+    const auto ck = bnd->contact_stiffness();
+    for (std::size_t c = 0; c < cp.size(); ++c) {
+      kt[cp[c]] += ck[c];
+      kr[cp[c]] += ck[c] * r[cp[c]] * r[cp[c]];
+    }
+  }
+  Real dt = std::numeric_limits<Real>::infinity();
+  for (std::size_t i = 0; i < n; ++i) {
+    // A particle with no contact yet still meets one like itself (free particles otherwise
+    // give no bound at all).
+    const Real k = kt[i] > 0 ? kt[i] : pair_stiffness(s, materials.pair(grp[i], grp[i]), r[i], r[i], 0.01 * r[i]);
+    const Real kk = kr[i] > 0 ? kr[i] : k * r[i] * r[i];
+    dt = std::min({dt, std::sqrt(1.0 / (particles.inv_mass[i] * k)), std::sqrt(1.0 / (particles.inv_inertia[i] * kk))});
+  }
+  return dt;
+}
+
+void scale_masses_for(DemSystem& s, Real dt, Real safety) {
+  // m~ = max(m, (dt/s)^2 k_tran) (METHODS.md 1.6): done by scaling until the estimate allows dt.
+  const Real dt_now = critical_time_step(s) * safety;
+  if (dt_now >= dt) return;
+  const Real f = (dt / dt_now) * (dt / dt_now);
+  for (std::size_t i = 0; i < s.particles.size(); ++i) {
+    s.particles.inv_mass[i] /= f;
+    s.particles.inv_inertia[i] /= f;
+  }
+}
+
+}  // namespace ff::dem
