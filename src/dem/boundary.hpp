@@ -17,6 +17,7 @@ class CheckpointReader;
 namespace ff::dem {
 
 class DemSystem;
+struct ParticleStore;
 
 // Load of one boundary contact: f = force ON THE BOUNDARY (the particle receives -f), m = moment
 // on the particle, xc = contact point (Love-Weber stress: branch xc - x_particle).
@@ -35,6 +36,9 @@ class Boundary {
   virtual void update_neighbors(const DemSystem& sys, bool rebuilt, Real travel) = 0;
   // compute_forces(): the contact forces, one slot per candidate contact.
   virtual void compute_forces(const DemSystem& sys) = 0;
+  // add_external_loads(): loads from outside the interactions, ADDED to p.ext_force/ext_moment
+  // (the particle membrane's confining loads); most boundaries have none.
+  virtual void add_external_loads(ParticleStore& /*p*/) const {}
   // integrate(): the loads on the particles, added serially after the walls' (fixed order).
   virtual void add_loads(std::span<Vec3> force, std::span<Vec3> moment) const = 0;
   // integrate(): after the particles moved (servo, own motion).
@@ -43,6 +47,9 @@ class Boundary {
   virtual std::span<const Index> contact_particles() const = 0;
   virtual std::span<const BoundaryLoad> contact_loads() const = 0;
   virtual std::span<const Real> contact_stiffness() const = 0;
+  // reorder_particles(): the particle arrays were permuted; old index i is now new_of_old[i].
+  // A boundary that holds particle indices maps them (keeping its contact history).
+  virtual void reorder(std::span<const Index> new_of_old) = 0;
   // Checkpoint: the boundary's state (the boundary itself is rebuilt by its owner's set-up).
   virtual void save(CheckpointWriter& w, const DemSystem& sys) const = 0;
   virtual void load(CheckpointReader& r, const DemSystem& sys) = 0;

@@ -15,7 +15,7 @@ struct CrackEvent {
   Real size;         // bond radius [m] (crack disc radius)
   std::uint8_t mode; // 1 tensile, 2 shear
   std::int32_t group_a, group_b;
-  Index i, j;        // particle indices
+  std::int64_t i, j; // global ids of the two particles (ParticleStore::id; stable under reordering)
 };
 
 struct CrackLog {

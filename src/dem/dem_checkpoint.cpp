@@ -33,19 +33,12 @@ template <> struct is_checkpoint_pod<dem::WallRecord> : std::true_type {};
 namespace ff::dem {
 
 void save_dem(CheckpointWriter& w, const DemSystem& s) {
+  // Particle fields: every field of the declaration that is saved (particle_store.hpp).
   const auto& P = s.particles;
-  w.put("dem.pos", P.pos);
-  w.put("dem.vel", P.vel);
-  w.put("dem.omega", P.omega);
-  w.put("dem.orient", P.orient);
-  w.put("dem.disp", P.disp);
-  w.put("dem.radius", P.radius);
-  w.put("dem.mass", P.mass);
-  w.put("dem.inertia", P.inertia);
-  w.put("dem.inv_mass", P.inv_mass);
-  w.put("dem.inv_inertia", P.inv_inertia);
-  w.put("dem.group", P.group);
-  w.put("dem.inward_force", P.inward_force);
+  ParticleStore::for_each_field([&](const auto& fd) {
+    if (fd.checkpoint == CheckpointPolicy::Saved) w.put(std::string("dem.") + fd.name, P.*fd.member);
+  });
+  w.put_value("dem.next_id", P.next_id);
   w.put("dem.bond_i", s.bonds.i);
   w.put("dem.bond_j", s.bonds.j);
   w.put("dem.bond_pair", s.bonds.pair);
@@ -84,21 +77,22 @@ void save_dem(CheckpointWriter& w, const DemSystem& s) {
 }
 
 void load_dem(CheckpointReader& r, DemSystem& s) {
+  // Particle fields: the saved ones are read, the recomputed ones start at their fill value.
   auto& P = s.particles;
   r.get("dem.pos", P.pos);
   const std::size_t n = P.pos.size();
-  P.resize(n);
-  r.get("dem.vel", P.vel);
-  r.get("dem.omega", P.omega);
-  r.get("dem.orient", P.orient);
-  r.get("dem.disp", P.disp);
-  r.get("dem.radius", P.radius);
-  r.get("dem.mass", P.mass);
-  r.get("dem.inertia", P.inertia);
-  r.get("dem.inv_mass", P.inv_mass);
-  r.get("dem.inv_inertia", P.inv_inertia);
-  r.get("dem.group", P.group);
-  if (r.has("dem.inward_force")) r.get("dem.inward_force", P.inward_force);  // older checkpoints: none
+  ParticleStore::for_each_field([&](const auto& fd) {
+    auto& v = P.*fd.member;
+    if (fd.checkpoint == CheckpointPolicy::Recomputed) {
+      v.assign(n, fd.fill);
+      return;
+    }
+    r.get(std::string("dem.") + fd.name, v);
+    if (v.size() != n)
+      throw InputError(fmt::format("checkpoint: dem.{} holds {} particles but dem.pos {}; the file is damaged", fd.name,
+                                   v.size(), n));
+  });
+  P.next_id = r.get_value<std::int64_t>("dem.next_id");
   r.get("dem.bond_i", s.bonds.i);
   r.get("dem.bond_j", s.bonds.j);
   r.get("dem.bond_pair", s.bonds.pair);
@@ -137,8 +131,6 @@ void load_dem(CheckpointReader& r, DemSystem& s) {
   s.cracks.tensile = s.cracks.shear = 0;
   for (auto& e : s.cracks.events) (e.mode == 1 ? s.cracks.tensile : s.cracks.shear)++;
   // Rebuild derived storage, then put back the exact neighbour list and histories.
-  s.particles.force.assign(n, Vec3::Zero());
-  s.particles.moment.assign(n, Vec3::Zero());
   s.build_bond_adjacency();
   auto& nl = s.neighbors();
   r.get("dem.nl_i", nl.pair_i());

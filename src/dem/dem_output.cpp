@@ -63,17 +63,12 @@ void DemVtkWriter::write(const DemSystem& sys, long index, Real wall_extent) {
   const auto& P = sys.particles;
   const std::size_t n = P.size();
   const std::string tag = fmt::format("{:06d}", index);
-  // Particles.
+  // Particles: every field of the declaration with a VTK name (particle_store.hpp).
   {
-    std::vector<std::int32_t> id(n);
-    for (std::size_t i = 0; i < n; ++i) id[i] = static_cast<std::int32_t>(i);
-    const VtkArray pd[] = {vtk_array("id", std::span<const std::int32_t>(id)),
-                           vtk_array("radius", std::span<const double>(P.radius)),
-                           vtk_array("group", std::span<const std::int32_t>(P.group)),
-                           vtk_array("velocity", std::span<const Vec3>(P.vel)),
-                           vtk_array("angular_velocity", std::span<const Vec3>(P.omega)),
-                           vtk_array("displacement", std::span<const Vec3>(P.disp)),
-                           vtk_array("force", std::span<const Vec3>(P.force))};
+    std::vector<VtkArray> pd;
+    ParticleStore::for_each_field([&](const auto& fd) {
+      if (fd.vtk) pd.push_back(vtk_array(fd.vtk, std::span(P.*fd.member)));
+    });
     const std::string f = "particles_" + tag + ".vtp";
     write_vtp(dir_ / f, P.pos, VtpCells{}, pd, {});
     particles_.add(sys.time, f);
@@ -175,7 +170,8 @@ void append_cracks_csv(const std::filesystem::path& csv, const CrackLog& log, co
   std::FILE* f = std::fopen(csv.c_str(), from == 0 ? "w" : "a");
   if (!f) throw Error(fmt::format("cannot write '{}'", csv.string()));
   // Names end in their SI unit (size_m: the crack disc radius, the bond's); the normal is a unit vector.
-  if (from == 0) fmt::print(f, "time_s,x_m,y_m,z_m,nx,ny,nz,size_m,mode,group_a,group_b,particle_a,particle_b\n");
+  // id_a, id_b: the particles' global ids (the "id" of the VTK particle files), not array indices.
+  if (from == 0) fmt::print(f, "time_s,x_m,y_m,z_m,nx,ny,nz,size_m,mode,group_a,group_b,id_a,id_b\n");
   for (std::size_t k = from; k < log.events.size(); ++k) {
     const auto& e = log.events[k];
     fmt::print(f, "{},{},{},{},{},{},{},{},{},{},{},{},{}\n", e.time, e.position.x(), e.position.y(), e.position.z(),

@@ -51,9 +51,9 @@ Boundary& DemSystem::add_boundary(std::unique_ptr<Boundary> b) {
 
 void DemSystem::initialise() {
   if (settings.skin <= 0) throw Error("internal: DemSystem skin must be set before initialise()");
-  particles.force.assign(particles.size(), Vec3::Zero());
-  particles.moment.assign(particles.size(), Vec3::Zero());
-  particles.inward_force.resize(particles.size(), 0);
+  particles.resize(particles.size());  // every declared field as long as pos (fresh ids if missing)
+  for (auto* a : {&particles.force, &particles.moment, &particles.ext_force, &particles.ext_moment})
+    a->assign(particles.size(), Vec3::Zero());
   wall_contacts_.resize(walls.size());
   build_bond_adjacency();
   pbond_coeffs_.reserve(materials.parallel.size());
@@ -231,7 +231,7 @@ void DemSystem::record_bond_failures() {
       size = ParallelBond::section(materials.parallel[bond_pair[b]], particles.radius[i], particles.radius[j], settings.dim).R;
     else size = 0.5 * (particles.radius[i] + particles.radius[j]);
     cracks.add(CrackEvent{time, particles.pos[i] + (particles.radius[i] + 0.5 * gap) * n, n, size, bond_broken[b],
-                          particles.group[i], particles.group[j], i, j});
+                          particles.group[i], particles.group[j], particles.id[i], particles.id[j]});
   }
 }
 
@@ -279,21 +279,8 @@ void DemSystem::wall_forces(const std::vector<typename Law::Params>& params) {
 }
 
 void DemSystem::add_external_loads() {
-  const std::size_t n = particles.size();
-  auto& F = particles.force;
-  auto& M = particles.moment;
-  const auto& inward = particles.inward_force;
-  const auto& pos = particles.pos;
-#pragma omp parallel for schedule(static) if (n > settings.parallel_min)
-  for (std::size_t i = 0; i < n; ++i) {
-    Vec3 f = Vec3::Zero();
-    if (inward[i] != 0) {  // constant magnitude, towards the z axis from where the particle is now
-      const Real rho = std::hypot(pos[i].x(), pos[i].y());
-      if (rho > 0) f = Vec3(pos[i].x(), pos[i].y(), 0) * (-inward[i] / rho);
-    }
-    F[i] = f;
-    M[i].setZero();
-  }
+  // The accumulators are zero here (integrate() zeroed them); loads are ADDED.
+  for (auto& b : boundaries_) b->add_external_loads(particles);
 }
 
 void DemSystem::integrate() {
@@ -307,10 +294,15 @@ void DemSystem::integrate() {
   const auto& bload_ = bonds.loads();
   auto& F = particles.force;
   auto& M = particles.moment;
-  // The external loads come first (their order is part of the bit-identical result).
+  auto& Fe = particles.ext_force;
+  auto& Me = particles.ext_moment;
+  // The external loads come first (their order is part of the bit-identical result); the
+  // accumulators are zeroed for the next step as they are read.
 #pragma omp parallel for schedule(static) if (n > settings.parallel_min)
   for (std::size_t i = 0; i < n; ++i) {
-    Vec3 f = F[i], m = M[i];
+    Vec3 f = Fe[i], m = Me[i];
+    Fe[i].setZero();
+    Me[i].setZero();
     for (std::int64_t k = adj_off[i]; k < adj_off[i + 1]; ++k) {
       const std::int64_t e = adj[k];
       const PairLoad& L = pload_[e >> 1];

@@ -2,11 +2,12 @@
 //   update_neighbors()    walls' step motion, neighbour rebuild when the skin is used up,
 //                         boundaries' own candidate searches;
 //   compute_forces()      contact, bond (+ crack events), wall and boundary forces, one slot per pair;
-//   add_external_loads()  sets particles.force/moment to the loads from outside the interactions
-//                         (today the particle membrane's inward load); after it, a coupled solver
-//                         adds its own forces to particles.force / particles.moment;
+//   add_external_loads()  boundaries add their loads from outside the interactions (the particle
+//                         membrane's inward loads) to particles.ext_force / ext_moment; a coupled
+//                         solver adds its own there too, after this stage or before it;
 //   integrate()           gathers the slots onto each particle after its external load, in a fixed
-//                         order; local damping; velocity Verlet; boundaries and walls move.
+//                         order, and zeroes the external accumulators; local damping; velocity
+//                         Verlet; boundaries and walls move.
 // step() is their composition; a coupled solver may call them itself (and sub-cycle them).
 // Every per-pair result is written to its own slot and gathered per particle in increasing pair
 // order, so results are bit-identical on any number of OpenMP threads.
@@ -108,6 +109,7 @@ class DemSystem {
   template <class Law, class Mat> void bond_forces(const std::vector<Mat>& mats, std::vector<typename Law::State>& st);
   template <class Law> void wall_forces(const std::vector<typename Law::Params>& params);
   void record_bond_failures();
+  friend void reorder_particles(DemSystem& sys, const std::vector<Index>& order);
 
   NeighborList nl_;
   BoundaryList boundaries_;

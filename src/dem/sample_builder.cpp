@@ -121,20 +121,13 @@ std::string group_list(const Materials& mat) {
   return s;
 }
 
-// Keeps the particles with !remove[i]. Called before bonds exist: every neighbour pair and wall
-// contact is dropped first, because the renumbering would attach their history to other particles.
+// Keeps the particles with !remove[i] (every declared field; ids stay with their particles).
+// Called before bonds exist: every neighbour pair and wall contact is dropped first, because the
+// renumbering would attach their history to other particles.
 void remove_particles(DemSystem& sys, const std::vector<char>& remove) {
   ParticleStore& P = sys.particles;
-  ParticleStore kept;
-  auto keep = [&](auto& from, auto& to) {
-    for (std::size_t i = 0; i < from.size(); ++i)
-      if (!remove[i]) to.push_back(from[i]);
-  };
-  keep(P.pos, kept.pos), keep(P.vel, kept.vel), keep(P.omega, kept.omega), keep(P.orient, kept.orient);
-  keep(P.disp, kept.disp), keep(P.radius, kept.radius), keep(P.mass, kept.mass), keep(P.inertia, kept.inertia);
-  keep(P.inv_mass, kept.inv_mass), keep(P.inv_inertia, kept.inv_inertia), keep(P.group, kept.group);
-  keep(P.inward_force, kept.inward_force);
-  keep(P.force, kept.force), keep(P.moment, kept.moment);
+  ParticleStore kept = std::move(P);
+  kept.keep(remove);
   P = ParticleStore{};
   sys.wall_contacts().clear();
   sys.rebuild_neighbors();

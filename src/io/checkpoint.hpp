@@ -36,8 +36,10 @@ struct Checksum {
 }  // namespace detail
 
 // 2: parallel-bond state holds loads only; 3: the UCS lateral gauge, the triaxial isotropic-stage
-// counter and the flexible membrane's contact history are stored instead of re-derived at resume.
-inline constexpr std::uint32_t kCheckpointFormatVersion = 3;
+// counter and the flexible membrane's contact history are stored instead of re-derived at resume;
+// 4: particle global ids (dem.id, dem.next_id), crack events name particles by global id, no
+// dem.inward_force (the particle membrane's loads come from its layout at resume).
+inline constexpr std::uint32_t kCheckpointFormatVersion = 4;
 
 // Types stored as raw bytes: trivially copyable ones, plus Eigen fixed-size vectors/matrices and
 // quaternions of arithmetic scalars (memcpy-safe though Eigen declares copy constructors).

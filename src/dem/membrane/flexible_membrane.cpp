@@ -266,6 +266,34 @@ void FlexibleMembrane::find_candidates(std::span<const Vec3> pos, std::span<cons
   motion_ = 0;
 }
 
+void FlexibleMembrane::remap_particles(std::span<const Index> new_of_old) {
+  // Candidates ordered by (new particle, element): each particle's run keeps its element order,
+  // so the per-particle gather (add_loads_to) and keep_contact() see the same runs as before.
+  const std::size_t nc = cand_p_.size();
+  std::vector<std::size_t> order(nc);
+  for (std::size_t c = 0; c < nc; ++c) order[c] = c;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return new_of_old[cand_p_[a]] < new_of_old[cand_p_[b]];
+  });
+  auto permute = [&](auto& v) {
+    if (v.size() != nc) return;  // scratch not sized yet
+    auto copy = v;
+    for (std::size_t c = 0; c < nc; ++c) v[c] = copy[order[c]];
+  };
+  for (auto& p : cand_p_) p = new_of_old[p];
+  permute(cand_p_);
+  permute(cand_e_);
+  permute(state_);
+  permute(load_);
+  permute(cp_);
+  permute(dist_);
+  permute(kn_);
+  permute(touch_);
+  group_off_.assign(1, 0);
+  for (std::size_t c = 0; c < nc; ++c)
+    if (c + 1 == nc || cand_p_[c + 1] != cand_p_[c]) group_off_.push_back(static_cast<std::int64_t>(c + 1));
+}
+
 bool FlexibleMembrane::keep_contact(std::size_t c, std::size_t begin, std::size_t end) const {
   // One contact per local minimum of the particle's distance to the mesh (file comment).
   if (!touch_[c]) return false;

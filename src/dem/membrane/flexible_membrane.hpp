@@ -159,6 +159,9 @@ class FlexibleMembrane {
   std::span<ContactState> contact_states() { return state_; }  // shear history per candidate
   std::span<const ContactState> contact_states() const { return state_; }
   void add_loads_to(std::span<Vec3> force, std::span<Vec3> moment) const;
+  // The particles were reordered (old index i is now new_of_old[i]): candidates renumbered and
+  // sorted again by (particle, element) with their contact history and last loads.
+  void remap_particles(std::span<const Index> new_of_old);
   // Servo + vertex update from the last compute_forces(); z of the platen planes [m].
   void move(Real dt, Real z_bottom, Real z_top);
   Real motion_since_build() const { return motion_; }  // max vertex travel since find_candidates [m]

@@ -25,6 +25,7 @@ class MembraneBoundary final : public Boundary {
   void compute_forces(const DemSystem& sys) override;
   void add_loads(std::span<Vec3> force, std::span<Vec3> moment) const override { m_.add_loads_to(force, moment); }
   void after_integrate(const DemSystem& sys) override;
+  void reorder(std::span<const Index> new_of_old) override { m_.remap_particles(new_of_old); }
   std::span<const Index> contact_particles() const override { return m_.candidate_particles(); }
   std::span<const BoundaryLoad> contact_loads() const override { return m_.candidate_loads(); }
   std::span<const Real> contact_stiffness() const override { return m_.candidate_stiffness(); }

@@ -115,6 +115,25 @@ void remap_pair_indices(std::span<std::int32_t> pair, int n_old, int n_new) {
   for (auto& p : pair) p = (p / n_old) * n_new + p % n_old;
 }
 
+void InwardLoads::add_external_loads(ParticleStore& p) const {
+  if (force_ == 0) return;
+  for (const Index i : particle_) {  // constant magnitude, towards the z axis from where it is now
+    const Vec3& x = p.pos[i];
+    const Real rho = std::hypot(x.x(), x.y());
+    if (rho > 0) p.ext_force[i] += Vec3(x.x(), x.y(), 0) * (-force_ / rho);
+  }
+}
+
+void InwardLoads::reorder(std::span<const Index> new_of_old) {
+  for (auto& i : particle_) i = new_of_old[i];
+}
+
+InwardLoads& attach_particle_membrane_loads(DemSystem& sys, const ParticleMembraneLayout& l) {
+  std::vector<Index> idx(static_cast<std::size_t>(l.count()));
+  for (std::int64_t k = 0; k < l.count(); ++k) idx[static_cast<std::size_t>(k)] = static_cast<Index>(l.first + k);
+  return static_cast<InwardLoads&>(sys.add_boundary(std::make_unique<InwardLoads>(std::move(idx), l.force)));
+}
+
 ParticleMembraneLayout add_particle_membrane(DemSystem& sys, const ParticleMembraneSpec& spec,
                                              const ParticleMembraneMaterial& pm) {
   if (sys.settings.dim != 3) throw InputError("particle membrane: 3D samples only (dem.dim = 3)");
@@ -134,8 +153,8 @@ ParticleMembraneLayout add_particle_membrane(DemSystem& sys, const ParticleMembr
       P.radius[k] = l.particle_radius;
       P.group[k] = l.group;
       P.set_mass_from_density(k, pm.density, 3);
-      P.inward_force[k] = l.force;
     }
+  attach_particle_membrane_loads(sys, l);
   // Ring neighbours, then row neighbours, sphere by sphere (a fixed order).
   if (pm.bonded)
     for (std::int64_t j = 0; j < l.n_z; ++j)

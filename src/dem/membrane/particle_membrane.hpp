@@ -3,7 +3,7 @@
 // Bono et al. (2012) and Cheung & O'Sullivan (2008) (METHODS.md 3, "alternatives"). A layer of
 // bonded spheres around the sample, each pushed towards the axis by a force of CONSTANT
 // magnitude: the confining pressure times its share of the membrane's area when it is built
-// (ParticleStore::inward_force). As the sample bulges the forces neither grow with the stretched
+// (InwardLoads, added to ParticleStore::ext_force every step). As the sample bulges the forces neither grow with the stretched
 // area nor tilt with the bulging surface, so the confinement actually applied drops; [S000] finds
 // a clearly lower peak strength than with its flexible wall.
 //
@@ -38,6 +38,7 @@
 //
 // Units: SI. 3D only.
 #pragma once
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -98,8 +99,42 @@ int add_particle_membrane_group(Materials& m, const ParticleMembraneMaterial& pm
 // Re-indexes pair indices a*n_old + b to a*n_new + b.
 void remap_pair_indices(std::span<std::int32_t> pair, int n_old, int n_new);
 
-// Builds the membrane in `sys` (3D, materials and skin set): group, spheres (at rest, constant
-// external forces), ring and row bonds (unless !pm.bonded); initialises the system. Returns the layout.
+// Loads of constant magnitude `force` [N] towards the z axis on a set of particles: each step
+// (add_external_loads stage) every one gets f = -force (x, y, 0) / |(x, y)| from its current
+// position, ADDED to ParticleStore::ext_force (none on the axis itself). Holds particle indices,
+// renumbered by reorder_particles(); no state of its own to checkpoint (whoever attached it
+// attaches it again at a resume).
+class InwardLoads final : public Boundary {
+ public:
+  InwardLoads(std::vector<Index> particles, Real force) : particle_(std::move(particles)), force_(force) {}
+  std::span<const Index> particles() const { return particle_; }
+  Real force() const { return force_; }
+
+  std::unique_ptr<Boundary> clone() const override { return std::make_unique<InwardLoads>(*this); }
+  void update_neighbors(const DemSystem&, bool, Real) override {}
+  void compute_forces(const DemSystem&) override {}
+  void add_external_loads(ParticleStore& p) const override;
+  void add_loads(std::span<Vec3>, std::span<Vec3>) const override {}
+  void after_integrate(const DemSystem&) override {}
+  void reorder(std::span<const Index> new_of_old) override;
+  std::span<const Index> contact_particles() const override { return {}; }
+  std::span<const BoundaryLoad> contact_loads() const override { return {}; }
+  std::span<const Real> contact_stiffness() const override { return {}; }
+  void save(CheckpointWriter&, const DemSystem&) const override {}
+  void load(CheckpointReader&, const DemSystem&) override {}
+
+ private:
+  std::vector<Index> particle_;
+  Real force_;
+};
+
+// Attaches the inward loads of a particle membrane (layout.force on each of its spheres) to
+// `sys`: add_particle_membrane() does it; a driver that resumes from a checkpoint does it again.
+InwardLoads& attach_particle_membrane_loads(DemSystem& sys, const ParticleMembraneLayout& l);
+
+// Builds the membrane in `sys` (3D, materials and skin set): group, spheres (at rest), their
+// constant inward loads (attach_particle_membrane_loads), ring and row bonds (unless !pm.bonded);
+// initialises the system. Returns the layout.
 ParticleMembraneLayout add_particle_membrane(DemSystem& sys, const ParticleMembraneSpec& spec,
                                              const ParticleMembraneMaterial& pm);
 

@@ -240,6 +240,7 @@ class TriaxialRun final : public DemRun {
       lat_.particles = r.get_value<dem::ParticleMembraneLayout>("triaxial.particle_membrane");
       if (dem::add_particle_membrane_group(sys.materials, particle_membrane_material(cfg)) != lat_.particles.group)
         cfg.fail("triaxial.lateral", "the checkpoint's particle groups differ from the scenario's");
+      dem::attach_particle_membrane_loads(sys, lat_.particles);  // its confining loads
     }
     st_ = r.get_value<TriaxialState>("triaxial.state");
     info = sample_info(r.get_value<SampleRecord>("triaxial.sample"));

@@ -132,7 +132,7 @@ TEST(RunResults, UcsSummaryIsTypedAndColumnsCarryUnits) {
   EXPECT_EQ(first_line(out / "series.csv"),
             "step,time_s,axial_strain,axial_stress_Pa,lateral_strain,volumetric_strain,cracks_tensile,cracks_shear,"
             "cracks_total,intact_bonds,kinetic_energy_J,unbalanced_force_ratio");
-  EXPECT_EQ(first_line(out / "cracks.csv"), "time_s,x_m,y_m,z_m,nx,ny,nz,size_m,mode,group_a,group_b,particle_a,particle_b");
+  EXPECT_EQ(first_line(out / "cracks.csv"), "time_s,x_m,y_m,z_m,nx,ny,nz,size_m,mode,group_a,group_b,id_a,id_b");
   fs::remove_all(out);
 }
 

@@ -10,6 +10,7 @@
 #include "core/rng.hpp"
 #include "dem/diagnostics.hpp"
 #include "dem/dem_system.hpp"
+#include "dem/membrane/particle_membrane.hpp"
 
 using namespace ff;
 using namespace ff::dem;
@@ -63,8 +64,8 @@ TEST(DemStages, ExternalLoadAddedBetweenStagesIsIntegrated) {
       s.update_neighbors();
       s.compute_forces();
       s.add_external_loads();
-      s.particles.force[0] += F;
-      s.particles.moment[0] += T;
+      s.particles.ext_force[0] += F;
+      s.particles.ext_moment[0] += T;
       s.integrate();
     }
   const long N = fluid_steps * sub;
@@ -90,7 +91,9 @@ TEST(DemStages, StagesCalledOneByOneGiveTheStepBitForBit) {
       for (int j = 0; j < n; ++j)
         for (int i = 0; i < n; ++i)
           add_particle(s, Vec3(a * i, a * j, a * k) + 1e-5 * Vec3(g.uniform(-1, 1), g.uniform(-1, 1), g.uniform(-1, 1)));
-    for (std::size_t i = 0; i < s.particles.size(); i += 5) s.particles.inward_force[i] = 1e-2;
+    std::vector<Index> loaded;
+    for (std::size_t i = 0; i < s.particles.size(); i += 5) loaded.push_back(static_cast<Index>(i));
+    s.add_boundary(std::make_unique<InwardLoads>(loaded, 1e-2));
     s.install_bonds(0.1 * kRadius);
     Wall w;
     w.point = Vec3(0, 0, -1.05 * kRadius);
@@ -108,7 +111,7 @@ TEST(DemStages, StagesCalledOneByOneGiveTheStepBitForBit) {
     b.update_neighbors();
     b.compute_forces();
     b.add_external_loads();
-    for (auto& f : b.particles.force) f += Vec3::Zero();
+    for (auto& f : b.particles.ext_force) f += Vec3::Zero();
     b.integrate();
   }
   EXPECT_GT(a.cracks.total(), 0) << "bonds must break during the comparison";

@@ -7,7 +7,9 @@
 // normal stiffness kn = pi min(r)^2 E / (rA + rB) (METHODS.md 1.3-1.4).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <unistd.h>
 
@@ -91,7 +93,7 @@ DemSystem one_free_sphere(const Vec3& pos, const Vec3& vel, Real inward) {
   s.particles.pos[0] = pos;
   s.particles.vel[0] = vel;
   s.particles.set_mass_from_density(0, 1390, 3);
-  s.particles.inward_force[0] = inward;
+  s.add_boundary(std::make_unique<InwardLoads>(std::vector<Index>{0}, inward));
   s.initialise();
   return s;
 }
@@ -186,15 +188,24 @@ TEST(ParticleMembrane, AddedAsItsOwnBondedGroupWithInwardConstantForces) {
     EXPECT_NEAR((s.particles.pos[s.bonds.j[b]] - s.particles.pos[s.bonds.i[b]]).norm(), 2 * l.particle_radius,
                 1e-12 * l.particle_radius);
   }
+  // The constant inward loads: one InwardLoads boundary with every membrane sphere, l.force each.
+  ASSERT_EQ(s.boundaries().size(), 1u);
+  const auto* loads = dynamic_cast<const InwardLoads*>(s.boundaries().begin()->get());
+  ASSERT_NE(loads, nullptr);
+  ASSERT_EQ(loads->particles().size(), static_cast<std::size_t>(l.count()));
+  EXPECT_EQ(loads->force(), l.force);
+  for (std::int64_t k = 0; k < l.count(); ++k) EXPECT_EQ(loads->particles()[k], l.first + k);
   Real sum = 0;
   for (std::size_t i = 0; i < s.particles.size(); ++i) {
-    const Real f = s.particles.inward_force[i];
+    const bool loaded = std::find(loads->particles().begin(), loads->particles().end(), static_cast<Index>(i)) !=
+                        loads->particles().end();
     if (static_cast<std::int64_t>(i) < l.first) {
-      EXPECT_EQ(f, 0.0);
+      EXPECT_FALSE(loaded);
       continue;
     }
     EXPECT_EQ(s.particles.group[i], 2);
-    EXPECT_EQ(f, l.force);
+    EXPECT_TRUE(loaded);
+    const Real f = l.force;
     sum += f;
     for (Index k = 0; k < 4; ++k)  // no membrane sphere overlaps the sample
       EXPECT_GT((s.particles.pos[i] - s.particles.pos[k]).norm(), s.particles.radius[i] + s.particles.radius[k]);
@@ -360,29 +371,40 @@ TEST(DemInwardForce, ExertsNoMomentAboutTheAxis) {
   EXPECT_GT(rmax - rmin, 0.05 * r0);
 }
 
-TEST(DemInwardForce, CheckpointKeepsIt) {
+TEST(DemInwardForce, CheckpointOfAParticleMembraneRunResumesBitForBit) {
+  // The inward loads are no particle field any more (format 4: no dem.inward_force): a membrane
+  // run resumed from its checkpoint, with the loads attached again from the layout as the
+  // triaxial driver does, continues bit for bit like the uninterrupted run.
   DemSystem s = two_group_system();
   s.settings.skin = 0.1e-3;
-  s.settings.dt = 1e-6;
-  s.particles.resize(2);
-  for (int i = 0; i < 2; ++i) {
-    s.particles.pos[i] = Vec3(3e-3 * i, 0, 0);
-    s.particles.radius[i] = 0.5e-3;
-    s.particles.set_mass_from_density(i, 1390, 3);
+  s.settings.local_damping = 0.7;
+  for (int k = 0; k < 3; ++k) {
+    s.particles.resize(static_cast<std::size_t>(k) + 1);
+    s.particles.pos[k] = Vec3(1.5e-3 * k, 0, 5e-3);
+    s.particles.radius[k] = 0.5e-3;
+    s.particles.set_mass_from_density(k, 1390, 3);
   }
-  s.particles.inward_force[1] = 2.5;
-  s.initialise();
-  const auto path = std::filesystem::temp_directory_path() / ("fracflow_inward_force_" + std::to_string(::getpid()) + ".ffcp");
+  const auto l = add_particle_membrane(s, short_membrane_spec(), ParticleMembraneMaterial{1e7, 1000, 0});
+  s.settings.dt = 1e-7;
+  s.run(50);
+  const auto path = std::filesystem::temp_directory_path() / ("fracflow_inward_loads_" + std::to_string(::getpid()) + ".ffcp");
   {
     CheckpointWriter w(path);
     save_dem(w, s);
     w.commit();
   }
   DemSystem t = two_group_system();
+  add_particle_membrane_group(t.materials, ParticleMembraneMaterial{1e7, 1000, 0});
   CheckpointReader r(path);
+  EXPECT_FALSE(r.has("dem.inward_force"));
   load_dem(r, t);
-  ASSERT_EQ(t.particles.inward_force.size(), 2u);
-  EXPECT_EQ(t.particles.inward_force[0], 0.0);
-  EXPECT_EQ(t.particles.inward_force[1], 2.5);
+  attach_particle_membrane_loads(t, l);
   std::filesystem::remove(path);
+  s.run(50);
+  t.run(50);
+  const std::size_t n = s.particles.size();
+  ASSERT_EQ(t.particles.size(), n);
+  EXPECT_EQ(t.particles.id, s.particles.id);
+  EXPECT_EQ(std::memcmp(s.particles.pos.data(), t.particles.pos.data(), n * sizeof(Vec3)), 0);
+  EXPECT_GT((s.particles.pos[l.first] - particle_membrane_position(l, 0, 0)).norm(), 0.0);  // the loads moved it
 }
