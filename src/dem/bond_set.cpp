@@ -33,15 +33,13 @@ void BondSet::build_adjacency(std::size_t n) {
 
 void BondSet::compact(std::size_t n_particles) {
   std::size_t k = 0;
-  const bool par = !parallel.empty(), rot = !rotational.empty();
   for (std::size_t b = 0; b < i.size(); ++b) {
     if (broken[b]) continue;
     i[k] = i[b];
     j[k] = j[b];
     pair[k] = pair[b];
     broken[k] = 0;
-    if (par) parallel[k] = parallel[b];
-    if (rot) rotational[k] = rotational[b];
+    std::apply([&](auto&... st) { ((st.empty() ? void() : void(st[k] = st[b])), ...); }, states);
     ++k;
   }
   if (k == i.size()) return;
@@ -49,8 +47,7 @@ void BondSet::compact(std::size_t n_particles) {
   j.resize(k);
   pair.resize(k);
   broken.resize(k);
-  if (par) parallel.resize(k);
-  if (rot) rotational.resize(k);
+  std::apply([&](auto&... st) { ((st.empty() ? void() : st.resize(k)), ...); }, states);
   build_adjacency(n_particles);
 }
 

@@ -6,8 +6,7 @@
 #include <span>
 #include <vector>
 
-#include "dem/bond/parallel_bond.hpp"
-#include "dem/bond/rotational_bond.hpp"
+#include "dem/laws.hpp"
 
 namespace ff::dem {
 
@@ -21,8 +20,12 @@ class BondSet {
   std::vector<Index> i, j;                // ends, i < j
   std::vector<std::int32_t> pair;         // pair type (Materials::pair)
   std::vector<std::uint8_t> broken;       // 0 intact, 1 tensile, 2 shear
-  std::vector<ParallelBond::State> parallel;      // state when the parallel bond law is active
-  std::vector<RotationalBond::State> rotational;  // state when the rotational bond law is active
+  BondStates states;  // per bond law, the state of each bond (only the active law's is filled)
+
+  template <class Law> std::vector<typename Law::State>& state() { return std::get<law_index<Law>(BondLaws{})>(states); }
+  template <class Law> const std::vector<typename Law::State>& state() const {
+    return std::get<law_index<Law>(BondLaws{})>(states);
+  }
 
   std::size_t size() const { return i.size(); }
   std::size_t intact() const;

@@ -6,8 +6,6 @@
 
 namespace ff {
 // Bond and history states are plain aggregates of doubles and Eigen fixed-size members.
-template <> struct is_checkpoint_pod<dem::ParallelBond::State> : std::true_type {};
-template <> struct is_checkpoint_pod<dem::RotationalBond::State> : std::true_type {};
 template <> struct is_checkpoint_pod<dem::ContactState> : std::true_type {};
 template <> struct is_checkpoint_pod<dem::CrackEvent> : std::true_type {};
 template <> struct is_checkpoint_pod<dem::PairLoad> : std::true_type {};
@@ -43,8 +41,10 @@ void save_dem(CheckpointWriter& w, const DemSystem& s) {
   w.put("dem.bond_j", s.bonds.j);
   w.put("dem.bond_pair", s.bonds.pair);
   w.put("dem.bond_broken", s.bonds.broken);
-  w.put("dem.pbond", s.bonds.parallel);
-  w.put("dem.rbond", s.bonds.rotational);
+  // Each bond law's states under its own key (the law owns its state: laws.hpp).
+  for_each_law(BondLaws{}, [&]<class Law>(std::type_identity<Law>) {
+    if constexpr (!Law::checkpoint_key.empty()) w.put(std::string(Law::checkpoint_key), s.bonds.state<Law>());
+  });
   w.put_value("dem.time", s.time);
   w.put_value("dem.step", s.step_count);
   w.put_value("dem.dt", s.settings.dt);
@@ -97,8 +97,13 @@ void load_dem(CheckpointReader& r, DemSystem& s) {
   r.get("dem.bond_j", s.bonds.j);
   r.get("dem.bond_pair", s.bonds.pair);
   r.get("dem.bond_broken", s.bonds.broken);
-  r.get("dem.pbond", s.bonds.parallel);
-  r.get("dem.rbond", s.bonds.rotational);
+  for_each_law(BondLaws{}, [&]<class Law>(std::type_identity<Law>) {
+    if constexpr (!Law::checkpoint_key.empty()) {
+      const std::string key(Law::checkpoint_key);
+      if (r.has(key)) r.get(key, s.bonds.state<Law>());
+      else s.bonds.state<Law>().clear();
+    }
+  });
   s.time = r.get_value<Real>("dem.time");
   s.step_count = r.get_value<long>("dem.step");
   s.settings.dt = r.get_value<Real>("dem.dt");

@@ -13,9 +13,10 @@ namespace ff::dem {
 
 void declare_dem_params(ParamTable& t) {
   t.integer("dem.dim", 3, "-", "space dimension: 3 = spheres, 2 = disks of unit thickness in the x-y plane").range(2, 3);
-  t.string("dem.contact_law", "linear", "contact law between particles and with walls").one_of({"linear", "hertz_mindlin"});
+  // The laws' names come from their registry (laws.hpp); each law declares its own keys below.
+  t.string("dem.contact_law", "linear", "contact law between particles and with walls").one_of(law_name_list(ContactLaws{}));
   t.string("dem.bond_law", "parallel", "bond law: parallel (Potyondy & Cundall 2004), rotational (Wang & Mora 6-DOF), none")
-      .one_of({"parallel", "rotational", "none"});
+      .one_of(law_name_list(BondLaws{}));
   t.real("dem.local_damping", 0.7, "-", "Cundall local damping coefficient (PFC default 0.7)").range(0, 1).below(1);
   t.real("dem.normal_damping_ratio", 0.0, "-", "viscous normal dashpot as a fraction of critical damping").range(0, 1);
   t.real("dem.time_step", 0.0, "s", "time step; 0 = time_step_safety x critical time step").non_negative();
@@ -25,45 +26,27 @@ void declare_dem_params(ParamTable& t) {
   t.integer("dem.parallel_min", 2048, "-", "loops over fewer particles/contacts/bonds run on one thread (OpenMP fork/join costs more)").non_negative();
   t.real_list("dem.gravity", {0, 0, 0}, "m/s^2", "gravitational acceleration").size(3);
   t.real("dem.group.*.density", 2600, "kg/m^3", "particle density of the group").positive();
-  // Linear contact (PFC deformability method).
-  t.real("dem.contact.*.emod", 1e9, "Pa", "linear contact effective modulus E* (kn = A E*/L)").positive();
-  t.real("dem.contact.*.kratio", 1.0, "-", "linear contact normal-to-shear stiffness ratio kn/ks").positive();
+  // Keys common to the contact laws (each law reads them), then each law's own.
   t.real("dem.contact.*.friction", 0.5, "-", "Coulomb friction coefficient of the contact").non_negative();
-  // Hertz-Mindlin contact.
-  t.real("dem.contact.*.shear_modulus", 1e9, "Pa", "Hertz-Mindlin particle shear modulus G").positive();
-  t.real("dem.contact.*.poisson", 0.25, "-", "Hertz-Mindlin particle Poisson ratio").range(0, 0.5).below(0.5);
-  // Parallel bond.
-  t.real("dem.bond.*.emod", 1e9, "Pa", "parallel bond effective modulus (kn_bar = E_bar/L)").positive();
-  t.real("dem.bond.*.kratio", 1.0, "-", "parallel bond normal-to-shear stiffness ratio").positive();
-  t.real("dem.bond.*.tensile_strength", 10e6, "Pa", "parallel bond tensile strength").positive();
+  for_each_law(ContactLaws{}, [&]<class Law>(std::type_identity<Law>) { Law::declare(t); });
+  // Keys common to the bond laws that install bonds, then each law's own.
   t.real("dem.bond.*.cohesion", 10e6, "Pa", "bond cohesion (parallel and rotational bonds)").positive();
   t.real("dem.bond.*.friction_angle", 0.0, "deg", "bond friction angle (parallel: shear strength c - sigma tan(phi); rotational: > 0)")
       .range(0, 90).below(90);
-  t.real("dem.bond.*.radius_multiplier", 1.0, "-", "parallel bond radius multiplier lambda_bar").positive();
-  t.real("dem.bond.*.moment_factor", 1.0, "-", "parallel bond moment-contribution factor beta_bar").range(0, 1);
-  // Rotational bond (Wang & Mora).
-  t.real("dem.bond.*.youngs_modulus", 1e9, "Pa", "rotational bond Young's modulus E (beam of radius L0/2)").positive();
-  t.real("dem.bond.*.poisson_ratio", 0.25, "-", "rotational bond Poisson ratio").range(0, 0.5).below(0.5);
-  t.real("dem.bond.*.beta1", 1.0, "-", "rotational bond: weight of bending in the tensile criterion").non_negative();
-  t.real("dem.bond.*.beta2", 1.0, "-", "rotational bond: weight of twisting in the shear criterion").non_negative();
-  t.real("dem.bond.*.truncation", 1.0, "-", "rotational bond: tension cut-off t of the criterion").positive().at_most(1);
+  for_each_law(BondLaws{}, [&]<class Law>(std::type_identity<Law>) { Law::declare(t); });
 }
 
 namespace {
 
-// The law a key of a pair table belongs to ("" when every law of its section reads it).
-const char* law_of_key(std::string_view section, std::string_view leaf) {
-  if (section == "dem.contact") {
-    if (leaf == "emod" || leaf == "kratio") return "linear";
-    if (leaf == "shear_modulus" || leaf == "poisson") return "hertz_mindlin";
-    return "";
-  }
-  if (leaf == "emod" || leaf == "kratio" || leaf == "tensile_strength" || leaf == "radius_multiplier" ||
-      leaf == "moment_factor")
-    return "parallel";
-  if (leaf == "youngs_modulus" || leaf == "poisson_ratio" || leaf == "beta1" || leaf == "beta2" || leaf == "truncation")
-    return "rotational";
-  return "";
+// The registered law that declares `key` ("" when it is common to every law of its section).
+template <class List> std::string law_of_key(List list, const std::string& key) {
+  std::string owner;
+  for_each_law(list, [&]<class Law>(std::type_identity<Law>) {
+    ParamTable own;
+    Law::declare(own);
+    if (owner.empty() && own.find(key)) owner = Law::name;
+  });
+  return owner;
 }
 
 // A pair-table key of a law that is not the active one would be silently ignored: refused,
@@ -77,15 +60,15 @@ void check_law_keys(const Config& cfg) {
     for (auto it = values.lower_bound(p); it != values.end() && it->first.compare(0, p.size(), p) == 0; ++it) {
       const std::string& key = it->first;
       const std::string leaf = key.substr(key.rfind('.') + 1);
-      const char* law = law_of_key(section, leaf);
-      const bool unused = active == "none" || (*law != '\0' && active != law);
+      const std::string law = std::string(section) == "dem.contact" ? law_of_key(ContactLaws{}, key) : law_of_key(BondLaws{}, key);
+      const bool unused = active == NoBond::name || (!law.empty() && active != law);
       if (!unused) continue;
       const ParamSpec* spec = cfg.table().find(key);
       if (spec && spec->default_value && *spec->default_value == it->second.first) continue;
-      if (active == "none")
+      if (active == NoBond::name)
         cfg.fail(key, fmt::format("dem.bond_law = \"none\" installs no bonds, so this bond key would be ignored; remove "
-                                  "the [{}] table or choose a bond law (dem.bond_law = \"parallel\" or \"rotational\")",
-                                  key.substr(0, key.rfind('.'))));
+                                  "the [{}] table or choose a bond law (dem.bond_law, registered: {})",
+                                  key.substr(0, key.rfind('.')), law_names(BondLaws{})));
       cfg.fail(key, fmt::format("'{}' belongs to the {} law, but {} = \"{}\", which does not read it (it would be "
                                 "ignored); remove it, or set {} = \"{}\"",
                                 leaf, law, law_key, active, law_key, law));
@@ -111,16 +94,17 @@ Materials build_materials(const Config& cfg) {
       cfg.fail("dem.group." + g + ".density", "group names may not contain '-' (it separates the two groups of a pair)");
     m.density.push_back(cfg.real("dem.group." + g + ".density"));
   }
-  m.contact_law = cfg.string("dem.contact_law") == "linear" ? ContactLaw::Linear : ContactLaw::HertzMindlin;
-  const std::string bl = cfg.string("dem.bond_law");
-  m.bond_law = bl == "parallel" ? BondLaw::Parallel : bl == "rotational" ? BondLaw::Rotational : BondLaw::None;
+  m.contact_law = law_index_of(ContactLaws{}, cfg.string("dem.contact_law"));
+  m.bond_law = law_index_of(BondLaws{}, cfg.string("dem.bond_law"));
+  if (m.contact_law < 0)
+    cfg.fail("dem.contact_law", fmt::format("unknown contact law; registered: {}", law_names(ContactLaws{})));
+  if (m.bond_law < 0) cfg.fail("dem.bond_law", fmt::format("unknown bond law; registered: {}", law_names(BondLaws{})));
   m.normal_damping_ratio = cfg.real("dem.normal_damping_ratio");
   const int ng = m.groups();
   const int dim = static_cast<int>(cfg.integer("dem.dim"));
-  m.linear.resize(ng * ng);
-  m.hertz.resize(ng * ng);
-  m.parallel.resize(ng * ng);
-  m.rotational.resize(ng * ng);
+  // Only the active laws' tables are filled.
+  m.with_contact_law([&]<class Law>(std::type_identity<Law>) { m.contact_params<Law>().resize(ng * ng); });
+  m.with_bond_law([&]<class Law>(std::type_identity<Law>) { m.bond_params<Law>().resize(ng * ng); });
   // Pair tables must name declared groups, each pair once (a-b or b-a: both name the same pair).
   std::vector<std::string> contact_table(ng * ng), bond_table(ng * ng);
   for (const char* section : {"dem.contact", "dem.bond"}) {
@@ -155,37 +139,20 @@ Materials build_materials(const Config& cfg) {
         throw InputError(fmt::format("{}: contact properties of the group pair {}-{} are missing: add a table "
                                      "[dem.contact.{}-{}] (keys emod, kratio, friction, ...)",
                                      cfg.scenario_name(), ga, gb, ga, gb));
-      LinearContact::Params lp{cfg.real(ct + ".emod"), cfg.real(ct + ".kratio"), cfg.real(ct + ".friction")};
-      HertzMindlinContact::Params hp{cfg.real(ct + ".shear_modulus"), cfg.real(ct + ".poisson"), cfg.real(ct + ".friction")};
-      m.linear[m.pair(a, b)] = m.linear[m.pair(b, a)] = lp;
-      m.hertz[m.pair(a, b)] = m.hertz[m.pair(b, a)] = hp;
-      if (m.bond_law == BondLaw::None) continue;
+      m.with_contact_law([&]<class Law>(std::type_identity<Law>) {
+        auto& table = m.contact_params<Law>();
+        table[m.pair(a, b)] = table[m.pair(b, a)] = Law::read(cfg, ct);
+      });
+      if (!m.has_bonds()) continue;
       const std::string& bt = bond_table[m.pair(a, b)];
       if (bt.empty())
         throw InputError(fmt::format("{}: bond properties of the group pair {}-{} are missing: add a table "
                                      "[dem.bond.{}-{}] (or set dem.bond_law = \"none\")",
                                      cfg.scenario_name(), ga, gb, ga, gb));
-      ParallelBond::Material pb;
-      pb.emod = cfg.real(bt + ".emod");
-      pb.kratio = cfg.real(bt + ".kratio");
-      pb.ten = cfg.real(bt + ".tensile_strength");
-      pb.coh = cfg.real(bt + ".cohesion");
-      pb.fa_deg = cfg.real(bt + ".friction_angle");
-      pb.lambda = cfg.real(bt + ".radius_multiplier");
-      pb.beta = cfg.real(bt + ".moment_factor");
-      m.parallel[m.pair(a, b)] = m.parallel[m.pair(b, a)] = pb;
-      RotationalBond::Material rb;
-      rb.youngs_modulus = cfg.real(bt + ".youngs_modulus");
-      rb.poisson_ratio = cfg.real(bt + ".poisson_ratio");
-      rb.cohesion = cfg.real(bt + ".cohesion");
-      rb.friction_angle_deg = cfg.real(bt + ".friction_angle");
-      rb.beta1 = cfg.real(bt + ".beta1");
-      rb.beta2 = cfg.real(bt + ".beta2");
-      rb.truncation = cfg.real(bt + ".truncation");
-      rb.dim = dim;
-      if (m.bond_law == BondLaw::Rotational && rb.friction_angle_deg <= 0)
-        cfg.fail(bt + ".friction_angle", "the rotational bond needs a friction angle > 0 (its tensile strength is c/tan(phi))");
-      m.rotational[m.pair(a, b)] = m.rotational[m.pair(b, a)] = rb;
+      m.with_bond_law([&]<class Law>(std::type_identity<Law>) {
+        auto& table = m.bond_params<Law>();
+        table[m.pair(a, b)] = table[m.pair(b, a)] = Law::read(cfg, bt, dim);
+      });
     }
   }
   return m;

@@ -32,17 +32,15 @@ std::size_t DemSystem::install_bonds(Real max_gap) {
 }
 
 void DemSystem::add_bond(Index a, Index b) {
-  if (materials.bond_law == BondLaw::None) throw Error("internal: add_bond() with dem.bond_law = none");
+  if (!materials.has_bonds()) throw Error("internal: add_bond() with dem.bond_law = none");
   if (a > b) std::swap(a, b);
   const int pt = materials.pair(particles.group[a], particles.group[b]);
   bonds.add(a, b, pt);
-  if (materials.bond_law == BondLaw::Parallel) {
-    bonds.parallel.push_back(ParallelBond::install());
-  } else {
+  materials.with_bond_law([&]<class Law>(std::type_identity<Law>) {
     const BondEnds e{particles.pos[a], particles.pos[b], particles.orient[a], particles.orient[b], particles.radius[a],
                      particles.radius[b]};
-    bonds.rotational.push_back(RotationalBond::install(materials.rotational[pt], e));
-  }
+    bonds.state<Law>().push_back(Law::install(materials.bond_params<Law>()[pt], e));
+  });
 }
 
 Boundary& DemSystem::add_boundary(std::unique_ptr<Boundary> b) {
@@ -56,7 +54,9 @@ void DemSystem::initialise() {
     a->assign(particles.size(), Vec3::Zero());
   wall_contacts_.resize(walls.size());
   build_bond_adjacency();
-  pbond_coeffs_.reserve(materials.parallel.size());
+  materials.with_bond_law([&]<class Law>(std::type_identity<Law>) {
+    std::get<law_index<Law>(BondLaws{})>(bond_prepared_).reserve(materials.bond_params<Law>().size());
+  });
   // Every crack is a broken bond: with this reserve, logging never allocates in the time loop.
   cracks.events.reserve(cracks.events.size() + bonds.size());
   rebuild_neighbors();
@@ -153,9 +153,7 @@ void DemSystem::contact_forces(const std::vector<typename Law::Params>& params) 
     Real fn;
     Vec3 f = Law::force(prm, g, cstate_[p], dt, dim, fn);
     if (zeta > 0) {  // viscous normal dashpot, fraction zeta of critical damping
-      Real kn;
-      if constexpr (std::is_same_v<Law, LinearContact>) kn = Law::normal_stiffness(prm, g.rA, g.rB, dim);
-      else kn = Law::normal_stiffness(prm, g.rA, g.rB, -g.gap);
+      const Real kn = Law::normal_stiffness_at(prm, g.rA, g.rB, -g.gap, dim);
       const Real meff = particles.mass[a] * particles.mass[b] / (particles.mass[a] + particles.mass[b]);
       f -= 2 * zeta * std::sqrt(meff * kn) * (g.d_delta_n / dt) * g.n;
     }
@@ -166,13 +164,11 @@ void DemSystem::contact_forces(const std::vector<typename Law::Params>& params) 
   }
 }
 
-template <class Law, class Mat>
-void DemSystem::bond_forces(const std::vector<Mat>& mats, std::vector<typename Law::State>& st) {
+template <class Law>
+void DemSystem::bond_forces(const std::vector<typename Law::Prepared>& mats, std::vector<typename Law::State>& st) {
   const std::size_t nb = bonds.size();
   const Real dt = settings.dt;
   const int dim = settings.dim;
-  const auto& x = particles.pos;
-  const auto& r = particles.radius;
   const auto& bond_i = bonds.i;
   const auto& bond_j = bonds.j;
   const auto& bond_pair = bonds.pair;
@@ -189,16 +185,7 @@ void DemSystem::bond_forces(const std::vector<Mat>& mats, std::vector<typename L
     }
     const Index i = bond_i[b], j = bond_j[b];
     BondLoad load;
-    BondFailure fail;
-    if constexpr (std::is_same_v<Law, ParallelBond>) {
-      ContactGeom g;
-      sphere_sphere(g, x[i], r[i], x[j], r[j]);
-      contact_kinematics(g, x[i], particles.vel[i], particles.omega[i], x[j], particles.vel[j], particles.omega[j], dt);
-      fail = Law::compute(mats[bond_pair[b]], st[b], g, dt, dim, load);
-    } else {
-      const BondEnds e{x[i], x[j], particles.orient[i], particles.orient[j], r[i], r[j]};
-      fail = Law::compute(mats[bond_pair[b]], st[b], e, load);
-    }
+    const BondFailure fail = Law::compute_bond(mats[bond_pair[b]], st[b], particles, i, j, dt, dim, load);
     bond_fail_flag_[b] = static_cast<std::uint8_t>(fail);
     if (fail != BondFailure::None) {
       out = PairLoad{};  // a bond that fails carries nothing from this step on
@@ -227,9 +214,9 @@ void DemSystem::record_bond_failures() {
     const Vec3 n = dist > 0 ? Vec3(d / dist) : Vec3::UnitX();
     const Real gap = dist - particles.radius[i] - particles.radius[j];
     Real size = 0;
-    if (materials.bond_law == BondLaw::Parallel)
-      size = ParallelBond::section(materials.parallel[bond_pair[b]], particles.radius[i], particles.radius[j], settings.dim).R;
-    else size = 0.5 * (particles.radius[i] + particles.radius[j]);
+    materials.with_bond_law([&]<class Law>(std::type_identity<Law>) {
+      size = Law::crack_size(materials.bond_params<Law>()[bond_pair[b]], particles.radius[i], particles.radius[j], settings.dim);
+    });
     cracks.add(CrackEvent{time, particles.pos[i] + (particles.radius[i] + 0.5 * gap) * n, n, size, bond_broken[b],
                           particles.group[i], particles.group[j], particles.id[i], particles.id[j]});
   }
@@ -262,8 +249,7 @@ void DemSystem::wall_forces(const std::vector<typename Law::Params>& params) {
       const Vec3 f = Law::force(prm, g, wc.state[k], dt, dim, fn);  // force on the wall
       out.f = f;
       out.mA = -(g.rA + 0.5 * g.gap) * g.n.cross(f);  // moment on the particle
-      if constexpr (std::is_same_v<Law, LinearContact>) out.mB.x() = Law::normal_stiffness(prm, g.rA, 0, dim);
-      else out.mB.x() = Law::normal_stiffness(prm, g.rA, 0, -g.gap);
+      out.mB.x() = Law::normal_stiffness_at(prm, g.rA, 0, -g.gap, dim);
     }
     // Totals in candidate order (deterministic).
     wall.force.setZero();
@@ -409,19 +395,21 @@ void DemSystem::update_neighbors() {
 
 void DemSystem::compute_forces() {
   Lap lap;
-  if (materials.contact_law == ContactLaw::Linear) contact_forces<LinearContact>(materials.linear);
-  else contact_forces<HertzMindlinContact>(materials.hertz);
+  // The active laws are picked once per stage (laws.hpp); the loops are templated on them.
+  materials.with_contact_law([&]<class Law>(std::type_identity<Law>) { contact_forces<Law>(materials.contact_params<Law>()); });
   lap(stage_times.contacts);
-  if (materials.bond_law == BondLaw::Parallel) {
-    pbond_coeffs_.resize(materials.parallel.size());  // no allocation after the first step
-    for (std::size_t k = 0; k < materials.parallel.size(); ++k) pbond_coeffs_[k] = ParallelBond::coeffs(materials.parallel[k]);
-    bond_forces<ParallelBond>(pbond_coeffs_, bonds.parallel);
-  }
-  else if (materials.bond_law == BondLaw::Rotational) bond_forces<RotationalBond>(materials.rotational, bonds.rotational);
+  materials.with_bond_law([&]<class Law>(std::type_identity<Law>) {
+    if constexpr (Law::installs_bonds) {
+      const auto& mats = materials.bond_params<Law>();
+      auto& prep = std::get<law_index<Law>(BondLaws{})>(bond_prepared_);
+      prep.resize(mats.size());  // no allocation after the first step
+      for (std::size_t k = 0; k < mats.size(); ++k) prep[k] = Law::prepare(mats[k]);
+      bond_forces<Law>(prep, bonds.state<Law>());
+    }
+  });
   record_bond_failures();
   lap(stage_times.bonds);
-  if (materials.contact_law == ContactLaw::Linear) wall_forces<LinearContact>(materials.linear);
-  else wall_forces<HertzMindlinContact>(materials.hertz);
+  materials.with_contact_law([&]<class Law>(std::type_identity<Law>) { wall_forces<Law>(materials.contact_params<Law>()); });
   lap(stage_times.walls);
   if (!boundaries_.empty()) {
     for (auto& b : boundaries_) b->compute_forces(*this);

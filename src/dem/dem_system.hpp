@@ -106,7 +106,7 @@ class DemSystem {
 
  private:
   template <class Law> void contact_forces(const std::vector<typename Law::Params>& params);
-  template <class Law, class Mat> void bond_forces(const std::vector<Mat>& mats, std::vector<typename Law::State>& st);
+  template <class Law> void bond_forces(const std::vector<typename Law::Prepared>& mats, std::vector<typename Law::State>& st);
   template <class Law> void wall_forces(const std::vector<typename Law::Params>& params);
   void record_bond_failures();
   friend void reorder_particles(DemSystem& sys, const std::vector<Index>& order);
@@ -115,7 +115,7 @@ class DemSystem {
   BoundaryList boundaries_;
   std::vector<ContactState> cstate_;
   std::vector<PairLoad> pload_;
-  std::vector<ParallelBond::Coeffs> pbond_coeffs_;  // per group pair, refreshed each step
+  BondPrepared bond_prepared_;  // per bond law, its materials as the loop reads them, refreshed each step
   std::vector<WallContacts> wall_contacts_;
   std::vector<Index> old_i_, old_j_;
   std::vector<ContactState> old_state_;

@@ -49,33 +49,25 @@ Real strain_energy(const DemSystem& s) {
   const auto& materials = s.materials;
   const auto pi = s.neighbors().first(), pj = s.neighbors().second();
   const auto& cstate = s.contact_state();
+  const int dim = s.settings.dim;
   Real e = 0;
-  for (std::size_t p = 0; p < pi.size(); ++p) {
-    const Index a = pi[p], b = pj[p];
-    const Real gap = (x[b] - x[a]).norm() - r[a] - r[b];
-    if (gap >= 0) continue;
-    const int pt = materials.pair(s.particles.group[a], s.particles.group[b]);
-    if (materials.contact_law == ContactLaw::Linear) {
-      const Real kn = LinearContact::normal_stiffness(materials.linear[pt], r[a], r[b], s.settings.dim);
-      const Real ks = kn / materials.linear[pt].kratio;
-      e += 0.5 * kn * gap * gap + 0.5 * cstate[p].fs.squaredNorm() / ks;
-    } else {
-      Real es, gs;
-      HertzMindlinContact::moduli(materials.hertz[pt], false, es, gs);
-      const Real d = -gap;
-      e += 8.0 / 15.0 * es * std::sqrt(HertzMindlinContact::reduced_radius(r[a], r[b])) * std::pow(d, 2.5);
+  materials.with_contact_law([&]<class Law>(std::type_identity<Law>) {
+    const auto& prm = materials.contact_params<Law>();
+    for (std::size_t p = 0; p < pi.size(); ++p) {
+      const Index a = pi[p], b = pj[p];
+      const Real gap = (x[b] - x[a]).norm() - r[a] - r[b];
+      if (gap >= 0) continue;
+      const int pt = materials.pair(s.particles.group[a], s.particles.group[b]);
+      e += Law::strain_energy(prm[pt], r[a], r[b], -gap, cstate[p], dim);
     }
-  }
+  });
   const BondSet& bs = s.bonds;
-  if (materials.bond_law == BondLaw::Parallel) {
-    for (std::size_t b = 0; b < bs.size(); ++b) {
-      if (bs.broken[b]) continue;
-      const auto& st = bs.parallel[b];
-      const auto c = ParallelBond::section(materials.parallel[bs.pair[b]], r[bs.i[b]], r[bs.j[b]], s.settings.dim);
-      e += 0.5 * st.Fn * st.Fn / (c.kn * c.A) + 0.5 * st.Fs.squaredNorm() / (c.ks * c.A) +
-           0.5 * st.Mb.squaredNorm() / (c.kn * c.I) + (c.J > 0 ? 0.5 * st.Mt * st.Mt / (c.ks * c.J) : 0.0);
-    }
-  }
+  materials.with_bond_law([&]<class Law>(std::type_identity<Law>) {
+    const auto& mats = materials.bond_params<Law>();
+    const auto& st = bs.state<Law>();
+    for (std::size_t b = 0; b < bs.size(); ++b)
+      if (!bs.broken[b]) e += Law::energy(mats[bs.pair[b]], st[b], r[bs.i[b]], r[bs.j[b]], dim);
+  });
   return e;
 }
 
@@ -99,9 +91,11 @@ Real max_unbalanced_force_ratio(const DemSystem& s, std::size_t first) {
 }
 
 Real pair_stiffness(const DemSystem& s, int pt, Real rA, Real rB, Real overlap) {
-  const auto& m = s.materials;
-  if (m.contact_law == ContactLaw::Linear) return LinearContact::normal_stiffness(m.linear[pt], rA, rB, s.settings.dim);
-  return HertzMindlinContact::normal_stiffness(m.hertz[pt], rA, rB, std::max(overlap, 0.01 * std::min(rA, rB > 0 ? rB : rA)));
+  Real k = 0;
+  s.materials.with_contact_law([&]<class Law>(std::type_identity<Law>) {
+    k = Law::time_step_stiffness(s.materials.contact_params<Law>()[pt], rA, rB, overlap, s.settings.dim);
+  });
+  return k;
 }
 
 Real critical_time_step(const DemSystem& s) {
@@ -123,22 +117,19 @@ Real critical_time_step(const DemSystem& s) {
     kr[a] += k * r[a] * r[a]; kr[b] += k * r[b] * r[b];  // shear springs' lever arms (ks <= kn)
   }
   const BondSet& bs = s.bonds;
-  for (std::size_t b = 0; b < bs.size(); ++b) {
-    if (bs.broken[b]) continue;
-    const Index i = bs.i[b], j = bs.j[b];
-    Real k = 0, krot = 0;
-    if (materials.bond_law == BondLaw::Parallel) {
-      const auto sec = ParallelBond::section(materials.parallel[bs.pair[b]], r[i], r[j], s.settings.dim);
-      k = ParallelBond::translational_stiffness(sec);
-      krot = ParallelBond::rotational_stiffness(sec);
-    } else if (materials.bond_law == BondLaw::Rotational) {
-      k = std::max(bs.rotational[b].kr, bs.rotational[b].ks);
-      krot = std::max(bs.rotational[b].kt, bs.rotational[b].kb);
+  materials.with_bond_law([&]<class Law>(std::type_identity<Law>) {
+    const auto& mats = materials.bond_params<Law>();
+    const auto& st = bs.state<Law>();
+    for (std::size_t b = 0; b < bs.size(); ++b) {
+      if (bs.broken[b]) continue;
+      const Index i = bs.i[b], j = bs.j[b];
+      Real k = 0, krot = 0;
+      Law::time_step_stiffness(mats[bs.pair[b]], st[b], r[i], r[j], s.settings.dim, k, krot);
+      kt[i] += k; kt[j] += k;
+      kr[i] += krot + k * r[i] * r[i];
+      kr[j] += krot + k * r[j] * r[j];
     }
-    kt[i] += k; kt[j] += k;
-    kr[i] += krot + k * r[i] * r[i];
-    kr[j] += krot + k * r[j] * r[j];
-  }
+  });
   for (std::size_t w = 0; w < s.walls.size(); ++w) {
     const auto& wc = s.wall_contacts()[w];
     for (std::size_t k = 0; k < wc.particle.size(); ++k) {

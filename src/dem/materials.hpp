@@ -1,13 +1,12 @@
 // Material groups (e.g. matrix, inclusion) and the contact and bond properties of every pair
 // of groups (matrix-matrix, inclusion-inclusion, matrix-inclusion), as seed 000 Table 7.
+// The laws themselves are registered in laws.hpp; Materials holds which one is active and a
+// per-pair table for each (only the active law's table is read by the engine).
 #pragma once
 #include <string>
 #include <vector>
 
-#include "dem/bond/parallel_bond.hpp"
-#include "dem/bond/rotational_bond.hpp"
-#include "dem/contact/hertz_mindlin.hpp"
-#include "dem/contact/linear_contact.hpp"
+#include "dem/laws.hpp"
 
 namespace ff::dem {
 
@@ -16,19 +15,14 @@ namespace ff::dem {
 // segmented rock image has. Scenarios declaring more are refused (dem::build_materials).
 inline constexpr int kMaxGroups = 64;
 
-enum class ContactLaw : std::uint8_t { Linear, HertzMindlin };
-enum class BondLaw : std::uint8_t { None, Parallel, Rotational };
-
 struct Materials {
   std::vector<std::string> group_names;
   std::vector<Real> density;  // [kg/m^3] per group
-  ContactLaw contact_law = ContactLaw::Linear;
-  BondLaw bond_law = BondLaw::Parallel;
-  // Per ordered pair index a*n+b (symmetric: both orders hold the same values).
-  std::vector<LinearContact::Params> linear;
-  std::vector<HertzMindlinContact::Params> hertz;
-  std::vector<ParallelBond::Material> parallel;
-  std::vector<RotationalBond::Material> rotational;
+  int contact_law = law_index<LinearContact>(ContactLaws{});  // index in ContactLaws
+  int bond_law = law_index<ParallelBond>(BondLaws{});         // index in BondLaws
+  // Per law, per ordered pair index a*n+b (symmetric: both orders hold the same values).
+  ContactTables contact;
+  BondTables bond;
   Real normal_damping_ratio = 0;  // viscous dashpot, fraction of critical [-]
 
   int groups() const { return static_cast<int>(group_names.size()); }
@@ -38,8 +32,35 @@ struct Materials {
       if (group_names[g] == name) return g;
     return -1;
   }
+
+  template <class Law> std::vector<typename Law::Params>& contact_params() {
+    return std::get<law_index<Law>(ContactLaws{})>(contact);
+  }
+  template <class Law> const std::vector<typename Law::Params>& contact_params() const {
+    return std::get<law_index<Law>(ContactLaws{})>(contact);
+  }
+  template <class Law> std::vector<typename Law::Material>& bond_params() {
+    return std::get<law_index<Law>(BondLaws{})>(bond);
+  }
+  template <class Law> const std::vector<typename Law::Material>& bond_params() const {
+    return std::get<law_index<Law>(BondLaws{})>(bond);
+  }
+  template <class Law> void set_contact_law() { contact_law = law_index<Law>(ContactLaws{}); }
+  template <class Law> void set_bond_law() { bond_law = law_index<Law>(BondLaws{}); }
+  template <class Law> bool contact_is() const { return contact_law == law_index<Law>(ContactLaws{}); }
+  template <class Law> bool bond_is() const { return bond_law == law_index<Law>(BondLaws{}); }
+  bool has_bonds() const { return !bond_is<NoBond>(); }
+  std::string_view contact_law_name() const { return law_name(ContactLaws{}, contact_law); }
+  std::string_view bond_law_name() const { return law_name(BondLaws{}, bond_law); }
+
+  // Calls f(std::type_identity<Law>{}) with the active contact (bond) law: once per stage.
+  template <class F> void with_contact_law(F&& f) const { visit_law(ContactLaws{}, contact_law, f); }
+  template <class F> void with_bond_law(F&& f) const { visit_law(BondLaws{}, bond_law, f); }
+
   Real friction(int pair_index) const {
-    return contact_law == ContactLaw::Linear ? linear[pair_index].fric : hertz[pair_index].fric;
+    Real mu = 0;
+    with_contact_law([&]<class Law>(std::type_identity<Law>) { mu = contact_params<Law>()[pair_index].fric; });
+    return mu;
   }
 };
 

@@ -135,7 +135,7 @@ SampleInfo place_packing(const PackingFile& p, const Config& cfg, DemSystem& sys
   const auto t0 = std::chrono::steady_clock::now();
   if (p.pos.empty()) throw InputError("packing: no particles");
   if (group < 0 || group >= sys.materials.groups()) throw Error("internal: place_packing() with a bad group");
-  if (!p.bonds.empty() && sys.materials.bond_law == BondLaw::None)
+  if (!p.bonds.empty() && !sys.materials.has_bonds())
     throw InputError("the packing file lists bonds but dem.bond_law = none: set a bond law or remove the 'bonds' section");
   const std::size_t n = p.pos.size();
   std::vector<std::size_t> order(n);  // order[new] = old
@@ -157,18 +157,13 @@ SampleInfo place_packing(const PackingFile& p, const Config& cfg, DemSystem& sys
     rsum += P.radius[k];
   }
   sys.walls.clear();
-  sys.bonds.i.clear();
-  sys.bonds.j.clear();
-  sys.bonds.pair.clear();
-  sys.bonds.broken.clear();
-  sys.bonds.parallel.clear();
-  sys.bonds.rotational.clear();
+  sys.bonds = BondSet{};
   sys.settings.skin = cfg.real("dem.skin_ratio") * rsum / static_cast<Real>(n);
   SampleInfo info;
   info.dim = dim;
   info.axis = dim == 3 ? 2 : 1;
   info.cylinder = false;
-  if (sys.materials.bond_law != BondLaw::None) {
+  if (sys.materials.has_bonds()) {
     if (p.has_bond_list) {
       std::vector<std::pair<Index, Index>> bonds;
       bonds.reserve(p.bonds.size());

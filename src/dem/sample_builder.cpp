@@ -251,11 +251,10 @@ Real shrink_factor_for_stress(const DemSystem& sys, Real goal, Real volume) {
       const Real overlap = s * (P.radius[a] + P.radius[b]) - d;
       if (overlap <= 0) continue;
       const int pt = sys.materials.pair(P.group[a], P.group[b]);
-      Real f;
-      if (sys.materials.contact_law == ContactLaw::Linear)
-        f = LinearContact::normal_stiffness(sys.materials.linear[pt], s * P.radius[a], s * P.radius[b], dim) * overlap;
-      else
-        f = 2.0 / 3.0 * HertzMindlinContact::normal_stiffness(sys.materials.hertz[pt], s * P.radius[a], s * P.radius[b], overlap) * overlap;
+      Real f = 0;
+      sys.materials.with_contact_law([&]<class Law>(std::type_identity<Law>) {
+        f = Law::normal_force(sys.materials.contact_params<Law>()[pt], s * P.radius[a], s * P.radius[b], overlap, dim);
+      });
       sum += f * d;
     }
     return sum / (dim * volume);
@@ -433,10 +432,11 @@ SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
 
   // Frictionless genesis: the contact friction is restored before bonding.
   const Materials saved = sys.materials;
-  for (auto& p : sys.materials.linear) p.fric = 0;
-  for (auto& p : sys.materials.hertz) p.fric = 0;
-  const BondLaw bond_law = sys.materials.bond_law;
-  sys.materials.bond_law = BondLaw::None;
+  for_each_law(ContactLaws{}, [&]<class Law>(std::type_identity<Law>) {
+    for (auto& p : sys.materials.contact_params<Law>()) p.fric = 0;
+  });
+  const int bond_law = sys.materials.bond_law;
+  sys.materials.set_bond_law<NoBond>();
   Real rmean = 0;
   for (Real r : P.radius) rmean += r;
   rmean /= static_cast<Real>(P.size());
@@ -483,7 +483,7 @@ SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
     }
     info.pore_particles = removed;
   }
-  if (bond_law != BondLaw::None) info.bonds = sys.install_bonds(cfg.real("sample.bond_gap"));
+  if (sys.materials.has_bonds()) info.bonds = sys.install_bonds(cfg.real("sample.bond_gap"));
   {  // Floaters: particles held by fewer than 3 (2D: 2) bonds (PFC counts contacts; we report them).
     std::vector<int> degree(P.size(), 0);
     for (std::size_t b = 0; b < sys.bonds.i.size(); ++b) {

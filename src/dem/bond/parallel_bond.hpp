@@ -11,15 +11,23 @@
 #pragma once
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <string_view>
 
 #include "dem/bond/bond_load.hpp"
 #include "dem/contact/contact_geometry.hpp"
+#include "dem/particle_store.hpp"
+#include "io/checkpoint.hpp"
+#include "io/params.hpp"
 
 namespace ff::dem {
 
+struct BondEnds;
+
 struct ParallelBond {
   static constexpr std::string_view name = "parallel";
+  static constexpr std::string_view checkpoint_key = "dem.pbond";  // its states in a checkpoint
+  static constexpr bool installs_bonds = true;
   struct Material {
     Real emod = 1e9;       // bond effective modulus [Pa]
     Real kratio = 1;       // kn/ks [-]
@@ -74,6 +82,59 @@ struct ParallelBond {
   static Section section(const Material& m, Real rA, Real rB, int dim) { return section(coeffs(m), rA, rB, dim); }
   static State install() { return State{}; }  // stress-free when installed
 
+  // ---- Registry interface (laws.hpp) ----
+  using Prepared = Coeffs;
+  // Its keys; dem.bond.*.cohesion and dem.bond.*.friction_angle are common to the bond laws.
+  static void declare(ParamTable& t) {
+    t.real("dem.bond.*.emod", 1e9, "Pa", "parallel bond effective modulus (kn_bar = E_bar/L)").positive();
+    t.real("dem.bond.*.kratio", 1.0, "-", "parallel bond normal-to-shear stiffness ratio").positive();
+    t.real("dem.bond.*.tensile_strength", 10e6, "Pa", "parallel bond tensile strength").positive();
+    t.real("dem.bond.*.radius_multiplier", 1.0, "-", "parallel bond radius multiplier lambda_bar").positive();
+    t.real("dem.bond.*.moment_factor", 1.0, "-", "parallel bond moment-contribution factor beta_bar").range(0, 1);
+  }
+  static Material read(const Config& cfg, const std::string& bt, int /*dim*/) {
+    Material pb;
+    pb.emod = cfg.real(bt + ".emod");
+    pb.kratio = cfg.real(bt + ".kratio");
+    pb.ten = cfg.real(bt + ".tensile_strength");
+    pb.coh = cfg.real(bt + ".cohesion");
+    pb.fa_deg = cfg.real(bt + ".friction_angle");
+    pb.lambda = cfg.real(bt + ".radius_multiplier");
+    pb.beta = cfg.real(bt + ".moment_factor");
+    return pb;
+  }
+  // Soft elastic bond of strength `strength` (particle membrane).
+  static Material elastic(Real E, Real /*nu*/, Real strength) {
+    Material pb;
+    pb.emod = E;
+    pb.kratio = 1;
+    pb.ten = pb.coh = strength;
+    pb.fa_deg = 0;
+    return pb;
+  }
+  static Prepared prepare(const Material& m) { return coeffs(m); }
+  static State install(const Material&, const BondEnds&) { return install(); }
+  static BondFailure compute_bond(const Prepared& c, State& st, const ParticleStore& P, Index i, Index j, Real dt,
+                                  int dim, BondLoad& load) {
+    ContactGeom g;
+    sphere_sphere(g, P.pos[i], P.radius[i], P.pos[j], P.radius[j]);
+    contact_kinematics(g, P.pos[i], P.vel[i], P.omega[i], P.pos[j], P.vel[j], P.omega[j], dt);
+    return compute(c, st, g, dt, dim, load);
+  }
+  static void time_step_stiffness(const Material& m, const State&, Real rA, Real rB, int dim, Real& k, Real& krot) {
+    const auto sec = section(m, rA, rB, dim);
+    k = translational_stiffness(sec);
+    krot = rotational_stiffness(sec);
+  }
+  static Real crack_size(const Material& m, Real rA, Real rB, int dim) { return section(m, rA, rB, dim).R; }
+  // Energy of the four springs: Fn^2/(2 kn A) + |Fs|^2/(2 ks A) + |Mb|^2/(2 kn I) + Mt^2/(2 ks J)
+  // (Potyondy & Cundall 2004, strain energy of the parallel bond; PFC's "bond strain energy").
+  static Real energy(const Material& m, const State& s, Real rA, Real rB, int dim) {
+    const auto c = section(m, rA, rB, dim);
+    return 0.5 * s.Fn * s.Fn / (c.kn * c.A) + 0.5 * s.Fs.squaredNorm() / (c.ks * c.A) +
+           0.5 * s.Mb.squaredNorm() / (c.kn * c.I) + (c.J > 0 ? 0.5 * s.Mt * s.Mt / (c.ks * c.J) : 0.0);
+  }
+
   // Translational and rotational stiffness the bond adds to each end (time-step estimate).
   static Real translational_stiffness(const Section& s) { return std::max(s.kn, s.ks) * s.A; }
   static Real rotational_stiffness(const Section& s) { return std::max(s.kn * s.I, s.ks * s.J); }
@@ -125,3 +186,7 @@ struct ParallelBond {
 };
 
 }  // namespace ff::dem
+
+namespace ff {
+template <> struct is_checkpoint_pod<dem::ParallelBond::State> : std::true_type {};
+}  // namespace ff

@@ -29,13 +29,18 @@
 #pragma once
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <string_view>
 
 #include "core/error.hpp"
 #include "core/types.hpp"
 #include "dem/bond/bond_load.hpp"
+#include "dem/particle_store.hpp"
+#include "io/checkpoint.hpp"
+#include "io/params.hpp"
 
 namespace ff::dem {
 
@@ -49,6 +54,8 @@ struct BondEnds {
 
 struct RotationalBond {
   static constexpr std::string_view name = "rotational";
+  static constexpr std::string_view checkpoint_key = "dem.rbond";  // its states in a checkpoint
+  static constexpr bool installs_bonds = true;
 
   struct Material {               // per group pair, from the scenario
     Real youngs_modulus;          // E [Pa]: kr = E A/L0, kb = E I/L0
@@ -79,6 +86,49 @@ struct RotationalBond {
   static Real energy(const State& s) {
     return 0.5 * (s.Fn * s.Fn / s.kr + s.Fs * s.Fs / s.ks + s.Mt * s.Mt / s.kt + s.Mb * s.Mb / s.kb);
   }
+
+  // ---- Registry interface (laws.hpp) ----
+  using Prepared = Material;
+  // Its keys; dem.bond.*.cohesion and dem.bond.*.friction_angle are common to the bond laws.
+  static void declare(ParamTable& t) {
+    t.real("dem.bond.*.youngs_modulus", 1e9, "Pa", "rotational bond Young's modulus E (beam of radius L0/2)").positive();
+    t.real("dem.bond.*.poisson_ratio", 0.25, "-", "rotational bond Poisson ratio").range(0, 0.5).below(0.5);
+    t.real("dem.bond.*.beta1", 1.0, "-", "rotational bond: weight of bending in the tensile criterion").non_negative();
+    t.real("dem.bond.*.beta2", 1.0, "-", "rotational bond: weight of twisting in the shear criterion").non_negative();
+    t.real("dem.bond.*.truncation", 1.0, "-", "rotational bond: tension cut-off t of the criterion").positive().at_most(1);
+  }
+  static Material read(const Config& cfg, const std::string& bt, int dim) {
+    Material rb;
+    rb.youngs_modulus = cfg.real(bt + ".youngs_modulus");
+    rb.poisson_ratio = cfg.real(bt + ".poisson_ratio");
+    rb.cohesion = cfg.real(bt + ".cohesion");
+    rb.friction_angle_deg = cfg.real(bt + ".friction_angle");
+    rb.beta1 = cfg.real(bt + ".beta1");
+    rb.beta2 = cfg.real(bt + ".beta2");
+    rb.truncation = cfg.real(bt + ".truncation");
+    rb.dim = dim;
+    if (rb.friction_angle_deg <= 0)
+      cfg.fail(bt + ".friction_angle", "the rotational bond needs a friction angle > 0 (its tensile strength is c/tan(phi))");
+    return rb;
+  }
+  // Elastic bond of cohesion `strength` (particle membrane), friction angle 45 deg.
+  static Material elastic(Real E, Real nu, Real strength) {
+    Material rb{E, nu, strength, 45.0};
+    rb.dim = 3;
+    return rb;
+  }
+  static Prepared prepare(const Material& m) { return m; }
+  static BondFailure compute_bond(const Prepared& m, State& st, const ParticleStore& P, Index i, Index j, Real /*dt*/,
+                                  int /*dim*/, BondLoad& load) {
+    const BondEnds e{P.pos[i], P.pos[j], P.orient[i], P.orient[j], P.radius[i], P.radius[j]};
+    return compute(m, st, e, load);
+  }
+  static void time_step_stiffness(const Material&, const State& s, Real, Real, int, Real& k, Real& krot) {
+    k = std::max(s.kr, s.ks);
+    krot = std::max(s.kt, s.kb);
+  }
+  static Real crack_size(const Material&, Real rA, Real rB, int) { return 0.5 * (rA + rB); }
+  static Real energy(const Material&, const State& s, Real, Real, int) { return energy(s); }
 
   // Bond vector r = qA^-1 (xB - xA), its length L and the relative rotation p = qA^-1 qB, all in
   // A's body frame. Deliberately not inlined: install() and compute() must run the same machine
@@ -221,3 +271,7 @@ inline BondFailure RotationalBond::compute(const Material& m, State& s, const Bo
 }
 
 }  // namespace ff::dem
+
+namespace ff {
+template <> struct is_checkpoint_pod<dem::RotationalBond::State> : std::true_type {};
+}  // namespace ff

@@ -9,9 +9,11 @@
 #pragma once
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <string_view>
 
 #include "dem/contact/contact_geometry.hpp"
+#include "io/params.hpp"
 
 namespace ff::dem {
 
@@ -23,6 +25,15 @@ struct HertzMindlinContact {
     Real fric = 0.5;           // [-]
   };
   using State = ContactState;
+  // Its keys (the friction, dem.contact.*.friction, is common to every contact law).
+  static void declare(ParamTable& t) {
+    t.real("dem.contact.*.shear_modulus", 1e9, "Pa", "Hertz-Mindlin particle shear modulus G").positive();
+    t.real("dem.contact.*.poisson", 0.25, "-", "Hertz-Mindlin particle Poisson ratio").range(0, 0.5).below(0.5);
+  }
+  static Params read(const Config& cfg, const std::string& table) {
+    return {cfg.real(table + ".shear_modulus"), cfg.real(table + ".poisson"), cfg.real(table + ".friction")};
+  }
+  static Params elastic(Real E, Real nu) { return {E / (2 * (1 + nu)), nu, 0.0}; }
   static void moduli(const Params& p, bool wall, Real& e_star, Real& g_star) {
     const Real E = 2 * p.shear_modulus * (1 + p.poisson);
     e_star = E / ((wall ? 1.0 : 2.0) * (1 - p.poisson * p.poisson));
@@ -34,6 +45,23 @@ struct HertzMindlinContact {
     Real es, gs;
     moduli(p, rB <= 0, es, gs);
     return 2 * es * std::sqrt(reduced_radius(rA, rB) * std::max(overlap, 0.0));
+  }
+  static Real normal_stiffness_at(const Params& p, Real rA, Real rB, Real overlap, int /*dim*/) {
+    return normal_stiffness(p, rA, rB, overlap);
+  }
+  // At least 1% of the smaller radius: a contact just closing must still bound the step.
+  static Real time_step_stiffness(const Params& p, Real rA, Real rB, Real overlap, int /*dim*/) {
+    return normal_stiffness(p, rA, rB, std::max(overlap, 0.01 * std::min(rA, rB > 0 ? rB : rA)));
+  }
+  // Fn = 4/3 E* sqrt(R*) delta^(3/2) = 2/3 (dFn/d delta) delta.
+  static Real normal_force(const Params& p, Real rA, Real rB, Real overlap, int /*dim*/) {
+    return 2.0 / 3.0 * normal_stiffness(p, rA, rB, overlap) * overlap;
+  }
+  // Normal: integral of Fn = 8/15 E* sqrt(R*) delta^(5/2) (Johnson 1985, ch. 4).
+  static Real strain_energy(const Params& p, Real rA, Real rB, Real overlap, const State& /*s*/, int /*dim*/) {
+    Real es, gs;
+    moduli(p, rB <= 0, es, gs);
+    return 8.0 / 15.0 * es * std::sqrt(reduced_radius(rA, rB)) * std::pow(overlap, 2.5);
   }
   static Vec3 force(const Params& p, const ContactGeom& g, State& s, Real dt, int /*dim*/, Real& fn) {
     if (g.gap >= 0) {

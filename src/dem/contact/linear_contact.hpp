@@ -4,9 +4,11 @@
 // Units: emod [Pa], kratio [-], fric [-]. No tension; dashpots off (as P&C 2004).
 #pragma once
 #include <algorithm>
+#include <string>
 #include <string_view>
 
 #include "dem/contact/contact_geometry.hpp"
+#include "io/params.hpp"
 
 namespace ff::dem {
 
@@ -18,6 +20,15 @@ struct LinearContact {
     Real fric = 0.5;  // Coulomb friction coefficient [-]
   };
   using State = ContactState;
+  // Its keys (the friction, dem.contact.*.friction, is common to every contact law).
+  static void declare(ParamTable& t) {
+    t.real("dem.contact.*.emod", 1e9, "Pa", "linear contact effective modulus E* (kn = A E*/L)").positive();
+    t.real("dem.contact.*.kratio", 1.0, "-", "linear contact normal-to-shear stiffness ratio kn/ks").positive();
+  }
+  static Params read(const Config& cfg, const std::string& table) {
+    return {cfg.real(table + ".emod"), cfg.real(table + ".kratio"), cfg.real(table + ".friction")};
+  }
+  static Params elastic(Real E, Real /*nu*/) { return {E, 1.0, 0.0}; }
   // kn = A E*/L, A = pi r^2 (3D) or 2 r t (2D, t = 1 m), r = min(RA, RB), L = RA + RB;
   // against a wall (rB = 0): r = L = RA.
   static Real normal_stiffness(const Params& p, Real rA, Real rB, int dim) {
@@ -25,6 +36,21 @@ struct LinearContact {
     const Real L = rB > 0 ? rA + rB : rA;
     const Real A = dim == 3 ? kPi * r * r : 2.0 * r;
     return A * p.emod / L;
+  }
+  static Real normal_stiffness_at(const Params& p, Real rA, Real rB, Real /*overlap*/, int dim) {
+    return normal_stiffness(p, rA, rB, dim);
+  }
+  static Real time_step_stiffness(const Params& p, Real rA, Real rB, Real /*overlap*/, int dim) {
+    return normal_stiffness(p, rA, rB, dim);
+  }
+  static Real normal_force(const Params& p, Real rA, Real rB, Real overlap, int dim) {
+    return normal_stiffness(p, rA, rB, dim) * overlap;
+  }
+  // 1/2 kn delta^2 + 1/2 |Fs|^2 / ks (PFC linear model, strain energy of the springs).
+  static Real strain_energy(const Params& p, Real rA, Real rB, Real overlap, const State& s, int dim) {
+    const Real kn = normal_stiffness(p, rA, rB, dim);
+    const Real ks = kn / p.kratio;
+    return 0.5 * kn * overlap * overlap + 0.5 * s.fs.squaredNorm() / ks;
   }
   // Force on B. `fn` returns the compressive normal force magnitude [N].
   static Vec3 force(const Params& p, const ContactGeom& g, State& s, Real dt, int dim, Real& fn) {

@@ -5,10 +5,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <tuple>
 
 #include "core/error.hpp"
-#include "dem/contact/hertz_mindlin.hpp"
-#include "dem/contact/linear_contact.hpp"
+#include "dem/laws.hpp"
 #include "dem/neighbor_list.hpp"
 #include "io/vtk.hpp"
 
@@ -360,8 +360,7 @@ void FlexibleMembrane::compute_forces(const MembraneParticles& p, std::span<cons
       out.f = f;
       out.m = -(g.rA + 0.5 * g.gap) * g.n.cross(f);  // moment on the particle
       out.xc = g.xc;
-      if constexpr (std::is_same_v<Law, LinearContact>) kn_[c] = Law::normal_stiffness(prm, r, 0, 3);
-      else kn_[c] = Law::normal_stiffness(prm, r, 0, -g.gap);
+      kn_[c] = Law::normal_stiffness_at(prm, r, 0, -g.gap, 3);
     }
   }
   // Element totals in candidate order (deterministic, serial: a few hundred elements).
@@ -377,11 +376,11 @@ void FlexibleMembrane::compute_forces(const MembraneParticles& p, std::span<cons
   }
 }
 
-template void FlexibleMembrane::compute_forces<LinearContact>(const MembraneParticles&,
-                                                              std::span<const LinearContact::Params>, int, Real);
-template void FlexibleMembrane::compute_forces<HertzMindlinContact>(const MembraneParticles&,
-                                                                    std::span<const HertzMindlinContact::Params>, int,
-                                                                    Real);
+// One instance per registered contact law (taking the addresses instantiates them).
+namespace {
+template <class... L> auto instantiate_compute_forces(LawList<L...>) { return std::tuple{&FlexibleMembrane::compute_forces<L>...}; }
+[[maybe_unused]] const auto kComputeForcesOfEveryLaw = instantiate_compute_forces(ContactLaws{});
+}  // namespace
 
 void FlexibleMembrane::add_loads_to(std::span<Vec3> force, std::span<Vec3> moment) const {
   for (std::size_t c = 0; c < cand_p_.size(); ++c) {

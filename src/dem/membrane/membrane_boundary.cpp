@@ -38,11 +38,9 @@ void MembraneBoundary::compute_forces(const DemSystem& sys) {
   const auto& P = sys.particles;
   const MembraneParticles p{P.pos, P.vel, P.omega, P.radius, P.group};
   const auto& mat = sys.materials;
-  if (mat.contact_law == ContactLaw::Linear)
-    m_.compute_forces<LinearContact>(p, std::span<const LinearContact::Params>(mat.linear), mat.groups(), sys.settings.dt);
-  else
-    m_.compute_forces<HertzMindlinContact>(p, std::span<const HertzMindlinContact::Params>(mat.hertz), mat.groups(),
-                                           sys.settings.dt);
+  mat.with_contact_law([&]<class Law>(std::type_identity<Law>) {
+    m_.compute_forces<Law>(p, std::span<const typename Law::Params>(mat.contact_params<Law>()), mat.groups(), sys.settings.dt);
+  });
 }
 
 void MembraneBoundary::after_integrate(const DemSystem& sys) {

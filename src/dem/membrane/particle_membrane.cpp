@@ -89,23 +89,17 @@ int add_particle_membrane_group(Materials& m, const ParticleMembraneMaterial& pm
                                  kParticleMembraneGroup));
   const int n = m.groups();
   const Real E = pm.emod, nu = kMembranePoisson;
-  grow_table(m.linear, n, LinearContact::Params{E, 1.0, 0.0}, [&](LinearContact::Params p) {
-    p.fric = boundary_friction(pm.friction, p.fric);
-    return p;
+  // Every registered law's table grows (a table not filled for this scenario stays empty).
+  for_each_law(ContactLaws{}, [&]<class Law>(std::type_identity<Law>) {
+    grow_table(m.contact_params<Law>(), n, Law::elastic(E, nu), [&](typename Law::Params p) {
+      p.fric = boundary_friction(pm.friction, p.fric);
+      return p;
+    });
   });
-  grow_table(m.hertz, n, HertzMindlinContact::Params{E / (2 * (1 + nu)), nu, 0.0}, [&](HertzMindlinContact::Params p) {
-    p.fric = boundary_friction(pm.friction, p.fric);
-    return p;
+  // Soft, unbreakable bonds; (sample, membrane) pairs are never bonded.
+  for_each_law(BondLaws{}, [&]<class Law>(std::type_identity<Law>) {
+    grow_table(m.bond_params<Law>(), n, Law::elastic(E, nu, kUnbreakable), [](const typename Law::Material& p) { return p; });
   });
-  ParallelBond::Material pb;  // soft, unbreakable; (sample, membrane) pairs are never bonded
-  pb.emod = E;
-  pb.kratio = 1;
-  pb.ten = pb.coh = kUnbreakable;
-  pb.fa_deg = 0;
-  grow_table(m.parallel, n, pb, [](const ParallelBond::Material& p) { return p; });
-  RotationalBond::Material rb{E, nu, kUnbreakable, 45.0};
-  rb.dim = 3;
-  grow_table(m.rotational, n, rb, [](const RotationalBond::Material& p) { return p; });
   m.group_names.emplace_back(kParticleMembraneGroup);
   m.density.push_back(pm.density);
   return n;
@@ -137,7 +131,7 @@ InwardLoads& attach_particle_membrane_loads(DemSystem& sys, const ParticleMembra
 ParticleMembraneLayout add_particle_membrane(DemSystem& sys, const ParticleMembraneSpec& spec,
                                              const ParticleMembraneMaterial& pm) {
   if (sys.settings.dim != 3) throw InputError("particle membrane: 3D samples only (dem.dim = 3)");
-  if (pm.bonded && sys.materials.bond_law == BondLaw::None)
+  if (pm.bonded && !sys.materials.has_bonds())
     throw InputError("particle membrane: its particles are bonded, so it needs dem.bond_law = \"parallel\" or \"rotational\"");
   ParticleMembraneLayout l = particle_membrane_layout(spec);
   const int n_old = sys.materials.groups();
@@ -186,16 +180,12 @@ Real stabilise_particle_membrane(DemSystem& sys, ParticleMembraneLayout& l, Real
   // Four bonds and four soft contacts with its ring and row neighbours.
   const int pm = mat.pair(l.group, l.group);
   Real kb = 0, kb_rot = 0;
-  if (mat.bond_law == BondLaw::Parallel) {
-    const auto sec = ParallelBond::section(mat.parallel[pm], r, r, 3);
-    kb = ParallelBond::translational_stiffness(sec);
-    kb_rot = ParallelBond::rotational_stiffness(sec);
-  } else if (mat.bond_law == BondLaw::Rotational) {
-    const auto st = RotationalBond::install(mat.rotational[pm], BondEnds{Vec3::Zero(), Vec3(2 * r, 0, 0), Quat::Identity(),
-                                                                         Quat::Identity(), r, r});
-    kb = std::max(st.kr, st.ks);
-    kb_rot = std::max(st.kt, st.kb);
-  }
+  mat.with_bond_law([&]<class Law>(std::type_identity<Law>) {
+    const auto& bm = mat.bond_params<Law>();
+    if (bm.empty()) return;
+    const auto st = Law::install(bm[pm], BondEnds{Vec3::Zero(), Vec3(2 * r, 0, 0), Quat::Identity(), Quat::Identity(), r, r});
+    Law::time_step_stiffness(bm[pm], st, r, r, 3, kb, kb_rot);
+  });
   const Real kmm = pair_stiffness(sys, pm, r, r, 0.01 * r);
   const Real kt = assumed_contacts * kc + 4 * (kb + kmm);
   const Real kr = assumed_contacts * kc * r * r + 4 * (kb_rot + (kb + kmm) * r * r);

@@ -6,3 +6,4 @@ fracflow_test(test_neighbor_list SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_neighbor
 fracflow_test(test_dem_system SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_dem_system.cpp LIBS fracflow_dem)
 fracflow_test(test_dem_no_allocation SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_no_allocation.cpp LIBS fracflow_dem)
 fracflow_test(test_dem_stages SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_dem_stages.cpp LIBS fracflow_dem)
+fracflow_test(test_law_registry SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_law_registry.cpp LIBS fracflow_dem fracflow_io)

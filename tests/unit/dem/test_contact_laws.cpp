@@ -53,9 +53,9 @@ DemSystem two_bodies(int dim, Real rA, Real rB, const Vec3& xA, const Vec3& xB, 
   s.settings.skin = 0.5 * std::min(rA, rB);
   s.materials.group_names = {"matrix"};
   s.materials.density = {2500};
-  s.materials.contact_law = ContactLaw::Linear;
-  s.materials.bond_law = BondLaw::None;
-  s.materials.linear = {p};
+  s.materials.set_contact_law<LinearContact>();
+  s.materials.set_bond_law<NoBond>();
+  s.materials.contact_params<LinearContact>() = {p};
   s.particles.resize(2);
   s.particles.radius = {rA, rB};
   s.particles.pos = {xA, xB};

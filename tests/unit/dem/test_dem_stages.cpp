@@ -30,13 +30,13 @@ DemSystem one_group_system() {
   lc.emod = 1e9;
   lc.kratio = 1.5;
   lc.fric = 0.5;
-  s.materials.linear = {lc};
+  s.materials.contact_params<LinearContact>() = {lc};
   ParallelBond::Material pb;
   pb.emod = 2e9;
   pb.kratio = 1.5;
   pb.ten = 3e6;
   pb.coh = 3e6;
-  s.materials.parallel = {pb};
+  s.materials.bond_params<ParallelBond>() = {pb};
   return s;
 }
 

@@ -37,19 +37,19 @@ DemSystem empty_system(int dim) {
   s.settings.skin = 0.2 * kRadius;
   s.materials.group_names = {"rock"};
   s.materials.density = {kDensity};
-  s.materials.contact_law = ContactLaw::Linear;
-  s.materials.bond_law = BondLaw::Parallel;
+  s.materials.set_contact_law<LinearContact>();
+  s.materials.set_bond_law<ParallelBond>();
   LinearContact::Params lc;
   lc.emod = 1e9;
   lc.kratio = 1.5;
   lc.fric = 0.5;
-  s.materials.linear = {lc};
+  s.materials.contact_params<LinearContact>() = {lc};
   ParallelBond::Material pb;
   pb.emod = 2e9;
   pb.kratio = 1.5;
   pb.ten = 1e300;
   pb.coh = 1e300;
-  s.materials.parallel = {pb};
+  s.materials.bond_params<ParallelBond>() = {pb};
   return s;
 }
 
@@ -228,7 +228,7 @@ TEST(DemMomentum, FreeClusterConservesLinearAndAngularMomentum) {
   Rng g(31);
   for (int dim : {3, 2}) {
     DemSystem s = bonded_lattice(dim, dim == 3 ? 5 : 10, -0.002, 0.002 * kRadius, g);
-    s.materials.linear[0].fric = 0.05;  // low friction: contacts may slide
+    s.materials.contact_params<LinearContact>()[0].fric = 0.05;  // low friction: contacts may slide
     s.settings.dt = 0.2 * critical_time_step(s);
     random_velocities(s, g, 0.2);
     const Vec3 P0 = linear_momentum(s.particles), L0 = angular_momentum(s.particles);
@@ -263,9 +263,9 @@ TEST(DemTimeStep, CriticalStepOfTwoBondedBodies) {
       add_particle(s, Vec3(rA + rB + gap, 0, 0), rB);
       ASSERT_EQ(s.install_bonds(2e-5), 1u);
       s.initialise();
-      const auto b = ParallelBond::section(s.materials.parallel[0], rA, rB, dim);
+      const auto b = ParallelBond::section(s.materials.bond_params<ParallelBond>()[0], rA, rB, dim);
       const Real k = std::max(b.kn, b.ks) * b.A, krot = std::max(b.kn * b.I, b.ks * b.J);
-      const Real kc = gap < 0 ? LinearContact::normal_stiffness(s.materials.linear[0], rA, rB, dim) : 0.0;
+      const Real kc = gap < 0 ? LinearContact::normal_stiffness(s.materials.contact_params<LinearContact>()[0], rA, rB, dim) : 0.0;
       Real want = 1e300;
       for (int i = 0; i < 2; ++i) {
         const Real r = s.particles.radius[i];
@@ -308,8 +308,8 @@ TEST(DemTimeStep, AxialBondOscillatorStableBelowTwoOverOmega) {
     add_particle(s, Vec3(2.02 * kRadius, 0, 0), kRadius);
     ASSERT_EQ(s.install_bonds(0.03 * kRadius), 1u);
     s.initialise();
-    const Real m = s.particles.mass[0], k = ParallelBond::section(s.materials.parallel[0], kRadius, kRadius, 3).kn *
-                                         ParallelBond::section(s.materials.parallel[0], kRadius, kRadius, 3).A;
+    const Real m = s.particles.mass[0], k = ParallelBond::section(s.materials.bond_params<ParallelBond>()[0], kRadius, kRadius, 3).kn *
+                                         ParallelBond::section(s.materials.bond_params<ParallelBond>()[0], kRadius, kRadius, 3).A;
     const Real dt_lim = std::sqrt(2 * m / k);
     EXPECT_LT(critical_time_step(s), dt_lim);
     s.settings.dt = f * dt_lim;
@@ -346,7 +346,7 @@ TEST(DemWalls, SphereOnPlaneWall) {
   for (int dim : {3, 2}) {
     const Real delta = 1e-6;
     DemSystem s = empty_system(dim);
-    s.materials.bond_law = BondLaw::None;
+    s.materials.set_bond_law<NoBond>();
     Wall w;
     w.kind = Wall::Kind::Plane;
     w.point = Vec3(0, 0.01, 0);
@@ -358,7 +358,7 @@ TEST(DemWalls, SphereOnPlaneWall) {
     s.particles.vel[0] = Vec3(2.0, 0, 0);  // sliding: ks v dt = 4.4 mu Fn
     s.initialise();
     s.step();
-    const Real kn = LinearContact::normal_stiffness(s.materials.linear[0], kRadius, 0, dim);
+    const Real kn = LinearContact::normal_stiffness(s.materials.contact_params<LinearContact>()[0], kRadius, 0, dim);
     EXPECT_NEAR(kn, dim == 3 ? kPi * kRadius * 1e9 : 2e9, 1e-14 * kn);
     const Vec3 f = s.particles.force[0];
     EXPECT_NEAR(f.y(), kn * delta, 1e-9 * kn * delta) << "dim " << dim;
@@ -377,8 +377,8 @@ TEST(DemWalls, GroupFrictionWallTakesTheParticlesContactFriction) {
   // Tolerance 1e-9 relative.
   const Real delta = 1e-6;
   DemSystem s = empty_system(3);
-  s.materials.bond_law = BondLaw::None;
-  s.materials.linear[0].fric = 0.25;
+  s.materials.set_bond_law<NoBond>();
+  s.materials.contact_params<LinearContact>()[0].fric = 0.25;
   Wall w;
   w.kind = Wall::Kind::Plane;
   w.point = Vec3(0, 0.01, 0);
@@ -390,7 +390,7 @@ TEST(DemWalls, GroupFrictionWallTakesTheParticlesContactFriction) {
   s.particles.vel[0] = Vec3(2.0, 0, 0);
   s.initialise();
   s.step();
-  const Real kn = LinearContact::normal_stiffness(s.materials.linear[0], kRadius, 0, 3);
+  const Real kn = LinearContact::normal_stiffness(s.materials.contact_params<LinearContact>()[0], kRadius, 0, 3);
   EXPECT_NEAR(s.particles.force[0].y(), kn * delta, 1e-9 * kn * delta);
   EXPECT_NEAR(s.particles.force[0].x(), -0.25 * kn * delta, 1e-9 * kn * delta);
 }
@@ -401,7 +401,7 @@ TEST(DemWalls, SphereInsideCylinderWall) {
   // wall records minus that force. Tolerance 1e-9 relative.
   const Real Rc = 0.01, delta = 1e-6, phi = 0.7;
   DemSystem s = empty_system(3);
-  s.materials.bond_law = BondLaw::None;
+  s.materials.set_bond_law<NoBond>();
   Wall w;
   w.kind = Wall::Kind::CylinderInside;
   w.point = Vec3(0, 0, -0.05);
@@ -412,7 +412,7 @@ TEST(DemWalls, SphereInsideCylinderWall) {
   add_particle(s, (Rc - kRadius + delta) * er + Vec3(0, 0, 0.003), kRadius);
   s.initialise();
   s.step();
-  const Real kn = LinearContact::normal_stiffness(s.materials.linear[0], kRadius, 0, 3);
+  const Real kn = LinearContact::normal_stiffness(s.materials.contact_params<LinearContact>()[0], kRadius, 0, 3);
   const Vec3 want = -kn * delta * er;
   EXPECT_LT((s.particles.force[0] - want).norm(), 1e-9 * kn * delta);
   EXPECT_EQ(s.walls[0].force, Vec3(-s.particles.force[0]));
@@ -437,8 +437,8 @@ TEST(DemThreads, BitIdenticalOnOneAndThreeThreads) {
     Rng g(41);
     DemSystem s = bonded_lattice(3, 6, -0.003, 0.003 * kRadius, g);
     s.settings.parallel_min = 0;  // every loop parallel, however small the system
-    s.materials.parallel[0].ten = 2e6;
-    s.materials.parallel[0].coh = 2e6;
+    s.materials.bond_params<ParallelBond>()[0].ten = 2e6;
+    s.materials.bond_params<ParallelBond>()[0].coh = 2e6;
     s.settings.local_damping = 0.7;
     s.settings.gravity = Vec3(0, 0, -9.81);
     Wall w;

@@ -211,8 +211,8 @@ TEST(NeighborList, DemSystemRebuildKeepsContactShearForce) {
   s.settings.skin = 0.2e-3;
   s.materials.group_names = {"matrix"};
   s.materials.density = {2500};
-  s.materials.bond_law = BondLaw::None;
-  s.materials.linear.resize(1);
+  s.materials.set_bond_law<NoBond>();
+  s.materials.contact_params<LinearContact>().resize(1);
   s.particles.resize(3);
   s.particles.radius = {1e-3, 1e-3, 1e-3};
   s.particles.pos = {Vec3(0.02, 0, 0), Vec3(0, 0, 0), Vec3(1.999e-3, 0, 0)};  // pair (1, 2) touches

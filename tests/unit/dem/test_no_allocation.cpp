@@ -58,15 +58,15 @@ DemSystem compressed_block() {
   lc.emod = 1e9;
   lc.kratio = 2;
   lc.fric = 0.5;
-  s.materials.linear = {lc};
-  s.materials.hertz = {HertzMindlinContact::Params{}};
+  s.materials.contact_params<LinearContact>() = {lc};
+  s.materials.contact_params<HertzMindlinContact>() = {HertzMindlinContact::Params{}};
   ParallelBond::Material pb;
   pb.emod = 1e9;
   pb.kratio = 2;
   pb.ten = 2e6;
   pb.coh = 2e6;
-  s.materials.parallel = {pb};
-  s.materials.rotational.resize(1);
+  s.materials.bond_params<ParallelBond>() = {pb};
+  s.materials.bond_params<RotationalBond>().resize(1);
   Rng g(3);
   for (int k = 0; k < h; ++k)
     for (int j = 0; j < n; ++j)

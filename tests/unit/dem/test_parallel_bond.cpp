@@ -239,14 +239,14 @@ DemSystem pair_system(int dim, const PB::Material& pb, Real r, Real x1) {
   s.settings.skin = 0.5 * r;
   s.materials.group_names = {"matrix", "inclusion"};
   s.materials.density = {2500, 2700};
-  s.materials.contact_law = ContactLaw::Linear;
-  s.materials.bond_law = BondLaw::Parallel;
+  s.materials.set_contact_law<LinearContact>();
+  s.materials.set_bond_law<ParallelBond>();
   LinearContact::Params lc;
   lc.emod = 1e9;
   lc.kratio = 1;
   lc.fric = 0.5;
-  s.materials.linear.assign(4, lc);
-  s.materials.parallel.assign(4, pb);
+  s.materials.contact_params<LinearContact>().assign(4, lc);
+  s.materials.bond_params<ParallelBond>().assign(4, pb);
   s.particles.resize(2);
   s.particles.radius = {r, r};
   s.particles.pos = {Vec3::Zero(), Vec3(x1, 0, 0)};
@@ -325,7 +325,7 @@ TEST(ParallelBondInSystem, BreaksInPureTensionAtTensileStrength) {
     EXPECT_GE(sigma_break, pb.ten * (1 - 1e-12));
     EXPECT_LT(sigma_break - st0.kn * du, pb.ten);
     EXPECT_NEAR(sigma_break, pb.ten, 0.01 * pb.ten);
-    EXPECT_NEAR(s.bonds.parallel[0].Fn, sigma_break * st0.A, 1e-9 * sigma_break * st0.A);
+    EXPECT_NEAR(s.bonds.state<ParallelBond>()[0].Fn, sigma_break * st0.A, 1e-9 * sigma_break * st0.A);
     EXPECT_EQ(s.bonds.broken[0], 1);
     EXPECT_EQ(intact_bonds(s), 0u);
     ASSERT_EQ(s.cracks.events.size(), 1u);
@@ -355,7 +355,7 @@ TEST(ParallelBondInSystem, BreaksInPureTensionAtTensileStrength) {
       s.step();
     }
     ASSERT_GT(overlap, 0);
-    const Real kn_c = LinearContact::normal_stiffness(s.materials.linear[1], r, r, dim);
+    const Real kn_c = LinearContact::normal_stiffness(s.materials.contact_params<LinearContact>()[1], r, r, dim);
     EXPECT_NEAR(s.particles.force[1].x(), kn_c * overlap, 1e-9 * kn_c * overlap);
     EXPECT_EQ(s.cracks.total(), 1);
   }
@@ -378,11 +378,11 @@ TEST(ParallelBondInSystem, BreaksInPureShearAtCohesion) {
     const long k = run_until_break(s, Vec3(0, du / s.settings.dt, 0), 2000);
     ASSERT_LE(k, 2000) << "dim " << dim << ": bond never broke";
     const Real tau_closed = st0.ks * du * static_cast<Real>(k);
-    EXPECT_NEAR(PB::stress(PB::coeffs(pb), st0, s.bonds.parallel[0]).tau, tau_closed, 1e-3 * tau_closed);
-    EXPECT_GE(PB::stress(PB::coeffs(pb), st0, s.bonds.parallel[0]).tau, pb.coh);
-    EXPECT_NEAR(PB::stress(PB::coeffs(pb), st0, s.bonds.parallel[0]).tau, pb.coh, 0.01 * pb.coh);
-    EXPECT_EQ(s.bonds.parallel[0].Mb.norm() + std::abs(s.bonds.parallel[0].Mt), 0.0);
-    EXPECT_LT(PB::stress(PB::coeffs(pb), st0, s.bonds.parallel[0]).sigma, 0.01 * pb.coh);  // the small geometric opening, far from ten
+    EXPECT_NEAR(PB::stress(PB::coeffs(pb), st0, s.bonds.state<ParallelBond>()[0]).tau, tau_closed, 1e-3 * tau_closed);
+    EXPECT_GE(PB::stress(PB::coeffs(pb), st0, s.bonds.state<ParallelBond>()[0]).tau, pb.coh);
+    EXPECT_NEAR(PB::stress(PB::coeffs(pb), st0, s.bonds.state<ParallelBond>()[0]).tau, pb.coh, 0.01 * pb.coh);
+    EXPECT_EQ(s.bonds.state<ParallelBond>()[0].Mb.norm() + std::abs(s.bonds.state<ParallelBond>()[0].Mt), 0.0);
+    EXPECT_LT(PB::stress(PB::coeffs(pb), st0, s.bonds.state<ParallelBond>()[0]).sigma, 0.01 * pb.coh);  // the small geometric opening, far from ten
     EXPECT_EQ(s.bonds.broken[0], 2);
     ASSERT_EQ(s.cracks.events.size(), 1u);
     EXPECT_EQ(s.cracks.events[0].mode, 2);
@@ -411,15 +411,15 @@ TEST(ParallelBondInSystem, ShearStrengthFollowsFrictionAngle) {
     s.particles.vel[1] = Vec3(sigma0 / st0.kn / (kn_steps * dt), 0, 0);
     s.run(kn_steps);
     ASSERT_EQ(s.bonds.broken[0], 0);
-    EXPECT_NEAR(s.bonds.parallel[0].Fn / st0.A, sigma0, 1e-9 * pb.ten);
+    EXPECT_NEAR(s.bonds.state<ParallelBond>()[0].Fn / st0.A, sigma0, 1e-9 * pb.ten);
     const Real tau_c = pb.coh - sigma0 * tanp;
     const Real du = 1e-3 * tau_c / st0.ks;
     const long k = run_until_break(s, Vec3(0, du / dt, 0), 3000);
     ASSERT_LE(k, 3000) << "sigma0 " << sigma0 << ": bond never broke";
     EXPECT_EQ(s.bonds.broken[0], 2) << "sigma0 " << sigma0;
-    EXPECT_NEAR(PB::stress(PB::coeffs(pb), st0, s.bonds.parallel[0]).tau, tau_c, 0.01 * tau_c) << "sigma0 " << sigma0;
-    const Real tau_c_now = pb.coh - s.bonds.parallel[0].Fn / st0.A * tanp;
-    EXPECT_GE(PB::stress(PB::coeffs(pb), st0, s.bonds.parallel[0]).tau, tau_c_now);
-    EXPECT_NEAR(PB::stress(PB::coeffs(pb), st0, s.bonds.parallel[0]).tau, tau_c_now, 0.002 * tau_c_now);
+    EXPECT_NEAR(PB::stress(PB::coeffs(pb), st0, s.bonds.state<ParallelBond>()[0]).tau, tau_c, 0.01 * tau_c) << "sigma0 " << sigma0;
+    const Real tau_c_now = pb.coh - s.bonds.state<ParallelBond>()[0].Fn / st0.A * tanp;
+    EXPECT_GE(PB::stress(PB::coeffs(pb), st0, s.bonds.state<ParallelBond>()[0]).tau, tau_c_now);
+    EXPECT_NEAR(PB::stress(PB::coeffs(pb), st0, s.bonds.state<ParallelBond>()[0]).tau, tau_c_now, 0.002 * tau_c_now);
   }
 }

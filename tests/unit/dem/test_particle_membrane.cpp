@@ -33,15 +33,15 @@ DemSystem two_group_system() {
   s.settings.local_damping = 0.7;
   s.materials.group_names = {"matrix", "vein"};
   s.materials.density = {1390, 1810};
-  s.materials.contact_law = ContactLaw::Linear;
-  s.materials.bond_law = BondLaw::Parallel;
-  s.materials.linear.resize(4);
-  s.materials.hertz.resize(4);
-  s.materials.parallel.resize(4);
-  s.materials.rotational.resize(4);
+  s.materials.set_contact_law<LinearContact>();
+  s.materials.set_bond_law<ParallelBond>();
+  s.materials.contact_params<LinearContact>().resize(4);
+  s.materials.contact_params<HertzMindlinContact>().resize(4);
+  s.materials.bond_params<ParallelBond>().resize(4);
+  s.materials.bond_params<RotationalBond>().resize(4);
   for (int k = 0; k < 4; ++k) {
-    s.materials.linear[k] = LinearContact::Params{2e9 + 1e8 * k, 1.5 + k, 0.4};
-    s.materials.parallel[k].emod = 3e9 + 1e8 * k;
+    s.materials.contact_params<LinearContact>()[k] = LinearContact::Params{2e9 + 1e8 * k, 1.5 + k, 0.4};
+    s.materials.bond_params<ParallelBond>()[k].emod = 3e9 + 1e8 * k;
   }
   return s;
 }
@@ -159,7 +159,7 @@ TEST(ParticleMembrane, AddedAsItsOwnBondedGroupWithInwardConstantForces) {
   s.settings.skin = 0.1e-3;
   ASSERT_EQ(s.install_bonds(0.01e-3), 2u);  // (0, 1), (1, 2): a matrix-vein pair each
   const std::vector<std::int32_t> old_pairs = s.bonds.pair;
-  const auto old_linear = s.materials.linear;
+  const auto old_linear = s.materials.contact_params<LinearContact>();
   s.initialise();
   const auto l = add_particle_membrane(s, spec, ParticleMembraneMaterial{1e7, 1000, 0.2});
   const int n = 3;
@@ -167,15 +167,15 @@ TEST(ParticleMembrane, AddedAsItsOwnBondedGroupWithInwardConstantForces) {
   EXPECT_EQ(s.materials.group_names[2], "membrane");
   EXPECT_EQ(l.group, 2);
   EXPECT_EQ(l.first, 4);
-  ASSERT_EQ(s.materials.linear.size(), 9u);
+  ASSERT_EQ(s.materials.contact_params<LinearContact>().size(), 9u);
   for (int a = 0; a < 2; ++a)
-    for (int b = 0; b < 2; ++b) EXPECT_EQ(s.materials.linear[a * n + b].emod, old_linear[a * 2 + b].emod);
-  EXPECT_EQ(s.materials.linear[0 * n + 2].emod, old_linear[0].emod);  // membrane-sample: the sample group's own
-  EXPECT_EQ(s.materials.linear[2 * n + 1].kratio, old_linear[3].kratio);
-  EXPECT_EQ(s.materials.linear[2 * n + 1].fric, 0.2);
-  EXPECT_EQ(s.materials.linear[2 * n + 2].emod, 1e7);
-  EXPECT_EQ(s.materials.parallel[2 * n + 2].emod, 1e7);
-  EXPECT_GE(s.materials.parallel[2 * n + 2].ten, 1e90);
+    for (int b = 0; b < 2; ++b) EXPECT_EQ(s.materials.contact_params<LinearContact>()[a * n + b].emod, old_linear[a * 2 + b].emod);
+  EXPECT_EQ(s.materials.contact_params<LinearContact>()[0 * n + 2].emod, old_linear[0].emod);  // membrane-sample: the sample group's own
+  EXPECT_EQ(s.materials.contact_params<LinearContact>()[2 * n + 1].kratio, old_linear[3].kratio);
+  EXPECT_EQ(s.materials.contact_params<LinearContact>()[2 * n + 1].fric, 0.2);
+  EXPECT_EQ(s.materials.contact_params<LinearContact>()[2 * n + 2].emod, 1e7);
+  EXPECT_EQ(s.materials.bond_params<ParallelBond>()[2 * n + 2].emod, 1e7);
+  EXPECT_GE(s.materials.bond_params<ParallelBond>()[2 * n + 2].ten, 1e90);
   for (std::size_t b = 0; b < old_pairs.size(); ++b) {
     const int a = old_pairs[b] / 2, c = old_pairs[b] % 2;
     EXPECT_EQ(s.bonds.pair[b], a * n + c);
@@ -224,21 +224,21 @@ TEST(ParticleMembrane, GroupFrictionKeepsEachSampleGroupsOwnFriction) {
   Materials m;
   m.group_names = {"matrix", "vein"};
   m.density = {1390, 1810};
-  m.linear.resize(4);
-  m.hertz.resize(4);
-  m.linear[0].fric = m.hertz[0].fric = 0.4;
-  m.linear[3].fric = m.hertz[3].fric = 0.3;
-  m.linear[1].fric = m.linear[2].fric = m.hertz[1].fric = m.hertz[2].fric = 0.35;
+  m.contact_params<LinearContact>().resize(4);
+  m.contact_params<HertzMindlinContact>().resize(4);
+  m.contact_params<LinearContact>()[0].fric = m.contact_params<HertzMindlinContact>()[0].fric = 0.4;
+  m.contact_params<LinearContact>()[3].fric = m.contact_params<HertzMindlinContact>()[3].fric = 0.3;
+  m.contact_params<LinearContact>()[1].fric = m.contact_params<LinearContact>()[2].fric = m.contact_params<HertzMindlinContact>()[1].fric = m.contact_params<HertzMindlinContact>()[2].fric = 0.35;
   ParticleMembraneMaterial pm;
   pm.friction = kGroupFriction;
   ASSERT_EQ(add_particle_membrane_group(m, pm), 2);
   for (int g = 0; g < 2; ++g) {
     const Real own = g == 0 ? 0.4 : 0.3;
-    EXPECT_EQ(m.linear[m.pair(g, 2)].fric, own);
-    EXPECT_EQ(m.linear[m.pair(2, g)].fric, own);
-    EXPECT_EQ(m.hertz[m.pair(g, 2)].fric, own);
+    EXPECT_EQ(m.contact_params<LinearContact>()[m.pair(g, 2)].fric, own);
+    EXPECT_EQ(m.contact_params<LinearContact>()[m.pair(2, g)].fric, own);
+    EXPECT_EQ(m.contact_params<HertzMindlinContact>()[m.pair(g, 2)].fric, own);
   }
-  EXPECT_EQ(m.linear[m.pair(2, 2)].fric, 0);
+  EXPECT_EQ(m.contact_params<LinearContact>()[m.pair(2, 2)].fric, 0);
 }
 
 TEST(ParticleMembrane, GroupNameIsReserved) {
@@ -265,7 +265,7 @@ TEST(ParticleMembrane, PressesOnARigidCoreWithItsConstantForces) {
   const Real E = 1e7;
   const auto l = add_particle_membrane(s, spec, ParticleMembraneMaterial{E, 1000, 0.3});
   ASSERT_EQ(l.n_theta, plan.n_theta);
-  const Real kc = LinearContact::normal_stiffness(s.materials.linear[0], r, rk, 3);
+  const Real kc = LinearContact::normal_stiffness(s.materials.contact_params<LinearContact>()[0], r, rk, 3);
   const Real sn = std::sin(kPi / static_cast<Real>(l.n_theta));
   const Real u = l.force / (kc + 4 * sn * sn * E * kPi * r);
   const std::size_t k0 = static_cast<std::size_t>(l.first);
@@ -281,7 +281,7 @@ TEST(ParticleMembrane, UnbondedSpheresPressOnARigidCoreThroughTheirContactsOnly)
   // u = f / (k_c + 4 sin^2(pi/N) E pi r / 2). The ring is closed in compression, so its contacts
   // carry the hoop load as the bonds did. Tolerance 1e-4 u.
   DemSystem s = two_group_system();
-  s.materials.bond_law = BondLaw::None;
+  s.materials.set_bond_law<NoBond>();
   const ParticleMembraneSpec spec = short_membrane_spec();
   const auto plan = particle_membrane_layout(spec);
   const Real rk = 0.4e-3, r = plan.particle_radius;
@@ -292,7 +292,7 @@ TEST(ParticleMembrane, UnbondedSpheresPressOnARigidCoreThroughTheirContactsOnly)
   const auto l = add_particle_membrane(s, spec, pm);
   EXPECT_EQ(s.bonds.i.size(), 0u);
   EXPECT_EQ(particle_membrane_bonds(s, l), 0u);
-  const Real kc = LinearContact::normal_stiffness(s.materials.linear[0], r, rk, 3);
+  const Real kc = LinearContact::normal_stiffness(s.materials.contact_params<LinearContact>()[0], r, rk, 3);
   const Real sn = std::sin(kPi / static_cast<Real>(l.n_theta));
   const Real u = l.force / (kc + 4 * sn * sn * E * kPi * r / 2);
   const std::size_t k0 = static_cast<std::size_t>(l.first);
@@ -301,7 +301,7 @@ TEST(ParticleMembrane, UnbondedSpheresPressOnARigidCoreThroughTheirContactsOnly)
   EXPECT_NEAR(particle_membrane_mean_radius(s.particles, l), l.centre_radius - u, 1e-4 * u);
   // A bonded membrane without a bond law is still refused.
   DemSystem t = two_group_system();
-  t.materials.bond_law = BondLaw::None;
+  t.materials.set_bond_law<NoBond>();
   EXPECT_THROW(add_particle_membrane(t, spec, ParticleMembraneMaterial{E, 1000, 0.3}), InputError);
 }
 
@@ -329,8 +329,8 @@ TEST(ParticleMembrane, StabilisedMassesKeepTheSampleTimeStep) {
   EXPECT_EQ(s.particles.inv_mass[0], inv_m_sample);
   const std::size_t k0 = static_cast<std::size_t>(l.first);
   const Real r = l.particle_radius;
-  const Real kc = LinearContact::normal_stiffness(s.materials.linear[s.materials.pair(l.group, 0)], r, 0.5e-3, 3);
-  const Real kc1 = LinearContact::normal_stiffness(s.materials.linear[s.materials.pair(l.group, 1)], r, 0.5e-3, 3);
+  const Real kc = LinearContact::normal_stiffness(s.materials.contact_params<LinearContact>()[s.materials.pair(l.group, 0)], r, 0.5e-3, 3);
+  const Real kc1 = LinearContact::normal_stiffness(s.materials.contact_params<LinearContact>()[s.materials.pair(l.group, 1)], r, 0.5e-3, 3);
   const Real ktot = 4 * std::max(kc, kc1);  // bonds and soft contacts add < 1%
   EXPECT_GE(std::sqrt(0.4 / (s.particles.inv_mass[k0] * ktot)), dt / safety);  // rotational bound, I = 0.4 m r^2
   EXPECT_NEAR(stabilise_particle_membrane(s, l, dt, safety), 1.0, 1e-12);  // idempotent
