@@ -40,13 +40,13 @@ DemSystem one_group_system() {
   lc.emod = 1e9;
   lc.kratio = 1.5;
   lc.fric = 0.5;
-  s.materials.linear = {lc};
+  s.materials.contact_params<LinearContact>() = {lc};
   ParallelBond::Material pb;
   pb.emod = 2e9;
   pb.kratio = 1.5;
   pb.ten = 3e6;
   pb.coh = 3e6;
-  s.materials.parallel = {pb};
+  s.materials.bond_params<ParallelBond>() = {pb};
   return s;
 }
 
@@ -131,7 +131,9 @@ TEST(ParticleFields, ResizeGivesEveryFieldItsFillAndFreshIds) {
   std::set<std::string> names;
   ParticleStore::for_each_field([&](const auto& fd) {
     EXPECT_TRUE(names.insert(fd.name).second) << fd.name;
-    if (std::string(fd.name) == "pos") EXPECT_EQ(fd.vtk, nullptr);
+    if (std::string(fd.name) == "pos") {
+      EXPECT_EQ(fd.vtk, nullptr);
+    }
   });
 }
 
