@@ -61,6 +61,7 @@ struct Options {
   double diameter = 25e-3, height = 50e-3;
   bool small = false;
   bool membrane = false;
+  bool energy = false;  // energy bookkeeping on in the timed steps (DemSettings::track_energy)
   int membrane_n_theta = 48;  // units around the sleeve (scenario default: 24)
   double radius_min = 0.4e-3, radius_max = 0.6e-3;
   double bond_gap = 0.05e-3;  // sample.bond_gap default (seed 000)
@@ -96,6 +97,7 @@ void print_help() {
       "  --membrane            also time a flexible membrane at 5 MPa around the genesis sample, on\n"
       "                        1 thread (not with --packing) [off]\n"
       "  --membrane-n-theta N  membrane units around the sleeve [{}]\n"
+      "  --energy              energy bookkeeping on in the timed steps, as in the DEM drivers [off]\n"
       "  -h, --help            print this text and exit\n"
       "\n"
       "What the figures mean: the sample is loaded for 200 steps (platens at 0.05 m/s each); each\n"
@@ -182,6 +184,8 @@ Options parse_args(int argc, char** argv) {
       o.write_packing = value();
     } else if (a == "--membrane") {
       o.membrane = true;
+    } else if (a == "--energy") {
+      o.energy = true;
     } else if (a == "--membrane-n-theta") {
       o.membrane_n_theta = static_cast<int>(parse_integer(a, value(), 3));
       membrane_n_set = true;
@@ -261,6 +265,10 @@ int run(const Options& o) {
   base.walls[0].velocity.z() = 0.05;
   base.walls[1].velocity.z() = -0.05;
   base.run(200);  // load the sample a little so every contact and bond is active
+  if (o.energy) {
+    base.settings.track_energy = true;
+    dem::start_energy_tracking(base);
+  }
   fmt::print("{}: {} particles, {} bonds, {} contacts touching; {}\n", o.packing.empty() ? "ucs-cylinder benchmark" : "packing benchmark",
              base.particles.size(), intact_bonds(base), contacts_touching(base), origin);
   if (base.particles.size() < base.settings.parallel_min)

@@ -73,6 +73,7 @@ void save_dem(CheckpointWriter& w, const DemSystem& s) {
   }
   w.put("dem.cracks", s.cracks.events);
   w.put_value("dem.wall_motion", s.wall_motion_since_build());
+  w.put_value("dem.energy", s.energy);
   for (const auto& b : s.boundaries()) b->save(w, s);
 }
 
@@ -152,6 +153,8 @@ void load_dem(CheckpointReader& r, DemSystem& s) {
     r.get(fmt::format("dem.wall{}.load", k), wc[k].load);
   }
   s.wall_motion_since_build() = r.get_value<Real>("dem.wall_motion");
+  // Energy book (checkpoints before issue 13 have none: the bookkeeping restarts from zero).
+  s.energy = r.has("dem.energy") ? r.get_value<EnergyBook>("dem.energy") : EnergyBook{};
   // Boundaries (the flexible membrane) are attached by the driver from its settings before
   // load_dem(); their state comes back here.
   for (const auto& b : s.boundaries()) b->load(r, s);

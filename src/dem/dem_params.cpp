@@ -24,6 +24,9 @@ void declare_dem_params(ParamTable& t) {
   t.boolean("dem.mass_scaling", false, "scale inertial masses so that dem.time_step is stable (quasi-static runs only)");
   t.real("dem.skin_ratio", 0.3, "-", "Verlet skin as a fraction of the mean particle radius").positive();
   t.integer("dem.parallel_min", 2048, "-", "loops over fewer particles/contacts/bonds run on one thread (OpenMP fork/join costs more)").non_negative();
+  t.boolean("dem.energy_tracking", true,
+            "energy bookkeeping: boundary work, kinetic and strain energy, damping, friction, dashpot and bond-breakage "
+            "dissipation in series.csv (docs/dem.md)");
   t.real_list("dem.gravity", {0, 0, 0}, "m/s^2", "gravitational acceleration").size(3);
   t.real("dem.group.*.density", 2600, "kg/m^3", "particle density of the group").positive();
   // Keys common to the contact laws (each law reads them), then each law's own.

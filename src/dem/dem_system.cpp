@@ -67,6 +67,11 @@ void DemSystem::initialise() {
   cstate_.reserve(room);
   old_state_.reserve(room);
   pload_.reserve(room);
+  if (settings.track_energy) {
+    pair_work_.reserve(room);
+    block_sums_.reserve(std::max(room, particles.size()) / 4096 + 16);
+    for (auto* v : {&ext_f_, &ext_m_, &particle_work_}) v->assign(particles.size(), Vec3::Zero());
+  }
 }
 
 void DemSystem::rebuild_neighbors() {
@@ -114,10 +119,14 @@ void DemSystem::rebuild_neighbors() {
   compact_bonds();
 }
 
-template <class Law>
+template <class Law, bool kEnergy>
 void DemSystem::contact_forces(const std::vector<typename Law::Params>& params) {
   const auto pi = nl_.first(), pj = nl_.second();
   const std::size_t np = pi.size();
+  if constexpr (kEnergy) {
+    reserve_with_headroom(pair_work_, np);
+    pair_work_.resize(np);
+  }
   const Real dt = settings.dt;
   const int dim = settings.dim;
   const Real zeta = materials.normal_damping_ratio;
@@ -139,6 +148,7 @@ void DemSystem::contact_forces(const std::vector<typename Law::Params>& params) 
       out.f.setZero();
       out.mA.setZero();
       out.mB.setZero();
+      if constexpr (kEnergy) pair_work_[p].setZero();
       continue;
     }
     ContactGeom g;
@@ -151,16 +161,26 @@ void DemSystem::contact_forces(const std::vector<typename Law::Params>& params) 
     contact_kinematics(g, x[a], v[a], w[a], x[b], v[b], w[b], dt);
     const auto& prm = params[grp[a] * ng + grp[b]];
     Real fn;
-    Vec3 f = Law::force(prm, g, cstate_[p], dt, dim, fn);
+    ContactWork work;
+    Vec3 f = Law::template force<kEnergy>(prm, g, cstate_[p], dt, dim, fn, &work);
+    Real dashpot = 0;
     if (zeta > 0) {  // viscous normal dashpot, fraction zeta of critical damping
       const Real kn = Law::normal_stiffness_at(prm, g.rA, g.rB, -g.gap, dim);
       const Real meff = particles.mass[a] * particles.mass[b] / (particles.mass[a] + particles.mass[b]);
       f -= 2 * zeta * std::sqrt(meff * kn) * (g.d_delta_n / dt) * g.n;
+      if constexpr (kEnergy) dashpot = 2 * zeta * std::sqrt(meff * kn) * g.d_delta_n * g.d_delta_n / dt;
     }
+    if constexpr (kEnergy) pair_work_[p] = Vec3(work.slip, work.shear, dashpot);
     const Vec3 nxf = g.n.cross(f);
     out.f = f;
     out.mA = -(g.rA + 0.5 * g.gap) * nxf;
     out.mB = -(g.rB + 0.5 * g.gap) * nxf;
+  }
+  if constexpr (kEnergy) {
+    const Vec3 sum = blocked_sum(np, settings.parallel_min, block_sums_, [&](std::size_t p) { return pair_work_[p]; });
+    energy.friction += sum.x();
+    energy.shear_work += sum.y();
+    energy.dashpot += sum.z();
   }
 }
 
@@ -204,22 +224,26 @@ void DemSystem::record_bond_failures() {
   const auto& bond_pair = bonds.pair;
   auto& bond_broken = bonds.broken;
   auto& bond_fail_flag_ = bonds.fail_flags();
-  for (std::size_t b = 0; b < nb; ++b) {
-    if (!bond_fail_flag_[b]) continue;
-    bond_broken[b] = bond_fail_flag_[b];
-    bond_fail_flag_[b] = 0;
-    const Index i = bond_i[b], j = bond_j[b];
-    const Vec3 d = particles.pos[j] - particles.pos[i];
-    const Real dist = d.norm();
-    const Vec3 n = dist > 0 ? Vec3(d / dist) : Vec3::UnitX();
-    const Real gap = dist - particles.radius[i] - particles.radius[j];
-    Real size = 0;
-    materials.with_bond_law([&]<class Law>(std::type_identity<Law>) {
-      size = Law::crack_size(materials.bond_params<Law>()[bond_pair[b]], particles.radius[i], particles.radius[j], settings.dim);
-    });
-    cracks.add(CrackEvent{time, particles.pos[i] + (particles.radius[i] + 0.5 * gap) * n, n, size, bond_broken[b],
-                          particles.group[i], particles.group[j], particles.id[i], particles.id[j]});
-  }
+  materials.with_bond_law([&]<class Law>(std::type_identity<Law>) {
+    const auto& mats = materials.bond_params<Law>();
+    for (std::size_t b = 0; b < nb; ++b) {
+      if (!bond_fail_flag_[b]) continue;
+      bond_broken[b] = bond_fail_flag_[b];
+      bond_fail_flag_[b] = 0;
+      const Index i = bond_i[b], j = bond_j[b];
+      const Real ri = particles.radius[i], rj = particles.radius[j];
+      const Vec3 d = particles.pos[j] - particles.pos[i];
+      const Real dist = d.norm();
+      const Vec3 n = dist > 0 ? Vec3(d / dist) : Vec3::UnitX();
+      const Real gap = dist - ri - rj;
+      const Real size = Law::crack_size(mats[bond_pair[b]], ri, rj, settings.dim);
+      cracks.add(CrackEvent{time, particles.pos[i] + (ri + 0.5 * gap) * n, n, size, bond_broken[b], particles.group[i],
+                            particles.group[j], particles.id[i], particles.id[j]});
+      // Its springs stop acting at once: their energy leaves the system (serial, bond order).
+      if (settings.track_energy)
+        energy.bond_break += Law::energy(mats[bond_pair[b]], bonds.state<Law>()[b], ri, rj, settings.dim);
+    }
+  });
 }
 
 template <class Law>
@@ -272,7 +296,28 @@ void DemSystem::add_external_loads() {
 void DemSystem::integrate() {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
+  if (settings.track_energy) integrate_particles<true>();
+  else integrate_particles<false>();
+  auto t1 = Clock::now();
+  stage_times.integrate += std::chrono::duration<double>(t1 - t0).count();
+  if (!boundaries_.empty()) {
+    for (auto& b : boundaries_) b->after_integrate(*this);
+    const auto t2 = Clock::now();
+    stage_times.boundaries += std::chrono::duration<double>(t2 - t1).count();
+  }
+  for (auto& wall : walls) wall.move(settings.dt);
+  wall_motion_since_build_ += wall_step_;
+  time += settings.dt;
+  ++step_count;
+}
+
+template <bool kEnergy>
+void DemSystem::integrate_particles() {
   const std::size_t n = particles.size();
+  if constexpr (kEnergy) {
+    if (ext_f_.size() != n)  // tracking switched on after initialise(): sized once here
+      for (auto* v : {&ext_f_, &ext_m_, &particle_work_}) v->assign(n, Vec3::Zero());
+  }
   const auto adj_off = nl_.adjacency_offsets();
   const auto adj = nl_.adjacency();
   const auto bond_adj_offset_ = bonds.adjacency_offsets();
@@ -289,6 +334,10 @@ void DemSystem::integrate() {
     Vec3 f = Fe[i], m = Me[i];
     Fe[i].setZero();
     Me[i].setZero();
+    if constexpr (kEnergy) {  // the loads from outside the particles' interactions (work bookkeeping)
+      ext_f_[i] = f;
+      ext_m_[i] = m;
+    }
     for (std::int64_t k = adj_off[i]; k < adj_off[i + 1]; ++k) {
       const std::int64_t e = adj[k];
       const PairLoad& L = pload_[e >> 1];
@@ -307,9 +356,16 @@ void DemSystem::integrate() {
     for (std::size_t k = 0; k < wc.particle.size(); ++k) {
       F[wc.particle[k]] -= wc.load[k].f;
       M[wc.particle[k]] += wc.load[k].mA;
+      if constexpr (kEnergy) {
+        ext_f_[wc.particle[k]] -= wc.load[k].f;
+        ext_m_[wc.particle[k]] += wc.load[k].mA;
+      }
     }
   }
-  for (auto& b : boundaries_) b->add_loads(F, M);  // serial, in candidate order
+  for (auto& b : boundaries_) {  // serial, in candidate order
+    b->add_loads(F, M);
+    if constexpr (kEnergy) b->add_loads(ext_f_, ext_m_);
+  }
   const Real dt = settings.dt, alpha = settings.local_damping;
   const Vec3 g = settings.gravity;
   const bool planar = settings.dim == 2;
@@ -325,6 +381,13 @@ void DemSystem::integrate() {
       f.z() = 0;
       m.x() = m.y() = 0;
     }
+    [[maybe_unused]] Vec3 f_undamped, m_undamped, v_old, w_old;
+    if constexpr (kEnergy) {
+      f_undamped = f;
+      m_undamped = m;
+      v_old = v[i];
+      w_old = w[i];
+    }
     // Local non-viscous damping (Cundall 1987; METHODS.md 1.5), per component.
     for (int c = 0; c < 3; ++c) {
       const Real sv = v[i][c] > 0 ? 1.0 : (v[i][c] < 0 ? -1.0 : 0.0);
@@ -335,6 +398,27 @@ void DemSystem::integrate() {
     // Velocity Verlet in PFC's leapfrog form (METHODS.md 1.1).
     v[i] += f * (particles.inv_mass[i] * dt);
     w[i] += m * (particles.inv_inertia[i] * dt);
+    if constexpr (kEnergy) {  // works with the step's mean velocity and spin (energy.hpp)
+      const Vec3 vm = (0.5 * dt) * (v_old + v[i]), wm = (0.5 * dt) * (w_old + w[i]);
+      Vec3 fe = ext_f_[i] + particles.mass[i] * g;
+      if (planar) fe.z() = 0;
+      Real w_ext = 0, d_damp = 0;
+      // A particle held at a prescribed velocity (zero inverse mass, e.g. a grip) is part of the
+      // boundary: what holds it does minus the work of the interactions on it.
+      if (particles.inv_mass[i] != 0) {
+        w_ext += fe.dot(vm);
+        d_damp -= (f - f_undamped).dot(vm);
+      } else {
+        w_ext -= (f_undamped - fe).dot(vm);
+      }
+      if (particles.inv_inertia[i] != 0) {
+        w_ext += ext_m_[i].dot(wm);
+        d_damp -= (m - m_undamped).dot(wm);
+      } else {
+        w_ext -= (m_undamped - ext_m_[i]).dot(wm);
+      }
+      particle_work_[i] = Vec3(w_ext, d_damp, 0);
+    }
     const Vec3 dx = v[i] * dt;
     x[i] += dx;
     particles.disp[i] += dx;
@@ -351,17 +435,11 @@ void DemSystem::integrate() {
         "DEM state became NaN/inf at step {} (t = {:.6g} s): the time step {:.3g} s is too large for the stiffness "
         "and mass of the sample; lower dem.time_step_safety (or dem.time_step), or enable mass scaling",
         step_count, time, dt));
-  auto t1 = Clock::now();
-  stage_times.integrate += std::chrono::duration<double>(t1 - t0).count();
-  if (!boundaries_.empty()) {
-    for (auto& b : boundaries_) b->after_integrate(*this);
-    const auto t2 = Clock::now();
-    stage_times.boundaries += std::chrono::duration<double>(t2 - t1).count();
+  if constexpr (kEnergy) {
+    const Vec3 sum = blocked_sum(n, settings.parallel_min, block_sums_, [&](std::size_t i) { return particle_work_[i]; });
+    energy.boundary_work += sum.x();
+    energy.damping += sum.y();
   }
-  for (auto& wall : walls) wall.move(settings.dt);
-  wall_motion_since_build_ += wall_step_;
-  time += settings.dt;
-  ++step_count;
 }
 
 namespace {
@@ -396,7 +474,10 @@ void DemSystem::update_neighbors() {
 void DemSystem::compute_forces() {
   Lap lap;
   // The active laws are picked once per stage (laws.hpp); the loops are templated on them.
-  materials.with_contact_law([&]<class Law>(std::type_identity<Law>) { contact_forces<Law>(materials.contact_params<Law>()); });
+  materials.with_contact_law([&]<class Law>(std::type_identity<Law>) {
+    if (settings.track_energy) contact_forces<Law, true>(materials.contact_params<Law>());
+    else contact_forces<Law, false>(materials.contact_params<Law>());
+  });
   lap(stage_times.contacts);
   materials.with_bond_law([&]<class Law>(std::type_identity<Law>) {
     if constexpr (Law::installs_bonds) {

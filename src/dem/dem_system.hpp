@@ -20,6 +20,7 @@
 #include "dem/bond_set.hpp"
 #include "dem/boundary.hpp"
 #include "dem/crack_log.hpp"
+#include "dem/energy.hpp"
 #include "dem/materials.hpp"
 #include "dem/neighbor_list.hpp"
 #include "dem/particle_store.hpp"
@@ -34,6 +35,7 @@ struct DemSettings {
   Vec3 gravity = Vec3::Zero();  // [m/s^2]
   Real skin = 0;                // Verlet skin [m]
   std::size_t parallel_min = 2048;  // loops over fewer items run on one thread (fork/join costs more)
+  bool track_energy = false;    // energy bookkeeping (energy.hpp; the DEM drivers' run loop sets it)
 };
 
 struct WallContacts {           // candidate particles of one wall, sorted by index
@@ -60,6 +62,7 @@ class DemSystem {
 
   Real time = 0;
   long step_count = 0;
+  EnergyBook energy;  // cumulative, while settings.track_energy (energy.hpp)
 
   // Installs bonds between every pair whose gap is <= max_gap (stress-free).
   std::size_t install_bonds(Real max_gap);
@@ -105,7 +108,8 @@ class DemSystem {
   Real wall_motion_since_build() const { return wall_motion_since_build_; }
 
  private:
-  template <class Law> void contact_forces(const std::vector<typename Law::Params>& params);
+  template <class Law, bool kEnergy> void contact_forces(const std::vector<typename Law::Params>& params);
+  template <bool kEnergy> void integrate_particles();
   template <class Law> void bond_forces(const std::vector<typename Law::Prepared>& mats, std::vector<typename Law::State>& st);
   template <class Law> void wall_forces(const std::vector<typename Law::Params>& params);
   void record_bond_failures();
@@ -123,6 +127,9 @@ class DemSystem {
   std::vector<ContactState> old_wall_state_;
   Real wall_motion_since_build_ = 0;
   Real wall_step_ = 0;  // largest wall motion of this step (update_neighbors -> integrate)
+  // Energy bookkeeping scratch (track_energy): per pair (slip, shear work, dashpot), per particle
+  // external load and (external work, damping dissipation, -), block sums.
+  std::vector<Vec3> pair_work_, ext_f_, ext_m_, particle_work_, block_sums_;
 };
 
 }  // namespace ff::dem

@@ -71,6 +71,73 @@ Real strain_energy(const DemSystem& s) {
   return e;
 }
 
+namespace {
+// Normal springs of the touching contacts plus the intact bonds [J] (with_shear: also the shear
+// springs' |Fs|^2/(2 k)).
+Real contact_and_bond_energy(const DemSystem& s, bool with_shear) {
+  const auto& x = s.particles.pos;
+  const auto& r = s.particles.radius;
+  const auto& materials = s.materials;
+  const auto pi = s.neighbors().first(), pj = s.neighbors().second();
+  const auto& cstate = s.contact_state();
+  const int dim = s.settings.dim;
+  Real e = 0;
+  materials.with_contact_law([&]<class Law>(std::type_identity<Law>) {
+    const auto& prm = materials.contact_params<Law>();
+    for (std::size_t p = 0; p < pi.size(); ++p) {
+      const Index a = pi[p], b = pj[p];
+      const Real gap = (x[b] - x[a]).norm() - r[a] - r[b];
+      if (gap >= 0) continue;
+      const int pt = materials.pair(s.particles.group[a], s.particles.group[b]);
+      e += with_shear ? Law::strain_energy(prm[pt], r[a], r[b], -gap, cstate[p], dim)
+                      : Law::normal_energy(prm[pt], r[a], r[b], -gap, dim);
+    }
+  });
+  const BondSet& bs = s.bonds;
+  materials.with_bond_law([&]<class Law>(std::type_identity<Law>) {
+    const auto& mats = materials.bond_params<Law>();
+    const auto& st = bs.state<Law>();
+    for (std::size_t b = 0; b < bs.size(); ++b)
+      if (!bs.broken[b]) e += Law::energy(mats[bs.pair[b]], st[b], r[bs.i[b]], r[bs.j[b]], dim);
+  });
+  return e;
+}
+
+Real inertial_kinetic_energy(const DemSystem& s) {
+  const auto& p = s.particles;
+  return deterministic_sum(p.size(), s.settings.parallel_min, [&](std::size_t i) {
+    // Particles held at a prescribed velocity (zero inverse mass) belong to the boundary.
+    return (p.inv_mass[i] != 0 ? 0.5 * p.vel[i].squaredNorm() / p.inv_mass[i] : 0.0) +
+           (p.inv_inertia[i] != 0 ? 0.5 * p.omega[i].squaredNorm() / p.inv_inertia[i] : 0.0);
+  });
+}
+}  // namespace
+
+void start_energy_tracking(DemSystem& s) {
+  EnergyBook b;
+  const Real normal = contact_and_bond_energy(s, false);
+  b.shear0 = contact_and_bond_energy(s, true) - normal;
+  b.strain0 = normal + b.shear0;
+  b.kinetic0 = inertial_kinetic_energy(s);
+  s.energy = b;
+}
+
+EnergyReport energy_report(const DemSystem& s) {
+  const EnergyBook& b = s.energy;
+  EnergyReport e;
+  e.kinetic = inertial_kinetic_energy(s);
+  // The shear springs hold what they held at the start plus the work of their force increments.
+  e.strain = contact_and_bond_energy(s, false) + b.shear0 + b.shear_work;
+  e.boundary_work = b.boundary_work;
+  e.damping = b.damping;
+  e.friction = b.friction;
+  e.dashpot = b.dashpot;
+  e.bond_break = b.bond_break;
+  const Real accounted = (e.kinetic - b.kinetic0) + (e.strain - b.strain0) + e.damping + e.friction + e.dashpot + e.bond_break;
+  e.balance_error = b.boundary_work != 0 ? (b.boundary_work - accounted) / std::abs(b.boundary_work) : 0.0;
+  return e;
+}
+
 Real max_unbalanced_force_ratio(const DemSystem& s, std::size_t first) {
   const std::size_t n = std::min(first, s.particles.size());
   const Real unbalanced =

@@ -23,6 +23,18 @@ Real critical_time_step(const DemSystem& s);
 // Density scaling: inertial masses so that `dt` is `safety` times the critical step.
 void scale_masses_for(DemSystem& s, Real dt, Real safety);
 
+// Energy bookkeeping (energy.hpp; settings.track_energy). start_energy_tracking() zeroes the
+// book and takes the present kinetic and strain energies as the reference.
+struct EnergyReport {
+  Real kinetic = 0;        // E_kin with the inertial masses, half-step velocities [J]
+  Real strain = 0;         // E_strain of contacts (normal + shear) and intact bonds [J]
+  Real boundary_work = 0, damping = 0, friction = 0, dashpot = 0, bond_break = 0;  // since the start [J]
+  // (W - dE_kin - dE_strain - D) / W: the part of the boundary work not accounted for [-]
+  Real balance_error = 0;
+};
+void start_energy_tracking(DemSystem& s);
+EnergyReport energy_report(const DemSystem& s);
+
 // Love-Weber average stress of the particles i with selected(i) (tension +), divided by `volume`
 // [Pa] (METHODS.md 1.7).
 template <class Pred> Mat3 average_stress_of(const DemSystem& s, Pred selected, Real volume);

@@ -9,6 +9,7 @@
 #include "core/progress.hpp"
 #include "dem/dem_checkpoint.hpp"
 #include "dem/dem_params.hpp"
+#include "dem/diagnostics.hpp"
 #include "drivers/dem_results.hpp"
 #include "drivers/run_estimate.hpp"
 #include "drivers/run_record.hpp"
@@ -41,8 +42,25 @@ void DemRun::checkpoint() {
   control_.checkpoint_written();
 }
 
+// Energy bookkeeping over the loading curve (dem/energy.hpp): its columns follow the driver's.
+void DemRun::start_energy() {
+  if (!cfg.boolean("dem.energy_tracking")) return;
+  sys.settings.track_energy = true;
+  dem::start_energy_tracking(sys);
+}
+
+void DemRun::add_energy_columns() {
+  if (!cfg.boolean("dem.energy_tracking") || energy_columns_) return;
+  energy_columns_ = true;
+  for (const char* c : {"energy_kinetic_J", "strain_energy_J", "boundary_work_J", "damping_dissipation_J",
+                        "friction_dissipation_J", "dashpot_dissipation_J", "bond_break_energy_J", "energy_balance_error"})
+    columns.emplace_back(c);
+}
+
 void DemRun::begin_curve() {
   *c_.next_vtk_strain = vtk_every_;
+  start_energy();
+  add_energy_columns();
   series_.open(opt.out_dir / "series.csv", columns);
   if (vtk_) vtk_writer_.write(sys, (*c_.vtk_index)++, extent_);
   checkpoint();  // the end of a stage
@@ -51,7 +69,12 @@ void DemRun::begin_curve() {
 // Outputs. On resume, rows, crack lines and snapshots after the checkpoint are dropped: the
 // run recomputes them identically.
 void DemRun::open_outputs() {
-  row.reserve(columns.size());
+  if (on_curve()) {
+    add_energy_columns();
+    if (!opt.resume) start_energy();
+    else sys.settings.track_energy = cfg.boolean("dem.energy_tracking");  // the book comes with the checkpoint
+  }
+  row.reserve(columns.size() + 8);
   if (on_curve()) {
     if (opt.resume) series_.reopen(opt.out_dir / "series.csv", columns, static_cast<std::size_t>(*c_.rows));
     else series_.open(opt.out_dir / "series.csv", columns);
@@ -80,6 +103,11 @@ void DemRun::open_outputs() {
 // One point of the loading curve: its row, the peak, the VTK cadence and the stop criteria.
 // Returns why the run ends here (empty: go on); `fraction` gets the progress.
 std::string DemRun::curve_row(const DemRowReport& r, double& fraction) {
+  if (energy_columns_) {
+    const dem::EnergyReport e = dem::energy_report(sys);
+    for (Real v : {e.kinetic, e.strain, e.boundary_work, e.damping, e.friction, e.dashpot, e.bond_break, e.balance_error})
+      row.push_back(v);
+  }
   series_.row(row);
   e_hist_.push_back(r.strain);
   s_hist_.push_back(r.stress);

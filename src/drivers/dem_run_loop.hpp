@@ -127,6 +127,9 @@ class DemRun {
   bool vtk_ = false;
   Real extent_ = 0, vtk_every_ = 0, stop_fraction_ = 0, max_strain_ = 0;
   std::vector<Real> e_hist_, s_hist_, l_hist_;  // the curve, for the elastic fit
+  void start_energy();
+  void add_energy_columns();
+  bool energy_columns_ = false;                 // the energy columns follow the driver's (dem/energy.hpp)
   bool stopped_at_strain_cap_ = false;          // the last curve row reached NAME.max_strain
 };
 

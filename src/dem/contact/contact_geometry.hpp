@@ -27,6 +27,25 @@ struct ContactState {
 };
 
 // Relative motion at the contact point (METHODS.md 1.2).
+// Energy bookkeeping of one contact over one step (DemSettings::track_energy): the elastic work
+// stored in (or released from) the incremental shear spring, and the energy dissipated by slip.
+struct ContactWork {
+  Real shear = 0;  // dU_s [J]
+  Real slip = 0;   // D_slip >= 0 [J]
+};
+
+// Incremental shear spring of stiffness k whose force went from f0 (rotated into the new plane)
+// to f1 under the tangential displacement increment ds: the elastic part of the increment is
+// -(f1 - f0)/k, so dU_s = (|f1|^2 - |f0|^2)/(2k), and the rest, ds + (f1 - f0)/k, is slip,
+// dissipating -(f0 + f1)/2 . (ds + (f1 - f0)/k) (Itasca PFC 5/6 documentation, "Energy
+// tracking", slip energy E_mu of the linear model). With a stiffness that varies along the path
+// (Hertz-Mindlin) the stored energy is the sum of these increments, the "work of the shear force
+// increments", rather than |Fs|^2/(2 k) with the current k.
+inline void shear_work(const Vec3& f0, const Vec3& f1, Real k, const Vec3& ds, ContactWork& w) {
+  w.shear = (f1.squaredNorm() - f0.squaredNorm()) / (2 * k);
+  w.slip = -0.5 * (f0 + f1).dot(ds + (f1 - f0) / k);
+}
+
 inline void contact_kinematics(ContactGeom& g, const Vec3& xA, const Vec3& vA, const Vec3& wA, const Vec3& xB,
                                const Vec3& vB, const Vec3& wB, Real dt) {
   const Vec3 vc = (vB + wB.cross(g.xc - xB)) - (vA + wA.cross(g.xc - xA));

@@ -58,15 +58,28 @@ struct HertzMindlinContact {
     return 2.0 / 3.0 * normal_stiffness(p, rA, rB, overlap) * overlap;
   }
   // Normal: integral of Fn = 8/15 E* sqrt(R*) delta^(5/2) (Johnson 1985, ch. 4).
-  static Real strain_energy(const Params& p, Real rA, Real rB, Real overlap, const State& /*s*/, int /*dim*/) {
+  static Real normal_energy(const Params& p, Real rA, Real rB, Real overlap, int /*dim*/) {
     Real es, gs;
     moduli(p, rB <= 0, es, gs);
     return 8.0 / 15.0 * es * std::sqrt(reduced_radius(rA, rB)) * std::pow(overlap, 2.5);
   }
-  static Vec3 force(const Params& p, const ContactGeom& g, State& s, Real dt, int /*dim*/, Real& fn) {
+  // Normal energy plus the shear spring's |Fs|^2/(2 kt) at the current kt = 8 G* sqrt(R* delta)
+  // (Mindlin's no-slip stiffness; since kt varies with delta this is not path independent: the
+  // energy balance instead sums the work of the shear force increments, shear_work()).
+  static Real strain_energy(const Params& p, Real rA, Real rB, Real overlap, const State& s, int dim) {
+    Real es, gs;
+    moduli(p, rB <= 0, es, gs);
+    const Real kt = 8 * gs * std::sqrt(reduced_radius(rA, rB) * overlap);
+    return normal_energy(p, rA, rB, overlap, dim) + (kt > 0 ? 0.5 * s.fs.squaredNorm() / kt : 0.0);
+  }
+  // With kEnergy, `w` receives the shear spring's work and the slip dissipation (shear_work()).
+  template <bool kEnergy = false>
+  static Vec3 force(const Params& p, const ContactGeom& g, State& s, Real dt, int /*dim*/, Real& fn,
+                    ContactWork* w = nullptr) {
     if (g.gap >= 0) {
       fn = 0;
-      s.fs.setZero();
+      s.fs.setZero();  // |Fs| <= mu Fn ~ delta^(3/2) and kt ~ delta^(1/2): nothing left to lose
+      if constexpr (kEnergy) *w = ContactWork{};
       return Vec3::Zero();
     }
     Real es, gs;
@@ -76,10 +89,13 @@ struct HertzMindlinContact {
     fn = 4.0 / 3.0 * es * a * delta;
     const Real kt = 8 * gs * a;
     rotate_into_plane(s.fs, g, dt);
+    Vec3 f0;
+    if constexpr (kEnergy) f0 = s.fs;
     s.fs -= kt * g.d_delta_s;
     const Real limit = p.fric * fn;
     const Real fs2 = s.fs.squaredNorm();
     if (fs2 > limit * limit) s.fs *= limit / std::sqrt(fs2);
+    if constexpr (kEnergy) shear_work(f0, s.fs, kt, g.d_delta_s, *w);
     return fn * g.n + s.fs;
   }
 };

@@ -47,25 +47,38 @@ struct LinearContact {
     return normal_stiffness(p, rA, rB, dim) * overlap;
   }
   // 1/2 kn delta^2 + 1/2 |Fs|^2 / ks (PFC linear model, strain energy of the springs).
+  static Real normal_energy(const Params& p, Real rA, Real rB, Real overlap, int dim) {
+    return 0.5 * normal_stiffness(p, rA, rB, dim) * overlap * overlap;
+  }
   static Real strain_energy(const Params& p, Real rA, Real rB, Real overlap, const State& s, int dim) {
     const Real kn = normal_stiffness(p, rA, rB, dim);
     const Real ks = kn / p.kratio;
     return 0.5 * kn * overlap * overlap + 0.5 * s.fs.squaredNorm() / ks;
   }
   // Force on B. `fn` returns the compressive normal force magnitude [N].
-  static Vec3 force(const Params& p, const ContactGeom& g, State& s, Real dt, int dim, Real& fn) {
+  // With kEnergy, `w` receives the shear spring's work and the slip dissipation (shear_work()).
+  template <bool kEnergy = false>
+  static Vec3 force(const Params& p, const ContactGeom& g, State& s, Real dt, int dim, Real& fn,
+                    ContactWork* w = nullptr) {
     const Real kn = normal_stiffness(p, g.rA, g.rB, dim);
     const Real ks = kn / p.kratio;
     fn = g.gap < 0 ? -kn * g.gap : 0.0;
     if (fn == 0) {  // separated: the contact forgets its shear force
+      if constexpr (kEnergy) {  // what the spring held is lost with it
+        w->shear = -0.5 * s.fs.squaredNorm() / ks;
+        w->slip = -w->shear;
+      }
       s.fs.setZero();
       return Vec3::Zero();
     }
     rotate_into_plane(s.fs, g, dt);
+    Vec3 f0;
+    if constexpr (kEnergy) f0 = s.fs;
     s.fs -= ks * g.d_delta_s;
     const Real limit = p.fric * fn;
     const Real fs2 = s.fs.squaredNorm();
     if (fs2 > limit * limit) s.fs *= limit / std::sqrt(fs2);  // slip
+    if constexpr (kEnergy) shear_work(f0, s.fs, ks, g.d_delta_s, *w);
     return fn * g.n + s.fs;
   }
 };

@@ -131,7 +131,10 @@ TEST(RunResults, UcsSummaryIsTypedAndColumnsCarryUnits) {
   EXPECT_TRUE(p["driver"].is_string());
   EXPECT_EQ(first_line(out / "series.csv"),
             "step,time_s,axial_strain,axial_stress_Pa,lateral_strain,volumetric_strain,cracks_tensile,cracks_shear,"
-            "cracks_total,intact_bonds,kinetic_energy_J,unbalanced_force_ratio");
+            "cracks_total,intact_bonds,kinetic_energy_J,unbalanced_force_ratio,"
+            // energy bookkeeping (issue 13 item 6)
+            "energy_kinetic_J,strain_energy_J,boundary_work_J,damping_dissipation_J,friction_dissipation_J,"
+            "dashpot_dissipation_J,bond_break_energy_J,energy_balance_error");
   EXPECT_EQ(first_line(out / "cracks.csv"), "time_s,x_m,y_m,z_m,nx,ny,nz,size_m,mode,group_a,group_b,id_a,id_b");
   fs::remove_all(out);
 }

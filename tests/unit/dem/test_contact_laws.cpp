@@ -131,6 +131,34 @@ TEST(LinearContact, ElasticShearThenCoulombSlip) {
   EXPECT_LT((f - (fn0 * Vec3::UnitZ() + st.fs)).norm(), 1e-13 * fn0);
 }
 
+TEST(LinearContact, SlipDissipatesMuFnTimesTheSlipDistance) {
+  // Energy bookkeeping (shear_work(), contact_geometry.hpp): B slides by L along y in N equal
+  // increments under a constant overlap. Elastic up to |Fs| = mu Fn (at u0 = mu Fn / ks), then
+  // Coulomb slip: the spring holds U = (mu Fn)^2 / (2 ks) and slip has dissipated
+  // mu Fn (L - u0) (rigid-plastic work; Itasca PFC "Energy tracking", slip energy). Their sum is
+  // the work done, mu Fn (L - u0) + mu Fn u0 / 2. Tolerance 1e-6 relative (u0 falls on an
+  // increment boundary up to rounding).
+  const auto p = linear_params(1e9, 2.5, 0.4);
+  const Real r = 1e-3, overlap = 2e-6;
+  const Real kn = LinearContact::normal_stiffness(p, r, r, 3), ks = kn / p.kratio, fn0 = kn * overlap;
+  const Real u0 = p.fric * fn0 / ks, L = 10 * u0;
+  const int N = 4000;  // u0 falls on an increment boundary: 400 increments
+  ContactState st;
+  ContactGeom g = geom(Vec3::UnitZ(), -overlap, r, r);
+  g.d_delta_s = Vec3(0, L / N, 0);
+  Real fn, shear = 0, slip = 0;
+  for (int k = 0; k < N; ++k) {
+    ContactWork w;
+    LinearContact::force<true>(p, g, st, 1e-8, 3, fn, &w);
+    shear += w.shear;
+    slip += w.slip;
+  }
+  const Real mu_fn = p.fric * fn0;
+  EXPECT_NEAR(shear, 0.5 * st.fs.squaredNorm() / ks, 1e-9 * mu_fn * u0);
+  EXPECT_NEAR(shear, mu_fn * mu_fn / (2 * ks), 1e-6 * mu_fn * u0);
+  EXPECT_NEAR(slip, mu_fn * (L - u0), 1e-6 * mu_fn * L);
+}
+
 TEST(LinearContact, StoredShearFollowsTheContactPlane) {
   // METHODS.md 1.2: the stored shear force is projected into the new plane with its magnitude
   // kept, then rotated by the mean spin about n: v <- v - v x (spin dt) n, a rotation by

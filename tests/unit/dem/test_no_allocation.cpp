@@ -108,6 +108,26 @@ TEST(DemAllocation, StepsOfACompressedBondedSampleDoNotAllocate) {
   EXPECT_EQ(allocations.load(), 0) << "over " << s.neighbors().builds() - builds << " rebuilds";
 }
 
+TEST(DemAllocation, StepsWithEnergyBookkeepingDoNotAllocate) {
+  // The same with the energy bookkeeping on (issue 13 item 6), switched on after initialise()
+  // as the DEM drivers do: per-pair and per-particle work slots and block sums reuse buffers.
+  omp_set_num_threads(1);
+  DemSystem s = compressed_block();
+  s.settings.track_energy = true;
+  start_energy_tracking(s);
+  s.run(500);
+  const long builds = s.neighbors().builds();
+  const long cracks = s.cracks.total();
+  allocations = 0;
+  counting = true;
+  s.run(3000);
+  counting = false;
+  EXPECT_GT(s.neighbors().builds(), builds + 2);
+  EXPECT_GT(s.cracks.total(), cracks);
+  EXPECT_GT(s.energy.bond_break, 0);
+  EXPECT_EQ(allocations.load(), 0) << "over " << s.neighbors().builds() - builds << " rebuilds";
+}
+
 TEST(DemAllocation, StepsInsideAFlexibleMembraneDoNotAllocate) {
   // The same compressed block inside a flexible membrane at 2 MPa (issue 4): candidate
   // searches at neighbour rebuilds, membrane contacts, servo and vertex updates reuse buffers.
