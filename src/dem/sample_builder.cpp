@@ -17,9 +17,11 @@
 namespace ff::dem {
 
 void declare_sample_params(ParamTable& t) {
-  t.string("sample.shape", "cylinder", "sample shape: cylinder (3D, axis z) or box (2D: rectangle in x-y, loaded along y)")
-      .one_of({"cylinder", "box"});
-  t.real("sample.diameter", 25e-3, "m", "cylinder diameter").positive();
+  t.string("sample.shape", "cylinder",
+           "sample shape: cylinder (3D, axis z, base at z = 0), box (3D box, or 2D rectangle in x-y loaded along y) "
+           "or disc (2D: disks in a circle of sample.diameter centred at the origin of the x-y plane)")
+      .one_of({"cylinder", "box", "disc"});
+  t.real("sample.diameter", 25e-3, "m", "cylinder or disc diameter").positive();
   t.real("sample.height", 50e-3, "m", "sample height along the loading axis (z in 3D, y in 2D)").positive();
   t.real("sample.width", 25e-3, "m", "box width along x").positive();
   t.real("sample.depth", 25e-3, "m", "box depth along y (3D box only)").positive();
@@ -284,8 +286,12 @@ struct SampleGeometry {
 
 SampleGeometry sample_geometry(const Config& cfg, int dim) {
   SampleGeometry g;
-  g.cylinder = cfg.string("sample.shape") == "cylinder";
-  if (dim == 2 && g.cylinder) cfg.fail("sample.shape", "a 2D sample is a rectangle: use shape = \"box\"");
+  const std::string shape = cfg.string("sample.shape");
+  if (dim == 2 && shape == "cylinder")
+    cfg.fail("sample.shape", "a 2D sample is a rectangle or a circle: use shape = \"box\" or \"disc\"");
+  if (dim == 3 && shape == "disc")
+    cfg.fail("sample.shape", "\"disc\" is a 2D shape (dem.dim = 2); a 3D sample is shape = \"cylinder\" or \"box\"");
+  g.cylinder = shape != "box";  // cylinder (3D) or disc (2D): round about the z axis through the origin
   const Real rmin = cfg.real("sample.radius_min"), rmax = cfg.real("sample.radius_max");
   if (rmax < rmin)
     cfg.fail("sample.radius_max", fmt::format("{} m is below sample.radius_min = {} m; radius_max must be >= radius_min",
@@ -296,8 +302,8 @@ SampleGeometry sample_geometry(const Config& cfg, int dim) {
   spec.radius_max = rmax;
   spec.porosity = cfg.real("sample.porosity");
   spec.seed = static_cast<std::uint64_t>(cfg.integer("sample.seed"));
-  const Real H = cfg.real("sample.height");
   const Real width = g.cylinder ? cfg.real("sample.diameter") : cfg.real("sample.width");
+  const Real H = g.cylinder && dim == 2 ? width : cfg.real("sample.height");  // a disc's height is its diameter
   if (width < 4 * rmax || H < 4 * rmax)
     cfg.fail(width < 4 * rmax ? (g.cylinder ? "sample.diameter" : "sample.width") : "sample.height",
              fmt::format("the sample must be at least 4 particle radii wide and high (radius_max = {} m)", rmax));
@@ -305,7 +311,7 @@ SampleGeometry sample_geometry(const Config& cfg, int dim) {
     spec.container = geom::PackingSpec::Container::Cylinder;
     spec.cyl_radius = 0.5 * width;
     spec.cyl_height = H;
-    g.volume = kPi * 0.25 * width * width * H;
+    g.volume = kPi * 0.25 * width * width * (dim == 3 ? H : 1.0);  // 2D: per metre of thickness
   } else {
     if (dim == 3 && cfg.real("sample.depth") < 4 * rmax)
       cfg.fail("sample.depth", fmt::format("the sample must be at least 4 particle radii deep (radius_max = {} m)", rmax));
@@ -423,8 +429,10 @@ SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
     c.radius = 0.5 * width;
     c.friction = 0;
     sys.walls.push_back(c);
-    plane("bottom", Vec3::Zero(), Vec3::UnitZ());
-    plane("top", Vec3(0, 0, H), -Vec3::UnitZ());
+    if (dim == 3) {  // in 2D the disks lie at z = 0: a plane there would touch every one
+      plane("bottom", Vec3::Zero(), Vec3::UnitZ());
+      plane("top", Vec3(0, 0, H), -Vec3::UnitZ());
+    }
   } else {
     const Vec3 hi = spec.box_hi;
     plane("x-", Vec3::Zero(), Vec3::UnitX());
@@ -515,7 +523,7 @@ SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
   sys.initialise();
   info.height = H;
   info.width = width;
-  info.area = info.cylinder ? kPi * 0.25 * width * width : (dim == 3 ? width * cfg.real("sample.depth") : width);
+  info.area = dim == 2 ? width : (info.cylinder ? kPi * 0.25 * width * width : width * cfg.real("sample.depth"));
   info.genesis_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   log::info("sample: {} particles, {} bonds, porosity {:.3f}, locked-in stress {:.3g} Pa, {} floaters, genesis {} steps in {:.1f} s",
             P.size(), info.bonds, info.porosity, info.locked_in_stress, info.floaters, steps, info.genesis_seconds);

@@ -17,11 +17,11 @@ namespace ff::dem {
 struct SampleInfo {
   int dim = 3;
   int axis = 2;               // loading axis: z in 3D, y in 2D
-  Real height = 0;            // along the loading axis, platen to platen [m]
-  Real width = 0;             // cylinder diameter or box width [m]
+  Real height = 0;            // along the loading axis, platen to platen [m] (disc: its diameter)
+  Real width = 0;             // cylinder or disc diameter, or box width [m]
   Real area = 0;              // loaded cross-section [m^2] (2D: width x 1 m)
-  Real volume = 0;            // container volume [m^3] (2D: area x 1 m)
-  bool cylinder = true;
+  Real volume = 0;            // container volume [m^3] (2D: area of the rectangle or circle x 1 m)
+  bool cylinder = true;       // round about the z axis through the origin: 3D cylinder or 2D disc (dim = 2)
   Real porosity = 0;          // after genesis
   Real locked_in_stress = 0;  // mean stress when bonds were installed [Pa], compression > 0
   std::size_t bonds = 0;

@@ -27,9 +27,6 @@ Real particle_measure(int dim, Real r) { return dim == 3 ? 4.0 / 3.0 * kPi * r *
 void check_packing_spec(const PackingSpec& p) {
   auto bad = [](const std::string& what) { throw InputError("packing: " + what); };
   if (p.dim != 2 && p.dim != 3) bad(fmt::format("dim = {} must be 2 or 3", p.dim));
-  if (p.dim == 2 && p.container != PackingSpec::Container::Box) {
-    bad("dim = 2 packs disks in a rectangle: use container = Box (box_lo, box_hi in x-y)");
-  }
   if (!(p.radius_min > 0) || !(p.radius_max >= p.radius_min) || !std::isfinite(p.radius_max)) {
     bad(fmt::format("radius range [{}, {}] must satisfy 0 < radius_min <= radius_max", p.radius_min, p.radius_max));
   }
@@ -40,7 +37,11 @@ void check_packing_spec(const PackingSpec& p) {
                     p.porosity, p.dim == 3 ? "spheres (3D)" : "disks (2D)", min_porosity, p.dim == 3 ? 0.36 : 0.16));
   }
   const Real d = 2 * p.radius_max;
-  if (p.container == PackingSpec::Container::Cylinder) {
+  if (p.container == PackingSpec::Container::Cylinder && p.dim == 2) {
+    if (!(p.cyl_radius >= d) || !std::isfinite(p.cyl_radius)) {
+      bad(fmt::format("circle diameter {} must be at least two largest particle diameters ({})", 2 * p.cyl_radius, 2 * d));
+    }
+  } else if (p.container == PackingSpec::Container::Cylinder) {
     if (!(p.cyl_radius >= d) || !(p.cyl_height >= 2 * d) || !std::isfinite(p.cyl_radius * p.cyl_height)) {
       bad(fmt::format("cylinder diameter {} and height {} must be at least two largest particle diameters ({})",
                       2 * p.cyl_radius, p.cyl_height, 2 * d));
@@ -59,7 +60,7 @@ void check_packing_spec(const PackingSpec& p) {
     bad(fmt::format("start_radius_scale {} must be in (0, 1]", p.start_radius_scale));
   }
   const Real container = p.container == PackingSpec::Container::Cylinder
-                             ? kPi * p.cyl_radius * p.cyl_radius * p.cyl_height
+                             ? kPi * p.cyl_radius * p.cyl_radius * (p.dim == 3 ? p.cyl_height : 1.0)
                              : (p.box_hi - p.box_lo).head(p.dim).prod();
   const Real expected = (1 - p.porosity) * container / particle_measure(p.dim, 0.5 * (p.radius_min + p.radius_max));
   if (expected > 5e7) {

@@ -4,7 +4,7 @@
 // (Potyondy & Cundall 2004, Int. J. Rock Mech. Min. Sci. 41:1329, Sec. 3.1) and the force-biased
 // family (Jodrey & Tory 1985, Phys. Rev. A 32:2347; Moscinski et al. 1989, Mol. Simul. 3:201):
 //  1. Draw radii uniformly in [radius_min, radius_max] until the solid volume (2D: disk area) is
-//     closest to (1 - porosity) * container volume (2D: rectangle area); N follows from that.
+//     closest to (1 - porosity) * container volume (2D: circle or rectangle area); N follows from that.
 //  2. Place the centres uniformly at random inside the container shrunk by each radius, with the
 //     radii at start_radius_scale of full size.
 //  3. Geometric relaxation: every overlapping pair pushes both partners apart along its normal by
@@ -46,7 +46,8 @@ inline constexpr Real kMinPorosity3D = 0.35;
 inline constexpr Real kMinPorosity2D = 0.16;
 
 struct PackingSpec {
-  int dim = 3;  // 3: spheres in a cylinder or box; 2: disks (z = 0) in a rectangle
+  int dim = 3;  // 3: spheres in a cylinder or box; 2: disks (z = 0) in a circle or rectangle
+  // Cylinder in 2D: the circle of radius cyl_radius about the origin in the x-y plane (cyl_height ignored).
   enum class Container { Cylinder, Box } container = Container::Cylinder;
   Real cyl_radius = 12.5e-3, cyl_height = 50e-3;  // cylinder along z, base at z = 0, axis at x = y = 0 [m]
   Vec3 box_lo{0, 0, 0}, box_hi{25e-3, 25e-3, 50e-3};  // box (2D: x-y rectangle, z ignored) [m]

@@ -9,13 +9,13 @@ namespace ff::geom::packing_detail {
 // Walls
 
 Real Walls::measure() const {
-  if (cylinder) return kPi * R * R * H;
+  if (cylinder) return dim == 3 ? kPi * R * R * H : kPi * R * R;
   const Vec3 e = hi - lo;
   return dim == 3 ? e.x() * e.y() * e.z() : e.x() * e.y();
 }
 
 Aabb Walls::bounds() const {
-  if (cylinder) return Aabb{Vec3(-R, -R, 0), Vec3(R, R, H)};
+  if (cylinder) return Aabb{Vec3(-R, -R, 0), Vec3(R, R, dim == 3 ? H : 0)};
   return dim == 3 ? Aabb{lo, hi} : Aabb{Vec3(lo.x(), lo.y(), 0), Vec3(hi.x(), hi.y(), 0)};
 }
 
@@ -27,7 +27,7 @@ Vec3 Walls::random_point(Rng& rng, Real r) const {
       x = rng.uniform(-rho, rho);
       y = rng.uniform(-rho, rho);
     } while (x * x + y * y > rho * rho);
-    return Vec3(x, y, rng.uniform(r, H - r));
+    return Vec3(x, y, dim == 3 ? rng.uniform(r, H - r) : 0.0);
   }
   Vec3 p = Vec3::Zero();
   for (int a = 0; a < dim; ++a) p[a] = rng.uniform(lo[a] + r, hi[a] - r);
@@ -49,6 +49,7 @@ void Walls::project(Vec3& x, Vec3& v, Real r) const {
         v.y() -= vr * ey;
       }
     }
+    if (dim == 2) return;  // circle: no end planes
     if (x.z() < r) {
       x.z() = r;
       v.z() = std::max(v.z(), Real(0));

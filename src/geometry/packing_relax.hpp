@@ -10,7 +10,7 @@
 namespace ff::geom::packing_detail {
 
 // Admissible centre positions for a particle of radius r: a z-axis cylinder (base z = 0) or a box;
-// in 2D the x-y rectangle with z = 0.
+// in 2D the x-y circle of radius R about the origin (cylinder = true) or the x-y rectangle, z = 0.
 struct Walls {
   int dim = 3;
   bool cylinder = true;
