@@ -28,6 +28,13 @@ struct SampleInfo {
   std::size_t floaters = 0;   // particles with fewer than 3 (3D) or 2 (2D) bonds
   std::size_t pore_particles = 0;  // removed before bonding: centre in a voxel of the "pore" window
   double genesis_seconds = 0;
+  // The packing genesis reached (reported in the log and summary.json).
+  double packing_seconds = 0;        // geometric packer (part of genesis_seconds)
+  long genesis_steps = 0;            // DEM cycles of the equilibration
+  bool equilibrium_reached = false;  // unbalanced_force_ratio <= sample.genesis_tolerance
+  Real unbalanced_force_ratio = 0;   // at the end of the equilibration (definition: docs/dem.md)
+  Real coordination_contacts = 0;    // touching contacts per particle (2 x contacts / N) when bonded
+  Real coordination_bonds = 0;       // bonds per particle (2 x bonds / N)
 };
 
 void declare_sample_params(ParamTable& t);

@@ -135,7 +135,9 @@ Packing dense_random_packing(const PackingSpec& spec) {
   // 3-4. Thermal compression, then FIRE with growth to full size. The settings were tuned on the
   // 30k-sphere cylinder: the thermal stage raises the overlap-free solid fraction there by ~0.006.
   RelaxSettings set;
-  set.skin = 0.3 * r_mean;
+  // Skin 0.8 r: the thermal stage moves every particle, so a thin skin rebuilds the list every few
+  // steps (0.3 r: rebuilds were 37% of the time); 0.8 r halves the total on the 28k cylinder.
+  set.skin = 0.8 * r_mean;
   set.tolerance = spec.overlap_tolerance * r_mean;
   set.growth_tolerance = std::max(set.tolerance, 0.01 * r_mean);
   set.growth_step = 1e-3;
@@ -144,6 +146,7 @@ Packing dense_random_packing(const PackingSpec& spec) {
   set.anneal_speed = 0.02 * r_mean;
   set.anneal_growth_rate = 0.01 * set.anneal_speed * packing_detail::kThermalDt / r_mean;  // 1% of thermal speed
   set.anneal_end_scale = std::max(spec.start_radius_scale, 0.985);
+  set.progress = n > 20000;
   VerletList nl(walls.bounds(), spec.dim, 2 * spec.radius_max + set.skin);
   const int anneal_steps = packing_detail::thermal_compression(s, walls, nl, set, rng);
   const packing_detail::RelaxResult rr = packing_detail::fire_relaxation(s, walls, nl, set);
@@ -151,6 +154,7 @@ Packing dense_random_packing(const PackingSpec& spec) {
   Packing out;
   out.achieved_porosity = 1 - solid / container;
   out.iterations = anneal_steps + rr.iterations;
+  out.thermal_steps = anneal_steps;
   out.converged = rr.converged;
   out.position = std::move(s.x);
   out.radius = std::move(s.r_full);

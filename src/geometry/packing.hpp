@@ -70,7 +70,8 @@ struct Packing {
   std::vector<Real> radius;    // [m]
   Real achieved_porosity = 0;  // 1 - (sum of particle volumes or areas) / container volume or area
   Real max_overlap_ratio = 0;  // max over contacts of overlap / min(r_i, r_j)
-  int iterations = 0;          // relaxation steps taken
+  int iterations = 0;          // relaxation steps taken (thermal + FIRE)
+  int thermal_steps = 0;       // of which in the thermal compression stage
   bool converged = false;      // max overlap reached overlap_tolerance * mean radius
 };
 

@@ -21,8 +21,8 @@ TEST(Packing30k, CylinderAtPorosity038) {
   const Packing p = dense_random_packing(spec);
   const double cpu = double(std::clock() - c0) / CLOCKS_PER_SEC;
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::printf("30k packing: N = %zu, porosity %.4f, max overlap/r_min %.4f, %d steps, %.2f s CPU, %.2f s wall\n",
-              p.radius.size(), p.achieved_porosity, p.max_overlap_ratio, p.iterations, cpu, wall);
+  std::printf("30k packing: N = %zu, porosity %.4f, max overlap/r_min %.4f, %d steps (%d thermal), %.2f s CPU, %.2f s wall\n",
+              p.radius.size(), p.achieved_porosity, p.max_overlap_ratio, p.iterations, p.thermal_steps, cpu, wall);
   EXPECT_GT(p.radius.size(), 27000u);
   EXPECT_TRUE(p.converged);
   EXPECT_NEAR(p.achieved_porosity, 0.38, 0.01);  // task tolerance
