@@ -71,9 +71,9 @@ void DemRun::open_outputs() {
   }
   if (opt.resume && on_curve() && *c_.rows > 0) {  // the elastic fit needs the whole curve
     const CsvTable t = read_csv(opt.out_dir / "series.csv");
-    e_hist_ = t.column("axial_strain");
+    e_hist_ = t.column(spec.strain_column);
     s_hist_ = t.column(spec.stress_column);
-    l_hist_ = t.column("lateral_strain");
+    l_hist_ = spec.lateral_column.empty() ? std::vector<Real>(e_hist_.size(), 0.0) : t.column(spec.lateral_column);
   }
 }
 
@@ -99,7 +99,7 @@ std::string DemRun::curve_row(const DemRowReport& r, double& fraction) {
   const bool past_peak = peak > 0 && *c_.rows > 10 && r.strain > *c_.strain_at_peak && r.stress < stop_fraction_ * peak;
   if (past_peak) stop = fmt::format("{} fell below {} of the peak", spec.stress_name, stop_fraction_);
   stopped_at_strain_cap_ = r.strain >= max_strain_;
-  if (stopped_at_strain_cap_) stop = fmt::format("axial strain reached {}.max_strain = {}", spec.name, max_strain_);
+  if (stopped_at_strain_cap_) stop = fmt::format("{} reached {}.max_strain = {}", spec.strain_name, spec.name, max_strain_);
   Real f = r.strain / max_strain_;
   if (peak > 0 && r.strain > *c_.strain_at_peak) f = std::max(f, (peak - r.stress) / (peak * (1 - stop_fraction_)));
   fraction = std::min(f, 1.0);
