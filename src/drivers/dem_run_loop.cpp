@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -106,6 +107,22 @@ std::string DemRun::curve_row(const DemRowReport& r, double& fraction) {
   return stop;
 }
 
+// A state can blow up without a NaN position (e.g. a huge body force: velocities overflow the
+// energies first); a NaN or inf measurement stops the run like a NaN position does.
+void DemRun::check_finite(const DemRowReport& r) const {
+  std::string what;
+  if (r.on_curve)
+    for (std::size_t k = 0; k < row.size() && k < columns.size() && what.empty(); ++k)
+      if (!std::isfinite(row[k])) what = fmt::format("series.csv column '{}' is {}", columns[k], row[k]);
+  if (what.empty() && !std::isfinite(r.strain + r.stress + r.lateral)) what = "the measured strain or stress is NaN/inf";
+  if (what.empty()) return;
+  throw NumericalError(fmt::format(
+      "the DEM run became unstable by step {} (t = {:.6g} s): {}. The last good checkpoint stays in {}/checkpoint and "
+      "the failing state is saved in {}/checkpoint_failed. Check dem.gravity and the loading rate ({}), lower "
+      "dem.time_step_safety (or dem.time_step), or raise dem.local_damping",
+      sys.step_count, sys.time, what, opt.out_dir.string(), opt.out_dir.string(), spec.long_run_keys));
+}
+
 RunStatus DemRun::run() {
   c_ = counters();
   const std::string& p = spec.name;
@@ -140,6 +157,7 @@ RunStatus DemRun::run() {
     for (;;) {
       advance(every);
       const DemRowReport r = measure();
+      check_finite(r);
       double fraction = r.fraction;
       if (r.on_curve) stop_reason = curve_row(r, fraction);
       progress.update(sys.step_count, sys.time, fraction, status);

@@ -119,6 +119,7 @@ class DemRun {
 
  private:
   void write_checkpoint(const std::filesystem::path& dir);
+  void check_finite(const DemRowReport& r) const;  // throws NumericalError naming the column
   void open_outputs();
   std::string curve_row(const DemRowReport& r, double& fraction);
   void finish(const std::string& stop_reason);
