@@ -40,18 +40,9 @@ nlohmann::json cracks_json(const dem::DemSystem& sys, int groups) {
 
 nlohmann::json sample_json(const dem::DemSystem& sys, const dem::SampleInfo& info, long particles) {
   const long n = particles < 0 ? static_cast<long>(sys.particles.size()) : particles;
-  nlohmann::json j = {{"particles", n},                   {"bonds", info.bonds},        {"porosity", info.porosity},
-                      {"height_m", info.height},          {"width_m", info.width},      {"locked_in_stress_Pa", info.locked_in_stress},
-                      {"floaters", info.floaters},        {"dimension", info.dim}};
-  if (info.genesis_steps > 0)  // built by genesis in this process (not kept in checkpoints)
-    j["genesis"] = {{"seconds", info.genesis_seconds},
-                    {"packing_seconds", info.packing_seconds},
-                    {"steps", info.genesis_steps},
-                    {"equilibrium_reached", info.equilibrium_reached},
-                    {"unbalanced_force_ratio", info.unbalanced_force_ratio},
-                    {"bonds_per_particle", info.coordination_bonds},
-                    {"contacts_per_particle", info.coordination_contacts}};
-  return j;
+  return {{"particles", n},                   {"bonds", info.bonds},        {"porosity", info.porosity},
+          {"height_m", info.height},          {"width_m", info.width},      {"locked_in_stress_Pa", info.locked_in_stress},
+          {"floaters", info.floaters},        {"dimension", info.dim}};
 }
 
 PlotJob axial_strain_plot(const std::filesystem::path& out, const std::string& name, const std::string& title,
