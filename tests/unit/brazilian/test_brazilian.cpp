@@ -177,7 +177,7 @@ TEST(Brazilian, ElasticDiscCentreStressMatchesTheClosedForm) {
 // data: BTS/DTS ~ 1.1-1.4 (DTS = f BTS, f ~ 0.7 sedimentary, 0.8 igneous, 0.9 metamorphic:
 // Perras & Diederichs 2014, Geotech. Geol. Eng. 32:525); Griffith's criterion gives exactly 1
 // (the centre's state, compression 3x the tension, fails at the uniaxial tensile strength).
-// This bonded-disk model gives ~0.55-0.65: the compression along the loaded diameter wedges the
+// This bonded-disk model gives ~0.5-0.65: the compression along the loaded diameter wedges the
 // bonded network open at the particle scale, and flat platens start cracks at their contacts.
 // The ratio is a calibration property of the micro-parameters, not a constant, so the check
 // (0.4-2) only catches a gross error (a lost factor 2, the wrong area or thickness).
