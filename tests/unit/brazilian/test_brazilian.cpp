@@ -1,7 +1,9 @@
 // The Brazilian and direct-tension drivers, through the fracflow program as a user runs them:
 // the stress at the centre of an elastic disc against the closed form, the tensile strength's
 // repeatability over packings, and the driver plumbing (check, outputs, resume bit for bit).
-// 2D samples of 300-700 disks keep the whole binary at about 20 s on one core.
+// 2D samples of 300-700 disks keep the whole binary at about 15 s on one core. The loading
+// speeds are quasi-static: halving them changes the strengths by 1-3% and the centre stresses
+// by less than their scatter.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
@@ -73,7 +75,7 @@ porosity = 0.2
 bond_gap = 0.2e-3
 seed = 1
 [direct_tension]
-grip_velocity = 0.05
+grip_velocity = 0.1
 [output]
 vtk = false
 plots = false
@@ -125,7 +127,7 @@ double coefficient_of_variation(const std::vector<double>& v) {
 // circle), rows after the first 0.2% of diametral strain (seating on the platens), the mean
 // over 4 packings. Tolerance 15% on that mean: one packing scatters by ~10% (force chains);
 // the flat platens spread P over an arc 2 alpha ~ 0.1 rad, which lowers the centre values by
-// ~1% (Hondros); the mean of 4 packings came within 3% (across) and 6% (along). The bond gap is
+// ~1% (Hondros); the mean of 4 packings came within 6% (across) and 2% (along). The bond gap is
 // 0.2 mm (4.9 bonds per disk): with the default 0.05 mm (3.6 bonds per disk, a network barely
 // above rigidity) the across stress reads ~24% low at this size, and ~10% low at twice the
 // diameter. A factor 2 in either formula, or the two components swapped, is off by 50% or more.
@@ -138,7 +140,7 @@ TEST(Brazilian, ElasticDiscCentreStressMatchesTheClosedForm) {
     const fs::path out = s / fmt::format("elastic{}", seed);
     // Bonds that cannot break; stop at the strain cap, long before anything would.
     run_scenario(file, out,
-                 fmt::format(" --set sample.diameter=30e-3 --set brazilian.platen_velocity=0.1"
+                 fmt::format(" --set sample.diameter=30e-3 --set brazilian.platen_velocity=0.2"
                              " --set brazilian.max_strain=0.006 --set brazilian.centre_gauge_radius={} --set sample.seed={}"
                              " --set dem.bond.matrix-matrix.tensile_strength=1e15 --set dem.bond.matrix-matrix.cohesion=1e15",
                              rho, seed));
