@@ -32,8 +32,11 @@ void declare_sample_params(ParamTable& t) {
   t.real("sample.locked_in_stress", 0.1e6, "Pa", "isotropic stress left in the packing when bonds are installed is reduced below this").positive();
   t.real("sample.bond_gap", 0.05e-3, "m", "bonds are installed between particles whose gap is at most this (seed 000: 0.05 mm)").non_negative();
   t.string("sample.default_group", "", "group of particles outside every region and image window (required when more than one group is declared)");
-  t.real("sample.genesis_tolerance", 1e-2, "-", "equilibrium criterion of the genesis: mean unbalanced-force ratio").positive();
-  t.integer("sample.genesis_max_steps", 1000, "-", "step cap of each genesis equilibration").positive();
+  t.real("sample.genesis_tolerance", 1e-2, "-",
+         "equilibrium criterion of the genesis: mean |unbalanced force| / max(mean contact force, force of one contact "
+         "at sample.locked_in_stress) (docs/dem.md); a warning when not met")
+      .positive();
+  t.integer("sample.genesis_max_steps", 1000, "-", "step cap of each genesis equilibration (after each radius shrink)").positive();
   // Regions assigning groups (later regions win).
   t.string("sample.region.*.group", "", "group of the particles whose centres lie in this region");
   t.string("sample.region.*.shape", "sphere", "region shape").one_of({"box", "sphere", "cylinder", "ellipsoid", "stl"});
