@@ -185,6 +185,11 @@ class BrazilianRun final : public DemRun {
                               {"within_half_radius_of_centre", peak ? nlohmann::json(centre) : nlohmann::json(nullptr)},
                               {"near_platens", peak ? nlohmann::json(platens) : nlohmann::json(nullptr)},
                               {"near_platens_means", "|y| > 0.75 R, where the platens crush the disc"}};
+    if (peak && platens > centre)
+      log::warn("brazilian: of the {} cracks before the peak, {} lie near the platens and {} within R/2 of the centre: "
+                "the platens crushed the disc before it split, so the peak may not measure the tensile strength (a "
+                "valid test splits from the centre, ISRM 1978)",
+                st_.cracks_at_peak, platens, centre);
     if (!peak) {
       j["peak"]["largest_stress_Pa"] = st_.peak_stress;
       log::warn("no tensile strength (null in summary.json): {}", out.no_peak);
