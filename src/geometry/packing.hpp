@@ -25,9 +25,10 @@
 //     (converged = false and a warning).
 // Deterministic for a seed: single thread, fixed loop orders, ff::Rng; independent of OpenMP
 // settings. Output particles are ordered along the cell grid (z slowest), not in drawing order.
-// Cost: ~2300 thermal steps + a few hundred to a few thousand FIRE steps, each O(N); the 28k-sphere
-// cylinder at porosity 0.38 takes ~7 s of CPU (tests/unit/geometry/test_packing_30k.cpp).
-// Small residual overlaps are left for the DEM stage to equilibrate with real contact forces.
+// Cost: ~750 thermal steps + a few hundred to a few thousand FIRE steps, each O(N); the 28k-sphere
+// cylinder at porosity 0.38 takes ~3 s of CPU (tests/unit/geometry/test_packing_30k.cpp; ~7 s with
+// the thermal step 0.2 and skin 0.3 r used before issue 13). Sample genesis asks for overlaps
+// below 2e-4 mean radii and leaves the rest to the DEM stage with real contact forces.
 // Achievable porosity: random close packing leaves about 0.36 (spheres) / 0.16 (disks), and walls
 // loosen the packing within about one diameter, so small containers need more. Requests below
 // kMinPorosity3D / kMinPorosity2D throw ff::InputError; requests between that and what the actual

@@ -1,7 +1,8 @@
 // Performance and quality of the PFC-size sample: ~28k spheres, radii 0.4-0.6 mm, in a 25 mm x
 // 50 mm cylinder at porosity 0.38 (Potyondy & Cundall 2004 use porosity ~0.35-0.38 for such samples).
-// Requirement: well under 30 s single-threaded; measured as this process's CPU time so that other
-// jobs on a shared machine cannot make it fail (wall time is printed too).
+// Requirement: a 25k-sphere genesis in under 5 s on 2 cores (issue 13), of which the single-threaded
+// packer is most: under 10 s of CPU here (3.0 s measured, 6.5 s before issue 13); measured as this
+// process's CPU time so that other jobs on a shared machine cannot make it fail (wall time printed).
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -33,7 +34,7 @@ TEST(Packing30k, CylinderAtPorosity038) {
     ASSERT_GE(x.z() - p.radius[i], -1e-15) << i;
     ASSERT_LE(x.z() + p.radius[i], spec.cyl_height * (1 + 1e-12)) << i;
   }
-  EXPECT_LT(cpu, 30.0);
+  EXPECT_LT(cpu, 10.0);
 }
 
 }  // namespace
