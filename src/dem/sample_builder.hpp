@@ -17,17 +17,24 @@ namespace ff::dem {
 struct SampleInfo {
   int dim = 3;
   int axis = 2;               // loading axis: z in 3D, y in 2D
-  Real height = 0;            // along the loading axis, platen to platen [m]
-  Real width = 0;             // cylinder diameter or box width [m]
+  Real height = 0;            // along the loading axis, platen to platen [m] (disc: its diameter)
+  Real width = 0;             // cylinder or disc diameter, or box width [m]
   Real area = 0;              // loaded cross-section [m^2] (2D: width x 1 m)
-  Real volume = 0;            // container volume [m^3] (2D: area x 1 m)
-  bool cylinder = true;
+  Real volume = 0;            // container volume [m^3] (2D: area of the rectangle or circle x 1 m)
+  bool cylinder = true;       // round about the z axis through the origin: 3D cylinder or 2D disc (dim = 2)
   Real porosity = 0;          // after genesis
   Real locked_in_stress = 0;  // mean stress when bonds were installed [Pa], compression > 0
   std::size_t bonds = 0;
   std::size_t floaters = 0;   // particles with fewer than 3 (3D) or 2 (2D) bonds
   std::size_t pore_particles = 0;  // removed before bonding: centre in a voxel of the "pore" window
   double genesis_seconds = 0;
+  // The packing genesis reached (reported in the log and summary.json).
+  double packing_seconds = 0;        // geometric packer (part of genesis_seconds)
+  long genesis_steps = 0;            // DEM cycles of the equilibration
+  bool equilibrium_reached = false;  // unbalanced_force_ratio <= sample.genesis_tolerance
+  Real unbalanced_force_ratio = 0;   // at the end of the equilibration (definition: docs/dem.md)
+  Real coordination_contacts = 0;    // touching contacts per particle (2 x contacts / N) when bonded
+  Real coordination_bonds = 0;       // bonds per particle (2 x bonds / N)
 };
 
 void declare_sample_params(ParamTable& t);

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -94,9 +95,9 @@ void DemRun::open_outputs() {
   }
   if (opt.resume && on_curve() && *c_.rows > 0) {  // the elastic fit needs the whole curve
     const CsvTable t = read_csv(opt.out_dir / "series.csv");
-    e_hist_ = t.column("axial_strain");
+    e_hist_ = t.column(spec.strain_column);
     s_hist_ = t.column(spec.stress_column);
-    l_hist_ = t.column("lateral_strain");
+    l_hist_ = spec.lateral_column.empty() ? std::vector<Real>(e_hist_.size(), 0.0) : t.column(spec.lateral_column);
   }
 }
 
@@ -127,11 +128,27 @@ std::string DemRun::curve_row(const DemRowReport& r, double& fraction) {
   const bool past_peak = peak > 0 && *c_.rows > 10 && r.strain > *c_.strain_at_peak && r.stress < stop_fraction_ * peak;
   if (past_peak) stop = fmt::format("{} fell below {} of the peak", spec.stress_name, stop_fraction_);
   stopped_at_strain_cap_ = r.strain >= max_strain_;
-  if (stopped_at_strain_cap_) stop = fmt::format("axial strain reached {}.max_strain = {}", spec.name, max_strain_);
+  if (stopped_at_strain_cap_) stop = fmt::format("{} reached {}.max_strain = {}", spec.strain_name, spec.name, max_strain_);
   Real f = r.strain / max_strain_;
   if (peak > 0 && r.strain > *c_.strain_at_peak) f = std::max(f, (peak - r.stress) / (peak * (1 - stop_fraction_)));
   fraction = std::min(f, 1.0);
   return stop;
+}
+
+// A state can blow up without a NaN position (e.g. a huge body force: velocities overflow the
+// energies first); a NaN or inf measurement stops the run like a NaN position does.
+void DemRun::check_finite(const DemRowReport& r) const {
+  std::string what;
+  if (r.on_curve)
+    for (std::size_t k = 0; k < row.size() && k < columns.size() && what.empty(); ++k)
+      if (!std::isfinite(row[k])) what = fmt::format("series.csv column '{}' is {}", columns[k], row[k]);
+  if (what.empty() && !std::isfinite(r.strain + r.stress + r.lateral)) what = "the measured strain or stress is NaN/inf";
+  if (what.empty()) return;
+  throw NumericalError(fmt::format(
+      "the DEM run became unstable by step {} (t = {:.6g} s): {}. The last good checkpoint stays in {}/checkpoint and "
+      "the failing state is saved in {}/checkpoint_failed. Check dem.gravity and the loading rate ({}), lower "
+      "dem.time_step_safety (or dem.time_step), or raise dem.local_damping",
+      sys.step_count, sys.time, what, opt.out_dir.string(), opt.out_dir.string(), spec.long_run_keys));
 }
 
 RunStatus DemRun::run() {
@@ -168,6 +185,7 @@ RunStatus DemRun::run() {
     for (;;) {
       advance(every);
       const DemRowReport r = measure();
+      check_finite(r);
       double fraction = r.fraction;
       if (r.on_curve) stop_reason = curve_row(r, fraction);
       progress.update(sys.step_count, sys.time, fraction, status);

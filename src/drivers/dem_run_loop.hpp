@@ -58,6 +58,10 @@ struct DemRunSpec {
   std::string stress_name;  // "stress", "differential stress" (stop reason)
   std::string stress_column;  // series.csv column of the curve's stress (re-read on resume)
   std::string long_run_keys;  // keys that shorten a long run
+  // The curve's strain columns of series.csv (re-read on resume for the elastic fit) and the
+  // strain's name in the stop message; an empty lateral column: none (the fit's lateral
+  // strain is 0).
+  std::string strain_column = "axial_strain", lateral_column = "lateral_strain", strain_name = "axial strain";
 };
 
 class DemRun {
@@ -115,6 +119,7 @@ class DemRun {
 
  private:
   void write_checkpoint(const std::filesystem::path& dir);
+  void check_finite(const DemRowReport& r) const;  // throws NumericalError naming the column
   void open_outputs();
   std::string curve_row(const DemRowReport& r, double& fraction);
   void finish(const std::string& stop_reason);

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "drivers/brazilian/brazilian_driver.hpp"
 #include "drivers/common_params.hpp"
 #include "drivers/driver.hpp"
 #include "drivers/triaxial/triaxial_driver.hpp"
@@ -19,6 +20,8 @@ const std::vector<Driver>& driver_list() {
   static const std::vector<Driver> list = {
       drivers::ucs_driver(),
       drivers::triaxial_driver(),
+      drivers::brazilian_driver(),
+      drivers::direct_tension_driver(),
       drivers::flow_poiseuille_driver(),
       drivers::flow_cavity_driver(),
       drivers::flow_cylinder_driver(),

@@ -27,9 +27,6 @@ Real particle_measure(int dim, Real r) { return dim == 3 ? 4.0 / 3.0 * kPi * r *
 void check_packing_spec(const PackingSpec& p) {
   auto bad = [](const std::string& what) { throw InputError("packing: " + what); };
   if (p.dim != 2 && p.dim != 3) bad(fmt::format("dim = {} must be 2 or 3", p.dim));
-  if (p.dim == 2 && p.container != PackingSpec::Container::Box) {
-    bad("dim = 2 packs disks in a rectangle: use container = Box (box_lo, box_hi in x-y)");
-  }
   if (!(p.radius_min > 0) || !(p.radius_max >= p.radius_min) || !std::isfinite(p.radius_max)) {
     bad(fmt::format("radius range [{}, {}] must satisfy 0 < radius_min <= radius_max", p.radius_min, p.radius_max));
   }
@@ -40,7 +37,11 @@ void check_packing_spec(const PackingSpec& p) {
                     p.porosity, p.dim == 3 ? "spheres (3D)" : "disks (2D)", min_porosity, p.dim == 3 ? 0.36 : 0.16));
   }
   const Real d = 2 * p.radius_max;
-  if (p.container == PackingSpec::Container::Cylinder) {
+  if (p.container == PackingSpec::Container::Cylinder && p.dim == 2) {
+    if (!(p.cyl_radius >= d) || !std::isfinite(p.cyl_radius)) {
+      bad(fmt::format("circle diameter {} must be at least two largest particle diameters ({})", 2 * p.cyl_radius, 2 * d));
+    }
+  } else if (p.container == PackingSpec::Container::Cylinder) {
     if (!(p.cyl_radius >= d) || !(p.cyl_height >= 2 * d) || !std::isfinite(p.cyl_radius * p.cyl_height)) {
       bad(fmt::format("cylinder diameter {} and height {} must be at least two largest particle diameters ({})",
                       2 * p.cyl_radius, p.cyl_height, 2 * d));
@@ -59,7 +60,7 @@ void check_packing_spec(const PackingSpec& p) {
     bad(fmt::format("start_radius_scale {} must be in (0, 1]", p.start_radius_scale));
   }
   const Real container = p.container == PackingSpec::Container::Cylinder
-                             ? kPi * p.cyl_radius * p.cyl_radius * p.cyl_height
+                             ? kPi * p.cyl_radius * p.cyl_radius * (p.dim == 3 ? p.cyl_height : 1.0)
                              : (p.box_hi - p.box_lo).head(p.dim).prod();
   const Real expected = (1 - p.porosity) * container / particle_measure(p.dim, 0.5 * (p.radius_min + p.radius_max));
   if (expected > 5e7) {
@@ -134,7 +135,9 @@ Packing dense_random_packing(const PackingSpec& spec) {
   // 3-4. Thermal compression, then FIRE with growth to full size. The settings were tuned on the
   // 30k-sphere cylinder: the thermal stage raises the overlap-free solid fraction there by ~0.006.
   RelaxSettings set;
-  set.skin = 0.3 * r_mean;
+  // Skin 0.8 r: the thermal stage moves every particle, so a thin skin rebuilds the list every few
+  // steps (0.3 r: rebuilds were 37% of the time); 0.8 r halves the total on the 28k cylinder.
+  set.skin = 0.8 * r_mean;
   set.tolerance = spec.overlap_tolerance * r_mean;
   set.growth_tolerance = std::max(set.tolerance, 0.01 * r_mean);
   set.growth_step = 1e-3;
@@ -143,6 +146,7 @@ Packing dense_random_packing(const PackingSpec& spec) {
   set.anneal_speed = 0.02 * r_mean;
   set.anneal_growth_rate = 0.01 * set.anneal_speed * packing_detail::kThermalDt / r_mean;  // 1% of thermal speed
   set.anneal_end_scale = std::max(spec.start_radius_scale, 0.985);
+  set.progress = n > 20000;
   VerletList nl(walls.bounds(), spec.dim, 2 * spec.radius_max + set.skin);
   const int anneal_steps = packing_detail::thermal_compression(s, walls, nl, set, rng);
   const packing_detail::RelaxResult rr = packing_detail::fire_relaxation(s, walls, nl, set);
@@ -150,6 +154,7 @@ Packing dense_random_packing(const PackingSpec& spec) {
   Packing out;
   out.achieved_porosity = 1 - solid / container;
   out.iterations = anneal_steps + rr.iterations;
+  out.thermal_steps = anneal_steps;
   out.converged = rr.converged;
   out.position = std::move(s.x);
   out.radius = std::move(s.r_full);

@@ -4,7 +4,7 @@
 // (Potyondy & Cundall 2004, Int. J. Rock Mech. Min. Sci. 41:1329, Sec. 3.1) and the force-biased
 // family (Jodrey & Tory 1985, Phys. Rev. A 32:2347; Moscinski et al. 1989, Mol. Simul. 3:201):
 //  1. Draw radii uniformly in [radius_min, radius_max] until the solid volume (2D: disk area) is
-//     closest to (1 - porosity) * container volume (2D: rectangle area); N follows from that.
+//     closest to (1 - porosity) * container volume (2D: circle or rectangle area); N follows from that.
 //  2. Place the centres uniformly at random inside the container shrunk by each radius, with the
 //     radii at start_radius_scale of full size.
 //  3. Geometric relaxation: every overlapping pair pushes both partners apart along its normal by
@@ -25,9 +25,10 @@
 //     (converged = false and a warning).
 // Deterministic for a seed: single thread, fixed loop orders, ff::Rng; independent of OpenMP
 // settings. Output particles are ordered along the cell grid (z slowest), not in drawing order.
-// Cost: ~2300 thermal steps + a few hundred to a few thousand FIRE steps, each O(N); the 28k-sphere
-// cylinder at porosity 0.38 takes ~7 s of CPU (tests/unit/geometry/test_packing_30k.cpp).
-// Small residual overlaps are left for the DEM stage to equilibrate with real contact forces.
+// Cost: ~750 thermal steps + a few hundred to a few thousand FIRE steps, each O(N); the 28k-sphere
+// cylinder at porosity 0.38 takes ~3 s of CPU (tests/unit/geometry/test_packing_30k.cpp; ~7 s with
+// the thermal step 0.2 and skin 0.3 r used before issue 13). Sample genesis asks for overlaps
+// below 2e-4 mean radii and leaves the rest to the DEM stage with real contact forces.
 // Achievable porosity: random close packing leaves about 0.36 (spheres) / 0.16 (disks), and walls
 // loosen the packing within about one diameter, so small containers need more. Requests below
 // kMinPorosity3D / kMinPorosity2D throw ff::InputError; requests between that and what the actual
@@ -46,7 +47,8 @@ inline constexpr Real kMinPorosity3D = 0.35;
 inline constexpr Real kMinPorosity2D = 0.16;
 
 struct PackingSpec {
-  int dim = 3;  // 3: spheres in a cylinder or box; 2: disks (z = 0) in a rectangle
+  int dim = 3;  // 3: spheres in a cylinder or box; 2: disks (z = 0) in a circle or rectangle
+  // Cylinder in 2D: the circle of radius cyl_radius about the origin in the x-y plane (cyl_height ignored).
   enum class Container { Cylinder, Box } container = Container::Cylinder;
   Real cyl_radius = 12.5e-3, cyl_height = 50e-3;  // cylinder along z, base at z = 0, axis at x = y = 0 [m]
   Vec3 box_lo{0, 0, 0}, box_hi{25e-3, 25e-3, 50e-3};  // box (2D: x-y rectangle, z ignored) [m]
@@ -69,7 +71,8 @@ struct Packing {
   std::vector<Real> radius;    // [m]
   Real achieved_porosity = 0;  // 1 - (sum of particle volumes or areas) / container volume or area
   Real max_overlap_ratio = 0;  // max over contacts of overlap / min(r_i, r_j)
-  int iterations = 0;          // relaxation steps taken
+  int iterations = 0;          // relaxation steps taken (thermal + FIRE)
+  int thermal_steps = 0;       // of which in the thermal compression stage
   bool converged = false;      // max overlap reached overlap_tolerance * mean radius
 };
 

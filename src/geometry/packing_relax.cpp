@@ -1,7 +1,10 @@
 #include "geometry/packing_relax.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+
+#include "core/log.hpp"
 
 namespace ff::geom::packing_detail {
 
@@ -9,13 +12,13 @@ namespace ff::geom::packing_detail {
 // Walls
 
 Real Walls::measure() const {
-  if (cylinder) return kPi * R * R * H;
+  if (cylinder) return dim == 3 ? kPi * R * R * H : kPi * R * R;
   const Vec3 e = hi - lo;
   return dim == 3 ? e.x() * e.y() * e.z() : e.x() * e.y();
 }
 
 Aabb Walls::bounds() const {
-  if (cylinder) return Aabb{Vec3(-R, -R, 0), Vec3(R, R, H)};
+  if (cylinder) return Aabb{Vec3(-R, -R, 0), Vec3(R, R, dim == 3 ? H : 0)};
   return dim == 3 ? Aabb{lo, hi} : Aabb{Vec3(lo.x(), lo.y(), 0), Vec3(hi.x(), hi.y(), 0)};
 }
 
@@ -27,7 +30,7 @@ Vec3 Walls::random_point(Rng& rng, Real r) const {
       x = rng.uniform(-rho, rho);
       y = rng.uniform(-rho, rho);
     } while (x * x + y * y > rho * rho);
-    return Vec3(x, y, rng.uniform(r, H - r));
+    return Vec3(x, y, dim == 3 ? rng.uniform(r, H - r) : 0.0);
   }
   Vec3 p = Vec3::Zero();
   for (int a = 0; a < dim; ++a) p[a] = rng.uniform(lo[a] + r, hi[a] - r);
@@ -49,6 +52,7 @@ void Walls::project(Vec3& x, Vec3& v, Real r) const {
         v.y() -= vr * ey;
       }
     }
+    if (dim == 2) return;  // circle: no end planes
     if (x.z() < r) {
       x.z() = r;
       v.z() = std::max(v.z(), Real(0));
@@ -177,6 +181,21 @@ ForceSums overlap_forces(State& s, const VerletList& nl) {
   return sums;
 }
 
+// A log line every 3 s when asked (checked every 64 steps).
+class Progress {
+ public:
+  explicit Progress(bool on) : on_(on), last_(std::chrono::steady_clock::now()) {}
+  bool due(int step) {
+    if (!on_ || step % 64 != 0 || std::chrono::steady_clock::now() - last_ < std::chrono::seconds(3)) return false;
+    last_ = std::chrono::steady_clock::now();
+    return true;
+  }
+
+ private:
+  bool on_;
+  std::chrono::steady_clock::time_point last_;
+};
+
 // Rebuilds the list when it may have missed a pair: 2 * (max displacement + radius growth) > skin.
 class ListGuard {
  public:
@@ -210,7 +229,11 @@ int thermal_compression(State& s, const Walls& walls, VerletList& nl, const Rela
   const Real target_v2 = set.anneal_speed * set.anneal_speed * walls.dim * static_cast<Real>(n);
   ListGuard guard(s, nl, set.skin);
   int steps = 0;
+  Progress progress(set.progress);
   while (s.scale < set.anneal_end_scale) {
+    if (progress.due(steps))
+      log::info("packing: {} particles, thermal compression step {}, radii at {:.4f} of full size (stage ends at {:.4f})", n,
+                steps, s.scale, set.anneal_end_scale);
     guard.update(s);
     overlap_forces(s, nl);
     Real v2 = 0;
@@ -248,9 +271,13 @@ RelaxResult fire_relaxation(State& s, const Walls& walls, VerletList& nl, const 
   RelaxResult res;
   Real best = INFINITY;  // lowest max overlap since the last growth
   int last_progress = 0;
+  Progress progress(set.progress);
   for (int it = 0; it < set.max_iterations; ++it) {
     guard.update(s);
     ForceSums fs = overlap_forces(s, nl);
+    if (progress.due(it))
+      log::info("packing: {} particles, relaxation step {}, radii at {:.4f} of full size, max overlap {:.2g} (target {:.2g})",
+                n, it, s.scale, fs.max_overlap, set.tolerance);
     res.max_overlap = fs.max_overlap;
     res.iterations = it;
     if (s.scale >= 1 && fs.max_overlap < set.tolerance) {

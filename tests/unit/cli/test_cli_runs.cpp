@@ -293,3 +293,18 @@ TEST(CliRuns, SignalDuringSetUpEndsAtOnceAndLeavesTheOldRun) {
   EXPECT_EQ(slurp(dir / "summary.json"), summary);
   EXPECT_EQ(std::distance(fs::directory_iterator(s.path), fs::directory_iterator()), 2) << "only the run and the log";
 }
+
+TEST(CliRuns, ARunThatBlowsUpStopsWithAdviceAndKeepsItsCheckpoints) {
+  // A body force of 1e300 m/s^2 overflows the velocities' energies before any position becomes
+  // NaN: the run used to go on for ever with NaN strains and infinite kinetic energy.
+  Scratch s;
+  const fs::path dir = s / "run";
+  const auto r = run("run --out " + dir.string() + kTiny + " --set 'dem.gravity=[0,0,-1e300]'");
+  EXPECT_EQ(r.code, 3) << r.output;
+  EXPECT_NE(r.output.find("became unstable"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("dem.gravity"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("dem.time_step_safety"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(dir / "checkpoint" / "state.ffcp")) << "the last good checkpoint stays";
+  EXPECT_TRUE(fs::exists(dir / "checkpoint_failed" / "state.ffcp")) << "the failing state is kept for inspection";
+  EXPECT_FALSE(fs::exists(dir / "summary.json")) << "no result from a broken run";
+}

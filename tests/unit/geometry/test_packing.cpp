@@ -37,7 +37,7 @@ void check_packing(const PackingSpec& spec, const Packing& p) {
   ASSERT_EQ(p.position.size(), p.radius.size());
   EXPECT_TRUE(p.converged);
   const Real volume = spec.container == PackingSpec::Container::Cylinder
-                          ? kPi * spec.cyl_radius * spec.cyl_radius * spec.cyl_height
+                          ? kPi * spec.cyl_radius * spec.cyl_radius * (spec.dim == 3 ? spec.cyl_height : 1.0)
                           : (spec.dim == 3 ? (spec.box_hi - spec.box_lo).prod()
                                            : (spec.box_hi - spec.box_lo).head<2>().prod());
   const Real porosity = 1 - solid_measure(p, spec.dim) / volume;
@@ -51,8 +51,10 @@ void check_packing(const PackingSpec& spec, const Packing& p) {
     ASSERT_LE(r, spec.radius_max);
     if (spec.container == PackingSpec::Container::Cylinder) {
       ASSERT_LE(std::hypot(x.x(), x.y()) + r, spec.cyl_radius + eps) << i;
-      ASSERT_GE(x.z() - r, -eps) << i;
-      ASSERT_LE(x.z() + r, spec.cyl_height + eps) << i;
+      if (spec.dim == 3) {
+        ASSERT_GE(x.z() - r, -eps) << i;
+        ASSERT_LE(x.z() + r, spec.cyl_height + eps) << i;
+      }
     } else {
       for (int a = 0; a < spec.dim; ++a) {
         ASSERT_GE(x[a] - r, spec.box_lo[a] - eps) << i;
@@ -101,6 +103,18 @@ TEST(Packing, DisksInRectangleReachPorosity018) {
   check_packing(spec, p);
 }
 
+// 2D disc (Brazilian test sample): disks in a circle of diameter 40 mm about the origin.
+TEST(Packing, DisksInCircleReachPorosity018) {
+  PackingSpec spec;
+  spec.dim = 2;
+  spec.container = PackingSpec::Container::Cylinder;
+  spec.cyl_radius = 20e-3;
+  spec.porosity = 0.18;
+  const Packing p = dense_random_packing(spec);
+  EXPECT_GT(p.radius.size(), 1000u);
+  check_packing(spec, p);
+}
+
 TEST(Packing, SameSeedSameArraysOtherSeedDifferent) {
   PackingSpec spec;
   spec.dim = 2;
@@ -137,8 +151,9 @@ TEST(Packing, UnreachableOrInvalidSpecsAreInputErrors) {
   EXPECT_NE(msg.find("0.35"), std::string::npos) << msg;
 
   PackingSpec flat;
-  flat.dim = 2;  // disks need the rectangle
-  EXPECT_NE(input_error([&] { dense_random_packing(flat); }).find("Box"), std::string::npos);
+  flat.dim = 2;
+  flat.cyl_radius = 1e-3;  // a circle narrower than two diameters
+  EXPECT_NE(input_error([&] { dense_random_packing(flat); }).find("circle diameter"), std::string::npos);
   flat.container = PackingSpec::Container::Box;
   flat.box_hi = Vec3(20e-3, 20e-3, 0);
   flat.porosity = 0.12;

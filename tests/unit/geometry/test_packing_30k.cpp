@@ -1,7 +1,8 @@
 // Performance and quality of the PFC-size sample: ~28k spheres, radii 0.4-0.6 mm, in a 25 mm x
 // 50 mm cylinder at porosity 0.38 (Potyondy & Cundall 2004 use porosity ~0.35-0.38 for such samples).
-// Requirement: well under 30 s single-threaded; measured as this process's CPU time so that other
-// jobs on a shared machine cannot make it fail (wall time is printed too).
+// Requirement: a 25k-sphere genesis in under 5 s on 2 cores (issue 13), of which the single-threaded
+// packer is most: under 10 s of CPU here (3.0 s measured, 6.5 s before issue 13); measured as this
+// process's CPU time so that other jobs on a shared machine cannot make it fail (wall time printed).
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -21,8 +22,8 @@ TEST(Packing30k, CylinderAtPorosity038) {
   const Packing p = dense_random_packing(spec);
   const double cpu = double(std::clock() - c0) / CLOCKS_PER_SEC;
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::printf("30k packing: N = %zu, porosity %.4f, max overlap/r_min %.4f, %d steps, %.2f s CPU, %.2f s wall\n",
-              p.radius.size(), p.achieved_porosity, p.max_overlap_ratio, p.iterations, cpu, wall);
+  std::printf("30k packing: N = %zu, porosity %.4f, max overlap/r_min %.4f, %d steps (%d thermal), %.2f s CPU, %.2f s wall\n",
+              p.radius.size(), p.achieved_porosity, p.max_overlap_ratio, p.iterations, p.thermal_steps, cpu, wall);
   EXPECT_GT(p.radius.size(), 27000u);
   EXPECT_TRUE(p.converged);
   EXPECT_NEAR(p.achieved_porosity, 0.38, 0.01);  // task tolerance
@@ -33,7 +34,7 @@ TEST(Packing30k, CylinderAtPorosity038) {
     ASSERT_GE(x.z() - p.radius[i], -1e-15) << i;
     ASSERT_LE(x.z() + p.radius[i], spec.cyl_height * (1 + 1e-12)) << i;
   }
-  EXPECT_LT(cpu, 30.0);
+  EXPECT_LT(cpu, 10.0);
 }
 
 }  // namespace
