@@ -114,7 +114,7 @@ struct ParallelBond {
   }
   static Prepared prepare(const Material& m) { return coeffs(m); }
   static State install(const Material&, const BondEnds&) { return install(); }
-  static BondFailure compute_bond(const Prepared& c, State& st, const ParticleStore& P, Index i, Index j, Real dt,
+  [[gnu::always_inline]] static BondFailure compute_bond(const Prepared& c, State& st, const ParticleStore& P, Index i, Index j, Real dt,
                                   int dim, BondLoad& load) {
     ContactGeom g;
     sphere_sphere(g, P.pos[i], P.radius[i], P.pos[j], P.radius[j]);
@@ -147,7 +147,7 @@ struct ParallelBond {
 
   // One step: update the stored loads from the increments in g, check failure, and return the
   // loads on both ends. Failure is judged on the loads after this step's increment.
-  static BondFailure compute(const Coeffs& c, State& s, const ContactGeom& g, Real dt, int dim, BondLoad& out,
+  [[gnu::always_inline]] static BondFailure compute(const Coeffs& c, State& s, const ContactGeom& g, Real dt, int dim, BondLoad& out,
                              Stress* stress_out = nullptr) {
     const Section sec = section(c, g.rA, g.rB, dim);
     // Stored shear force and bending moment follow the contact plane.

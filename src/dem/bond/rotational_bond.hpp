@@ -118,7 +118,7 @@ struct RotationalBond {
     return rb;
   }
   static Prepared prepare(const Material& m) { return m; }
-  static BondFailure compute_bond(const Prepared& m, State& st, const ParticleStore& P, Index i, Index j, Real /*dt*/,
+  [[gnu::always_inline]] static BondFailure compute_bond(const Prepared& m, State& st, const ParticleStore& P, Index i, Index j, Real /*dt*/,
                                   int /*dim*/, BondLoad& load) {
     const BondEnds e{P.pos[i], P.pos[j], P.orient[i], P.orient[j], P.radius[i], P.radius[j]};
     return compute(m, st, e, load);

@@ -41,12 +41,12 @@ struct ContactWork {
 // tracking", slip energy E_mu of the linear model). With a stiffness that varies along the path
 // (Hertz-Mindlin) the stored energy is the sum of these increments, the "work of the shear force
 // increments", rather than |Fs|^2/(2 k) with the current k.
-inline void shear_work(const Vec3& f0, const Vec3& f1, Real k, const Vec3& ds, ContactWork& w) {
+[[gnu::always_inline]] inline void shear_work(const Vec3& f0, const Vec3& f1, Real k, const Vec3& ds, ContactWork& w) {
   w.shear = (f1.squaredNorm() - f0.squaredNorm()) / (2 * k);
   w.slip = -0.5 * (f0 + f1).dot(ds + (f1 - f0) / k);
 }
 
-inline void contact_kinematics(ContactGeom& g, const Vec3& xA, const Vec3& vA, const Vec3& wA, const Vec3& xB,
+[[gnu::always_inline]] inline void contact_kinematics(ContactGeom& g, const Vec3& xA, const Vec3& vA, const Vec3& wA, const Vec3& xB,
                                const Vec3& vB, const Vec3& wB, Real dt) {
   const Vec3 vc = (vB + wB.cross(g.xc - xB)) - (vA + wA.cross(g.xc - xA));
   const Real vn = vc.dot(g.n);
@@ -59,7 +59,7 @@ inline void contact_kinematics(ContactGeom& g, const Vec3& xA, const Vec3& vA, c
 // Brings a stored shear vector into the current contact plane: drop the out-of-plane part,
 // keep the magnitude, rotate by the mean spin about n (standard incremental DEM practice,
 // as YADE/LIGGGHTS; METHODS.md 1.2).
-inline void rotate_into_plane(Vec3& v, const ContactGeom& g, Real dt) {
+[[gnu::always_inline]] inline void rotate_into_plane(Vec3& v, const ContactGeom& g, Real dt) {
   const Real mag2 = v.squaredNorm();
   if (mag2 == 0) return;
   const Real vn = v.dot(g.n);
@@ -74,7 +74,7 @@ inline void rotate_into_plane(Vec3& v, const ContactGeom& g, Real dt) {
 }
 
 // Sphere-sphere geometry; returns false when the centres coincide (then n is arbitrary, x).
-inline bool sphere_sphere(ContactGeom& g, const Vec3& xA, Real rA, const Vec3& xB, Real rB) {
+[[gnu::always_inline]] inline bool sphere_sphere(ContactGeom& g, const Vec3& xA, Real rA, const Vec3& xB, Real rB) {
   const Vec3 d = xB - xA;
   const Real d2 = d.squaredNorm(), dist = std::sqrt(d2);
   g.n = d2 > 0 ? Vec3(d * (1.0 / dist)) : Vec3::UnitX();

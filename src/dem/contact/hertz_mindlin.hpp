@@ -74,7 +74,7 @@ struct HertzMindlinContact {
   }
   // With kEnergy, `w` receives the shear spring's work and the slip dissipation (shear_work()).
   template <bool kEnergy = false>
-  static Vec3 force(const Params& p, const ContactGeom& g, State& s, Real dt, int /*dim*/, Real& fn,
+  [[gnu::always_inline]] static Vec3 force(const Params& p, const ContactGeom& g, State& s, Real dt, int /*dim*/, Real& fn,
                     ContactWork* w = nullptr) {
     if (g.gap >= 0) {
       fn = 0;

@@ -58,7 +58,7 @@ struct LinearContact {
   // Force on B. `fn` returns the compressive normal force magnitude [N].
   // With kEnergy, `w` receives the shear spring's work and the slip dissipation (shear_work()).
   template <bool kEnergy = false>
-  static Vec3 force(const Params& p, const ContactGeom& g, State& s, Real dt, int dim, Real& fn,
+  [[gnu::always_inline]] static Vec3 force(const Params& p, const ContactGeom& g, State& s, Real dt, int dim, Real& fn,
                     ContactWork* w = nullptr) {
     const Real kn = normal_stiffness(p, g.rA, g.rB, dim);
     const Real ks = kn / p.kratio;
