@@ -43,34 +43,6 @@ Real kinetic_energy(const DemSystem& s) {
   });
 }
 
-Real strain_energy(const DemSystem& s) {
-  const auto& x = s.particles.pos;
-  const auto& r = s.particles.radius;
-  const auto& materials = s.materials;
-  const auto pi = s.neighbors().first(), pj = s.neighbors().second();
-  const auto& cstate = s.contact_state();
-  const int dim = s.settings.dim;
-  Real e = 0;
-  materials.with_contact_law([&]<class Law>(std::type_identity<Law>) {
-    const auto& prm = materials.contact_params<Law>();
-    for (std::size_t p = 0; p < pi.size(); ++p) {
-      const Index a = pi[p], b = pj[p];
-      const Real gap = (x[b] - x[a]).norm() - r[a] - r[b];
-      if (gap >= 0) continue;
-      const int pt = materials.pair(s.particles.group[a], s.particles.group[b]);
-      e += Law::strain_energy(prm[pt], r[a], r[b], -gap, cstate[p], dim);
-    }
-  });
-  const BondSet& bs = s.bonds;
-  materials.with_bond_law([&]<class Law>(std::type_identity<Law>) {
-    const auto& mats = materials.bond_params<Law>();
-    const auto& st = bs.state<Law>();
-    for (std::size_t b = 0; b < bs.size(); ++b)
-      if (!bs.broken[b]) e += Law::energy(mats[bs.pair[b]], st[b], r[bs.i[b]], r[bs.j[b]], dim);
-  });
-  return e;
-}
-
 namespace {
 // Normal springs of the touching contacts plus the intact bonds [J] (with_shear: also the shear
 // springs' |Fs|^2/(2 k)).
@@ -112,6 +84,8 @@ Real inertial_kinetic_energy(const DemSystem& s) {
   });
 }
 }  // namespace
+
+Real strain_energy(const DemSystem& s) { return contact_and_bond_energy(s, true); }
 
 void start_energy_tracking(DemSystem& s) {
   EnergyBook b;
