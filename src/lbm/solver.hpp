@@ -38,8 +38,13 @@ enum class CellType : std::uint8_t { Fluid = 0, Solid = 1, Open = 2 };
 // Condition on one face of the box (faces numbered as in grid.hpp). Periodic is set by
 // the Grid; the other kinds need a non-periodic axis.
 struct FaceCondition {
-  enum class Kind { Periodic, Wall, Velocity, Pressure };
+  // Outflow: an open face whose unknown populations are extrapolated from the interior
+  // (zero-gradient) or convected out with the velocity `convective_velocity` (Yang 2013).
+  enum class Kind { Periodic, Wall, Velocity, Pressure, Outflow };
+  enum class Outflow { ZeroGradient, Convective };
   Kind kind = Kind::Wall;
+  Outflow outflow = Outflow::ZeroGradient;
+  double convective_velocity = 0;  // Convective: lattice speed; 0: the face's mean normal velocity
   Vec3 velocity = Vec3::Zero();  // Wall: wall velocity (moving wall); Velocity: inflow velocity
   double density = 1;            // Pressure: prescribed density (p = c_s^2 rho)
   // Velocity: per-cell velocity, overrides `velocity`. On a Wall it makes the face a moving-wall
