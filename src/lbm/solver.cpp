@@ -42,6 +42,8 @@ void Solver<L, T>::set_face(int f, const FaceCondition& c) {
                                  "set with the grid",
                                  face_name(f), periodic ? "cannot be periodic:" : "cannot take a wall or open condition:",
                                  "xyz"[axis], grid_.periodic[axis] ? "" : "not "));
+  if (c.kind == FaceCondition::Kind::Outflow)
+    throw Error(fmt::format("internal: outflow faces are not implemented yet (face {})", face_name(f)));
   faces_[f] = c;
   inflow_wall_[f] = c.kind == FaceCondition::Kind::Wall && bool(c.profile);
   if (c.kind == FaceCondition::Kind::Wall) objects_[f].velocity = c.velocity;
