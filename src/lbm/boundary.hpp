@@ -75,8 +75,9 @@ inline T reflect(WallScheme s, T delta, bool has_second, T A, T B, T C, T mw) {
 // unknowns g_q (c_q . n > 0) = g_o + 6 w_q rho c_q.u + sum_t c_qt N_t, with N_t chosen so the
 // tangential momentum equals rho u_t exactly. On D2Q9 this reduces to METHODS §4.5.
 // Every population with c_q . n <= 0 must already be set (streamed or bounced).
+// incompressible: momentum rho_0 u with rho_0 = 1 (He & Luo 1997), so sum = rho - u.n.
 template <class L, class T>
-void zou_he(T* g, const OpenNode<T>& nd) {
+void zou_he(T* g, const OpenNode<T>& nd, bool incompressible = false) {
   const int a = nd.axis, s = nd.sign;
   T k0 = 0, kneg = 0;
   for (int q = 0; q < L::Q; ++q) {
@@ -86,17 +87,25 @@ void zou_he(T* g, const OpenNode<T>& nd) {
   }
   T rho, u[3] = {nd.u[0], nd.u[1], nd.u[2]};
   const T sum = T(1) + k0 + T(2) * kneg;  // = rho (1 - u.n) in shifted populations
-  if (nd.pressure) {
+  if (incompressible) {
+    if (nd.pressure) {
+      rho = nd.rho;
+      u[a] = T(s) * (rho - sum);
+    } else {
+      rho = sum + T(s) * u[a];
+    }
+  } else if (nd.pressure) {
     rho = nd.rho;
     u[a] = T(s) * (T(1) - sum / rho);
   } else {
     rho = sum / (T(1) - T(s) * u[a]);
   }
+  const T rho_u = incompressible ? T(1) : rho;  // multiplies the momentum terms
   // Bounce-back of the non-equilibrium part plus the equilibrium difference.
   for (int q = 0; q < L::Q; ++q) {
     if (L::c[q][a] * s <= 0) continue;
     const T cu = L::c[q][0] * u[0] + L::c[q][1] * u[1] + L::c[q][2] * u[2];
-    g[q] = g[L::opp[q]] + T(6 * L::w[q]) * rho * cu;
+    g[q] = g[L::opp[q]] + T(6 * L::w[q]) * rho_u * cu;
   }
   // Transverse momentum correction.
   for (int t = 0; t < 3; ++t) {
@@ -106,7 +115,7 @@ void zou_he(T* g, const OpenNode<T>& nd) {
       have += L::c[q][t] * g[q];
       if (L::c[q][a] * s > 0) nt += T(L::c[q][t] * L::c[q][t]);
     }
-    const T X = (rho * u[t] - have) / nt;
+    const T X = (rho_u * u[t] - have) / nt;
     for (int q = 0; q < L::Q; ++q)
       if (L::c[q][a] * s > 0) g[q] += L::c[q][t] * X;
   }

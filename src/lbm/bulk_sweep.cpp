@@ -33,7 +33,7 @@ namespace {
 // populations array, checkpoints included, is the same as with wrapped indices). Whole rows
 // thus stay one span, vectorised from x = 0 with no scalar cells at the seam: the split into
 // three spans per row (x = 0, 1..nx-2, nx-1) made the odd step 20-30% slower.
-template <class L, class T, CollisionModel M, bool kForce, bool kMoments>
+template <class L, class T, CollisionModel M, bool kForce, bool kMoments, bool kIncomp>
 FF_LBM_CLONES void sweep_span(const Grid& g, T* f, CellIndex N, int x0, int y, int z, int n, bool odd,
                               const Relax<T>& r, T* drho, T* const* u) {
   T* p[L::Q];
@@ -68,7 +68,7 @@ FF_LBM_CLONES void sweep_span(const Grid& g, T* f, CellIndex N, int x0, int y, i
       }
     }
   });
-  stream_collide_span<L, T, M, kForce, kMoments>(p, n, r, m);
+  stream_collide_span<L, T, M, kForce, kMoments, kIncomp>(p, n, r, m);
   static_for<L::Q>([&](auto q) FF_LBM_LAMBDA_INLINE {
     if constexpr (L::c[q][0] > 0) {
       if (lo) {
@@ -92,14 +92,15 @@ void Solver<L, T>::bulk_sweep(bool odd, bool sample) {
   const bool trt = settings_.collision == CollisionModel::Trt;
   // Pick the instantiation once per step; the loop below has no further branches.
   using Fn = void (*)(const Grid&, T*, CellIndex, int, int, int, int, bool, const Relax<T>&, T*, T* const*);
+  auto pick = [&]<CollisionModel M, bool kIncomp>() -> Fn {
+    if (force) return sample ? &sweep_span<L, T, M, true, true, kIncomp> : &sweep_span<L, T, M, true, false, kIncomp>;
+    return sample ? &sweep_span<L, T, M, false, true, kIncomp> : &sweep_span<L, T, M, false, false, kIncomp>;
+  };
   Fn fn;
-  if (trt) {
-    if (force) fn = sample ? &sweep_span<L, T, CollisionModel::Trt, true, true> : &sweep_span<L, T, CollisionModel::Trt, true, false>;
-    else fn = sample ? &sweep_span<L, T, CollisionModel::Trt, false, true> : &sweep_span<L, T, CollisionModel::Trt, false, false>;
-  } else {
-    if (force) fn = sample ? &sweep_span<L, T, CollisionModel::Bgk, true, true> : &sweep_span<L, T, CollisionModel::Bgk, true, false>;
-    else fn = sample ? &sweep_span<L, T, CollisionModel::Bgk, false, true> : &sweep_span<L, T, CollisionModel::Bgk, false, false>;
-  }
+  if (settings_.incompressible)
+    fn = trt ? pick.template operator()<CollisionModel::Trt, true>() : pick.template operator()<CollisionModel::Bgk, true>();
+  else
+    fn = trt ? pick.template operator()<CollisionModel::Trt, false>() : pick.template operator()<CollisionModel::Bgk, false>();
   T* f = f_.data();
   const CellIndex N = n_();
   T* u[3] = {u_[0].data(), u_[1].data(), u_[2].data()};

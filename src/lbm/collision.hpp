@@ -11,6 +11,11 @@
 //   BGK: f*_q = f_q - (f_q - f^eq_q)/tau                                 ([S003] Eq. 1)
 //   TRT (Ginzburg et al. 2008): symmetric / antisymmetric parts relax with
 //        w+ = 1/tau and w- from the magic parameter (1/w+ - 1/2)(1/w- - 1/2) = Lambda
+//   Incompressible variant (He & Luo 1997, J. Stat. Phys. 88:927; Zou et al. 1995): the momentum
+//        terms use rho_0 = 1, f^eq_q = w_q [rho + 3 c.u + 9/2 (c.u)^2 - 3/2 u^2], u = sum f c.
+//        rho is then a pressure variable only: a steady flow no longer carries the O(Ma^2) error of
+//        a density (and so a dynamic viscosity rho nu) that rises with the pressure drop, which is
+//        what put the DFG cylinder's drag ~Ma^2 above its interval (docs/lbm.md, "Accuracy").
 //   Guo, Zheng & Shi (2002): rho u = sum f c + F/2,
 //        S_q = (1 - w/2) w_q [3 (c - u) + 9 (c.u) c] . F, split into its even part (relaxed
 //        with w+) and odd part (with w-) for TRT.
@@ -82,7 +87,8 @@ FF_LBM_INLINE T cdot(T x, T y, T z) {
 
 // Collides the shifted populations g[] of one cell in place. Returns the density deviation
 // (rho - 1) and the velocity (Guo's half-force corrected), used for output and checks.
-template <class L, class T, CollisionModel M, bool kForce>
+// kIncomp: the incompressible equilibrium of He & Luo (1997) (rho_0 = 1 in the momentum terms).
+template <class L, class T, CollisionModel M, bool kForce, bool kIncomp = false>
 FF_LBM_INLINE void collide(T* g, const Relax<T>& r, T& drho_out, T* u_out) {
   constexpr int P = (L::Q - 1) / 2;  // opposite pairs (2p+1, 2p+2)
   // Moments: sums and differences over opposite pairs.
@@ -106,8 +112,9 @@ FF_LBM_INLINE void collide(T* g, const Relax<T>& r, T& drho_out, T* u_out) {
   if constexpr (kForce) {
     static_for<L::D>([&](auto a) FF_LBM_LAMBDA_INLINE { j[a] += T(0.5) * r.force[a]; });
   }
-  const T rho = T(1) + drho;
-  const T inv_rho = T(1) / rho;
+  // rho multiplies the momentum terms: the density (compressible) or rho_0 = 1 (incompressible).
+  const T rho = kIncomp ? T(1) : T(1) + drho;
+  const T inv_rho = kIncomp ? T(1) : T(1) / rho;
   const T ux = j[0] * inv_rho, uy = j[1] * inv_rho;
   const T uz = L::D == 3 ? j[2] * inv_rho : T(0);
   T usq = ux * ux + uy * uy;
@@ -164,13 +171,15 @@ FF_LBM_INLINE void collide(T* g, const Relax<T>& r, T& drho_out, T* u_out) {
   u_out[2] = uz;
 }
 
-// Shifted equilibrium g^eq_q = f^eq_q - w_q for density rho and velocity u.
+// Shifted equilibrium g^eq_q = f^eq_q - w_q for density rho and velocity u (incompressible:
+// rho_0 = 1 in the momentum terms, as in collide()).
 template <class L, class T>
-inline void equilibrium(T rho, const T* u, T* geq) {
+inline void equilibrium(T rho, const T* u, T* geq, bool incompressible = false) {
   const T usq15 = T(1.5) * (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+  const T rho_u = incompressible ? T(1) : rho;
   for (int q = 0; q < L::Q; ++q) {
     const T cu = L::c[q][0] * u[0] + L::c[q][1] * u[1] + L::c[q][2] * u[2];
-    geq[q] = T(L::w[q]) * ((rho - T(1)) + rho * (T(3) * cu + T(4.5) * cu * cu - usq15));
+    geq[q] = T(L::w[q]) * ((rho - T(1)) + rho_u * (T(3) * cu + T(4.5) * cu * cu - usq15));
   }
 }
 

@@ -122,7 +122,7 @@ void Solver<L, T>::initialize(const std::function<void(int, int, int, double&, V
         if (type_[i] == CellType::Fluid) init(x, y, z, rho, u);
         const T uu[3] = {T(u[0]), T(u[1]), T(L::D == 3 ? u[2] : 0.0)};
         T geq[Q];
-        equilibrium<L, T>(T(rho), uu, geq);
+        equilibrium<L, T>(T(rho), uu, geq, settings_.incompressible);
         for (int q = 0; q < Q; ++q) f_[q * N + i] = geq[q];
         drho_[i] = T(rho - 1);
         for (int a = 0; a < 3; ++a) u_[a][i] = uu[a];
@@ -264,17 +264,22 @@ void Solver<L, T>::update_boundary_cell(std::size_t i, bool odd, bool sample) {
     OpenNode<T> nd = open_[b.open];
     if (!nd.pressure)
       for (int a = 0; a < 3; ++a) nd.u[a] *= inflow_scale_;
-    zou_he<L, T>(g, nd);
+    zou_he<L, T>(g, nd, settings_.incompressible);
   }
   // 4. Collide.
   T drho, u[3];
   const bool force = settings_.body_force.squaredNorm() > 0;
-  if (settings_.collision == CollisionModel::Trt) {
-    if (force) collide<L, T, CollisionModel::Trt, true>(g, relax_, drho, u);
-    else collide<L, T, CollisionModel::Trt, false>(g, relax_, drho, u);
+  auto run = [&]<CollisionModel M, bool kIncomp>() {
+    if (force) collide<L, T, M, true, kIncomp>(g, relax_, drho, u);
+    else collide<L, T, M, false, kIncomp>(g, relax_, drho, u);
+  };
+  const bool trt = settings_.collision == CollisionModel::Trt;
+  if (settings_.incompressible) {
+    if (trt) run.template operator()<CollisionModel::Trt, true>();
+    else run.template operator()<CollisionModel::Bgk, true>();
   } else {
-    if (force) collide<L, T, CollisionModel::Bgk, true>(g, relax_, drho, u);
-    else collide<L, T, CollisionModel::Bgk, false>(g, relax_, drho, u);
+    if (trt) run.template operator()<CollisionModel::Trt, false>();
+    else run.template operator()<CollisionModel::Bgk, false>();
   }
   // 5. Store: even -> own cell, swapped slot; odd -> neighbour x + c_q, regular slot.
   f_[b.cell] = g[0];

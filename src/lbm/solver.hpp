@@ -57,6 +57,8 @@ struct SolverSettings {
   double tau = 0.8;                  // relaxation time of the shear modes (viscosity)
   double magic = 3.0 / 16.0;         // TRT magic parameter Lambda
   Vec3 body_force = Vec3::Zero();    // force density, lattice units (Guo forcing)
+  // He & Luo (1997) incompressible equilibrium (collision.hpp): rho_0 = 1 in the momentum terms.
+  bool incompressible = false;
 };
 
 // A solid body (or a wall of the box) and the hydrodynamic load on it.

@@ -24,7 +24,7 @@ inline constexpr int kPrefetchLines = 4;
 
 // Cells [i0, i1) of a span: g_q = p[q][i] for every q, collide, p[opp q][i] = g*_q.
 // Cells never share memory slots (AA pattern), so iterations are independent (hence `ivdep`).
-template <class L, class T, CollisionModel M, bool kForce, bool kMoments>
+template <class L, class T, CollisionModel M, bool kForce, bool kMoments, bool kIncomp>
 FF_LBM_INLINE void stream_collide_cells(T* const* p, std::int64_t i0, std::int64_t i1, const Relax<T>& r,
                                         const MomentOut<T>& m) {
 #pragma GCC ivdep
@@ -32,7 +32,7 @@ FF_LBM_INLINE void stream_collide_cells(T* const* p, std::int64_t i0, std::int64
     T g[L::Q];
     static_for<L::Q>([&](auto q) FF_LBM_LAMBDA_INLINE { g[q] = p[q][i]; });
     T drho, u[3];
-    collide<L, T, M, kForce>(g, r, drho, u);
+    collide<L, T, M, kForce, kIncomp>(g, r, drho, u);
     static_for<L::Q>([&](auto q) FF_LBM_LAMBDA_INLINE { p[L::opp[q]][i] = g[q]; });
     if constexpr (kMoments) {
       m.drho[i] = drho;
@@ -54,7 +54,7 @@ FF_LBM_INLINE void stream_collide_cells(T* const* p, std::int64_t i0, std::int64
 // of every stream kAhead (= kPrefetchLines; 2-12 were timed, 3-6 were equally good) lines ahead;
 // past the span's end that is the start of the next row, which the next span needs. Always inlined, so each target clone of the caller
 // vectorises it for its ISA; the arithmetic per cell is that of collide(), whatever the ISA.
-template <class L, class T, CollisionModel M, bool kForce, bool kMoments, int kAhead = kPrefetchLines>
+template <class L, class T, CollisionModel M, bool kForce, bool kMoments, bool kIncomp, int kAhead = kPrefetchLines>
 FF_LBM_INLINE void stream_collide_span(T* const* p_in, std::int64_t n, const Relax<T>& r, const MomentOut<T>& m) {
   constexpr int Q = L::Q;
   constexpr int kLine = 64 / int(sizeof(T));  // cells per cache line
@@ -64,9 +64,9 @@ FF_LBM_INLINE void stream_collide_span(T* const* p_in, std::int64_t n, const Rel
   std::int64_t i = 0;
   for (; i + kLine <= n; i += kLine) {
     static_for<Q>([&](auto q) FF_LBM_LAMBDA_INLINE { __builtin_prefetch(p[q] + i + kAhead * kLine, 0, 3); });
-    stream_collide_cells<L, T, M, kForce, kMoments>(p, i, i + kLine, rl, m);
+    stream_collide_cells<L, T, M, kForce, kMoments, kIncomp>(p, i, i + kLine, rl, m);
   }
-  stream_collide_cells<L, T, M, kForce, kMoments>(p, i, n, rl, m);
+  stream_collide_cells<L, T, M, kForce, kMoments, kIncomp>(p, i, n, rl, m);
 }
 
 }  // namespace ff::lbm

@@ -29,6 +29,11 @@ void declare_lbm_params(ParamTable& t, const LbmDefaults& d) {
   t.integer("lbm.depth_cells", 1, "cells", "D3Q19 only: cells along the periodic z axis").at_least(1);
   t.string("lbm.precision", "double", "storage and arithmetic precision of the populations").one_of({"double", "float"});
   t.string("lbm.collision", "trt", "collision: two-relaxation-time (Ginzburg et al. 2008) or BGK").one_of({"trt", "bgk"});
+  t.string("lbm.equilibrium", "incompressible",
+           "equilibrium: compressible (rho in the momentum terms) or incompressible (He & Luo 1997: rho_0 = 1 there, "
+           "so a pressure drop no longer raises the density and dynamic viscosity; removes the O(Ma^2) drag error of "
+           "steady flows, docs/lbm.md)")
+      .one_of({"compressible", "incompressible"});
   t.real("lbm.trt_magic", 3.0 / 16.0, "-", "TRT magic parameter Lambda (3/16 puts bounce-back walls exactly mid-link)")
       .positive();
   t.real("lbm.tau", d.tau, "-", "relaxation time; gives dt = (tau - 1/2) dx^2 / (3 nu) unless lbm.time_step is set")
@@ -130,6 +135,7 @@ void Runner<L, T>::build() {
   s.collision = cfg_.string("lbm.collision") == "bgk" ? lbm::CollisionModel::Bgk : lbm::CollisionModel::Trt;
   s.tau = units_.tau();
   s.magic = cfg_.real("lbm.trt_magic");
+  s.incompressible = cfg_.string("lbm.equilibrium") == "incompressible";
   s.body_force = dom_.body_force;
   sol_ = std::make_unique<lbm::Solver<L, T>>(g, s);
   for (int f = 0; f < 4; ++f)
