@@ -49,6 +49,10 @@ struct FaceCondition {
   Kind kind = Kind::Wall;
   Outflow outflow = Outflow::ZeroGradient;
   double convective_velocity = 0;  // Convective: lattice speed; 0: the face's mean normal velocity
+  // Outflow: the copied populations carry the node's own density rather than the donor's (true),
+  // which keeps a pressure gradient at the outlet from acting as a mass source. false: the
+  // plain copy g_q(x) = g_q(x + n), for comparison only (the density then drifts).
+  bool outflow_density_free = true;
   Vec3 velocity = Vec3::Zero();  // Wall: wall velocity (moving wall); Velocity: inflow velocity
   double density = 1;            // Pressure: prescribed density (p = c_s^2 rho)
   // Velocity: per-cell velocity, overrides `velocity`. On a Wall it makes the face a moving-wall

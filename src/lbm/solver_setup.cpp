@@ -151,6 +151,7 @@ void Solver<L, T>::finalize() {
                               open_axis == 2 ? open_sign : 0};
             const auto d = donor_row.find(g.index(x + n[0], y + n[1], z + n[2]));
             nd.donor = d == donor_row.end() ? -1 : d->second;  // -1: solid donor
+            nd.density_free = fc.outflow_density_free;
             nd.ghost = g.index(x - n[0], y - n[1], z - n[2]);
             b.outflow = true;
             outflow_cells_.push_back(std::int32_t(bcells_.size()));
