@@ -44,7 +44,6 @@ struct OpenNode {
   T u[3] = {0, 0, 0};       // prescribed velocity (tangential part only for pressure nodes)
   // Outflow nodes only. The donor is the fluid cell x + n one layer inward: `donor` is the row of
   // its pre-collision populations in the solver's donor buffer, -1 if that cell is solid.
-  // `density_free`: the copied populations carry the node's own density (solver.cpp).
   // `ghost` is the open ghost cell x - n, whose otherwise unused slots hold the convective state.
   std::int8_t face = 0;
   bool density_free = true;  // the unknowns carry the node's density, not the donor's (solver.cpp)
