@@ -30,14 +30,25 @@ struct Link {
   float delta = 0.5f;          // wall distance fraction along the link
 };
 
-// A fluid cell next to an open (velocity or pressure) face.
+// How an open node fills its unknown populations.
+enum class OpenKind : std::uint8_t { Velocity, Pressure, ZeroGradient, Convective };
+
+// A fluid cell next to an open (velocity, pressure or outflow) face.
 template <class T>
 struct OpenNode {
   std::int8_t axis = 0;     // normal axis
   std::int8_t sign = 1;     // inward normal n = sign * e_axis
   bool pressure = false;    // true: prescribed density; false: prescribed velocity
+  OpenKind kind = OpenKind::Velocity;
   T rho = 1;                // prescribed density (pressure nodes)
   T u[3] = {0, 0, 0};       // prescribed velocity (tangential part only for pressure nodes)
+  // Outflow nodes only. The donor is the fluid cell x + n one layer inward: `donor` is the row of
+  // its pre-collision populations in the solver's donor buffer, -1 if that cell is solid.
+  // `ghost` is the open ghost cell x - n, whose otherwise unused slots hold the convective state.
+  std::int8_t face = 0;
+  bool density_free = true;  // the unknowns carry the node's density, not the donor's (solver.cpp)
+  std::int32_t donor = -1;
+  std::int64_t ghost = 0;
 };
 
 // Everything the non-bulk path needs about one fluid cell.
@@ -49,6 +60,9 @@ struct BoundaryCell {
   std::int32_t first_link = 0;  // links of this cell: [first_link, first_link + num_links)
   std::int32_t num_links = 0;
   std::int32_t open = -1;       // index of its OpenNode, -1 if none
+  std::int32_t capture = -1;    // outflow donor: row of the donor buffer that receives its
+                                //   pre-collision populations, -1 if none
+  bool outflow = false;         // on an outflow face: updated after every other boundary cell
 };
 
 // Reflected population for a wall link ([S003] Eq. 8 / METHODS §4.5-4.6).

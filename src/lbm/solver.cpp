@@ -42,8 +42,11 @@ void Solver<L, T>::set_face(int f, const FaceCondition& c) {
                                  "set with the grid",
                                  face_name(f), periodic ? "cannot be periodic:" : "cannot take a wall or open condition:",
                                  "xyz"[axis], grid_.periodic[axis] ? "" : "not "));
-  if (c.kind == FaceCondition::Kind::Outflow)
-    throw Error(fmt::format("internal: outflow faces are not implemented yet (face {})", face_name(f)));
+  if (c.kind == FaceCondition::Kind::Outflow && c.outflow == FaceCondition::Outflow::Convective &&
+      !(std::isfinite(c.convective_velocity) && c.convective_velocity >= 0))
+    throw InputError(fmt::format("face {}: convective outflow velocity {} must be a lattice speed >= 0 (0: the "
+                                 "face's mean outflow speed)",
+                                 face_name(f), c.convective_velocity));
   faces_[f] = c;
   inflow_wall_[f] = c.kind == FaceCondition::Kind::Wall && bool(c.profile);
   if (c.kind == FaceCondition::Kind::Wall) objects_[f].velocity = c.velocity;
@@ -139,6 +142,19 @@ void Solver<L, T>::initialize(const std::function<void(int, int, int, double&, V
     const T mw = T(6 * L::w[q]) * (L::c[q][0] * uw[0] + L::c[q][1] * uw[1] + L::c[q][2] * uw[2]);
     f_[L::opp[q] * N + src] = f_[q * N + b.cell] - mw;
   }
+  // Outflow nodes: the convective state of time 0 (incoming populations and outflow speed, in
+  // the open ghost x - n), and for a solid donor the slots the first step bounces back.
+  for (const std::int32_t i : outflow_cells_) {
+    const BoundaryCell& b = bcells_[i];
+    const OpenNode<T>& nd = open_[b.open];
+    f_[nd.ghost] = T(-nd.sign) * u_[nd.axis][b.cell];
+    for (int q = 1; q < Q; ++q) {
+      if (!(b.open_mask & (1u << q))) continue;
+      f_[q * N + nd.ghost] = f_[q * N + b.cell];
+      if (nd.donor < 0)
+        f_[L::opp[q] * N + grid_.neighbour(b.x, b.y, b.z, -L::c[q][0], -L::c[q][1], -L::c[q][2])] = f_[q * N + b.cell];
+    }
+  }
   time_ = 0;
 }
 
@@ -196,6 +212,7 @@ template <class L, class T>
 void Solver<L, T>::step(bool sample) {
   const bool odd = (time_ & 1) != 0;
   save_interpolation_inputs(odd);
+  save_outflow_inputs(odd);
   bulk_sweep(odd, sample);
   boundary_sweep(odd, sample);
   reduce_forces();
@@ -220,11 +237,97 @@ void Solver<L, T>::save_interpolation_inputs(bool odd) {
   }
 }
 
+// Outflow donors that are bulk cells: their pre-collision populations g_q(x + n, t+1) are in the
+// slots the bulk kernel overwrites, so copy them first (even step: own slots f[q][y]; odd step:
+// the neighbours' swapped slots f[opp q][y - c_q]). Donors that are boundary cells copy theirs
+// during their own update. Then each convective face's speed U from the previous step's
+// outflow speeds, summed in node order (the same on any thread count).
+template <class L, class T>
+void Solver<L, T>::save_outflow_inputs(bool odd) {
+  if (outflow_cells_.empty()) return;
+  const CellIndex N = n_();
+  for (const BulkDonor& d : bulk_donors_) {
+    T* row = &donor_g_[std::size_t(Q) * d.row];
+    row[0] = f_[d.cell];
+    for (int q = 1; q < Q; ++q)
+      row[q] = odd ? f_[L::opp[q] * N + grid_.neighbour(d.x, d.y, d.z, -L::c[q][0], -L::c[q][1], -L::c[q][2])]
+                   : f_[q * N + d.cell];
+  }
+  std::array<double, kNumFaces> sum{};
+  std::array<long, kNumFaces> count{};
+  for (const std::int32_t i : outflow_cells_) {
+    const OpenNode<T>& nd = open_[bcells_[i].open];
+    sum[nd.face] += double(f_[nd.ghost]);
+    ++count[nd.face];
+  }
+  for (int f = 0; f < kNumFaces; ++f) {
+    const FaceCondition& fc = faces_[f];
+    convective_u_[f] = T(0);
+    if (fc.kind != FaceCondition::Kind::Outflow || fc.outflow != FaceCondition::Outflow::Convective) continue;
+    // Backflow would make the implicit update an extrapolation against the flow: U >= 0.
+    const double U = fc.convective_velocity > 0 ? fc.convective_velocity
+                                                : (count[f] > 0 ? std::max(0.0, sum[f] / double(count[f])) : 0.0);
+    convective_u_[f] = T(U);
+  }
+}
+
+// Outflow nodes read what their donors (one layer inside) gathered this step, so they run in a
+// second pass after every other boundary cell; each pass is parallel (cells own their slots).
 template <class L, class T>
 void Solver<L, T>::boundary_sweep(bool odd, bool sample) {
   const std::int64_t nb = std::int64_t(bcells_.size());
 #pragma omp parallel for schedule(static) if (nb > kParallelMinCells / 8)
-  for (std::int64_t i = 0; i < nb; ++i) update_boundary_cell(std::size_t(i), odd, sample);
+  for (std::int64_t i = 0; i < nb; ++i)
+    if (!bcells_[std::size_t(i)].outflow) update_boundary_cell(std::size_t(i), odd, sample);
+  const std::int64_t no = std::int64_t(outflow_cells_.size());
+#pragma omp parallel for schedule(static) if (no > kParallelMinCells / 8)
+  for (std::int64_t k = 0; k < no; ++k) update_boundary_cell(std::size_t(outflow_cells_[std::size_t(k)]), odd, sample);
+}
+
+// Unknown populations (c_q . n > 0) of an outflow node x from its donor x + n:
+//   zero-gradient: g_q(x, t+1) = d_q
+//   convective (Yang 2013, Comput. Math. Appl. 65:160, its convective condition with the face's
+//   average speed or a set one; Lou, Guo & Shi 2013, Phys. Rev. E 87:063301):
+//   g_q(x, t+1) = [g_q(x, t) + U d_q] / (1 + U), the implicit upwind form of dg/dt + U dg/dn_out = 0,
+// with d_q = g_q(x + n, t+1) + w_q delta. The plain copy (delta = 0) hands the node the donor's
+// density: where a flow has a density drop drho across the last cell, the node gains mass every
+// step and the density of the whole lattice rises by about drho/3 per step without end (found in
+// the Poiseuille test; derivation in docs/lbm.md). delta = rho(x) - rho(x + n) makes the
+// unknowns carry the node's own density instead: with K the known populations of x, D the donor's
+// unknown ones and W their weights, rho(x) - 1 = K + D + W delta, so delta = (K + D - rho_d + 1) / (1 - W).
+// g_q(x, t) is kept in the slot q of the ghost x - n (never streamed: c_q points inward).
+// A solid donor leaves nothing to copy: the node then bounces its unknowns back.
+template <class L, class T>
+void Solver<L, T>::apply_outflow(T* g, const BoundaryCell& b, const OpenNode<T>& nd, const CellIndex* src, bool odd) {
+  const CellIndex N = n_();
+  const bool convective = nd.kind == OpenKind::Convective;
+  const T U = convective_u_[nd.face];
+  const T* d = nd.donor >= 0 ? &donor_g_[std::size_t(Q) * nd.donor] : nullptr;
+  T delta = 0;
+  if (d && nd.density_free) {
+    T known = g[0], unknown = 0, drho_d = d[0], W = 0;
+    for (int q = 1; q < Q; ++q) {
+      drho_d += d[q];
+      if (b.open_mask & (1u << q)) {
+        unknown += d[q];
+        W += T(L::w[q]);
+      } else {
+        known += g[q];
+      }
+    }
+    delta = (known + unknown - drho_d) / (T(1) - W);
+  }
+  for (int q = 1; q < Q; ++q) {
+    if (!(b.open_mask & (1u << q))) continue;
+    const T dq = d ? d[q] + T(L::w[q]) * delta : (odd ? f_[q * N + b.cell] : f_[L::opp[q] * N + src[q]]);
+    if (convective) {
+      T& prev = f_[q * N + nd.ghost];
+      g[q] = (prev + U * dq) / (T(1) + U);
+      prev = g[q];
+    } else {
+      g[q] = dq;
+    }
+  }
 }
 
 template <class L, class T>
@@ -259,13 +362,18 @@ void Solver<L, T>::update_boundary_cell(std::size_t i, bool odd, bool sample) {
     for (int a = 0; a < 3; ++a)
       link_force_[3 * l + a] = double(L::c[o][a]) * (double(A) + double(gq)) - double(uw[a]) * (double(A) - double(gq));
   }
-  // 3. Open faces (Zou-He / Hecht-Harting): needs every other population first.
-  if (b.open >= 0) {
+  // 3. Open faces (Zou-He / Hecht-Harting): needs every other population first. Outflow
+  //    faces copy or convect from the donor layer instead.
+  if (b.outflow) {
+    apply_outflow(g, b, open_[b.open], src, odd);
+  } else if (b.open >= 0) {
     OpenNode<T> nd = open_[b.open];
     if (!nd.pressure)
       for (int a = 0; a < 3; ++a) nd.u[a] *= inflow_scale_;
     zou_he<L, T>(g, nd, settings_.incompressible);
   }
+  // An outflow donor hands its gathered populations g_q(x, t+1) to the node outside it.
+  if (b.capture >= 0) std::copy(g, g + Q, &donor_g_[std::size_t(Q) * b.capture]);
   // 4. Collide.
   T drho, u[3];
   const bool force = settings_.body_force.squaredNorm() > 0;
@@ -287,6 +395,11 @@ void Solver<L, T>::update_boundary_cell(std::size_t i, bool odd, bool sample) {
     const int o = L::opp[q];
     if (odd) f_[q * N + src[o]] = g[q];
     else f_[o * N + b.cell] = g[q];
+  }
+  // Outflow speed of this node, for the face's convective speed of the next step.
+  if (b.outflow) {
+    const OpenNode<T>& nd = open_[b.open];
+    f_[nd.ghost] = T(-nd.sign) * u[nd.axis];
   }
   if (sample) {
     drho_[b.cell] = drho;

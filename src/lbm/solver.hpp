@@ -13,11 +13,13 @@
 // form row spans updated by the branch-free kernel (stream_collide.hpp); every other fluid
 // cell is a BoundaryCell updated by a general path that applies the wall and open-face
 // conditions link by link. Solid cells are never updated; their memory holds the bounced
-// populations.
+// populations. Outflow nodes copy populations of the layer inside them, so they are updated
+// last, after the bulk and every other boundary cell (docs/lbm.md, "Outflow boundaries").
 //
 // Ownership: the Solver owns all its arrays; references returned stay valid until the
 // next finalize(). Not copyable (large), movable.
 #pragma once
+#include <array>
 #include <functional>
 #include <optional>
 #include <string>
@@ -40,11 +42,17 @@ enum class CellType : std::uint8_t { Fluid = 0, Solid = 1, Open = 2 };
 struct FaceCondition {
   // Outflow: an open face whose unknown populations are extrapolated from the interior
   // (zero-gradient) or convected out with the velocity `convective_velocity` (Yang 2013).
+  // The pressure there is free. An outflow face needs at least 3 cells along its axis and may
+  // meet walls and periodic faces, not other open faces.
   enum class Kind { Periodic, Wall, Velocity, Pressure, Outflow };
   enum class Outflow { ZeroGradient, Convective };
   Kind kind = Kind::Wall;
   Outflow outflow = Outflow::ZeroGradient;
   double convective_velocity = 0;  // Convective: lattice speed; 0: the face's mean normal velocity
+  // Outflow: the copied populations carry the node's own density rather than the donor's (true),
+  // which keeps a pressure gradient at the outlet from acting as a mass source. false: the
+  // plain copy g_q(x) = g_q(x + n), for comparison only (the density then drifts).
+  bool outflow_density_free = true;
   Vec3 velocity = Vec3::Zero();  // Wall: wall velocity (moving wall); Velocity: inflow velocity
   double density = 1;            // Pressure: prescribed density (p = c_s^2 rho)
   // Velocity: per-cell velocity, overrides `velocity`. On a Wall it makes the face a moving-wall
@@ -126,7 +134,12 @@ class Solver {
   std::size_t num_bulk_cells() const;
   std::size_t num_fluid_cells() const { return num_bulk_cells() + bcells_.size(); }
 
-  // ---- checkpoint: the populations and the step counter are the whole state
+  // Convective outflow: the speed U of the face's last step (set or the mean outflow speed).
+  double outflow_velocity(int face) const { return double(convective_u_[face]); }
+
+  // ---- checkpoint: the populations and the step counter are the whole state. The convective
+  // outflow's state (the previous step's incoming populations and outflow speed of each face
+  // node) lives in otherwise unused slots of the open ghost cells, so it is part of populations().
   const AlignedVector<T>& populations() const { return f_; }
   void restore(const std::vector<T>& f, long time_step);
 
@@ -140,6 +153,8 @@ class Solver {
   void boundary_sweep(bool odd, bool sample);
   void update_boundary_cell(std::size_t i, bool odd, bool sample);
   void save_interpolation_inputs(bool odd);
+  void save_outflow_inputs(bool odd);
+  void apply_outflow(T* g, const BoundaryCell& b, const OpenNode<T>& nd, const CellIndex* src, bool odd);
   void reduce_forces();
   void compute_link_velocities();
   Vec3 wall_velocity(int object, const Vec3& x) const;
@@ -168,6 +183,18 @@ class Solver {
   std::vector<T> link_uw_;             // 3 per link: wall velocity at the link
   std::vector<T> link_saved_;          // 1 per link: g*_q(x, t) saved before the step
   std::vector<double> link_force_;     // 3 per link: momentum exchange of the last step
+  // Outflow faces: the outflow nodes (boundary-cell indices, updated in a second pass), the donor
+  // buffer (Q pre-collision populations per donor row), the bulk donors copied into it before
+  // the step, and each face's convective speed U of the current step.
+  struct BulkDonor {
+    CellIndex cell;
+    int x, y, z;
+    std::int32_t row;
+  };
+  std::vector<std::int32_t> outflow_cells_;
+  std::vector<T> donor_g_;
+  std::vector<BulkDonor> bulk_donors_;
+  std::array<T, kNumFaces> convective_u_{};
 };
 
 extern template class Solver<D2Q9, double>;

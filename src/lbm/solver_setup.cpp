@@ -3,6 +3,8 @@
 // boundary cells with their wall links (and link fractions) and open-face data.
 #include <fmt/format.h>
 
+#include <unordered_map>
+
 #include "core/error.hpp"
 #include "lbm/solver.hpp"
 
@@ -11,6 +13,14 @@ namespace ff::lbm {
 template <class L, class T>
 void Solver<L, T>::finalize() {
   const Grid& g = grid_;
+  auto is_open = [](FaceCondition::Kind k) {
+    return k == FaceCondition::Kind::Velocity || k == FaceCondition::Kind::Pressure || k == FaceCondition::Kind::Outflow;
+  };
+  for (int f = 0; f < kNumFaces; ++f)
+    if (faces_[f].kind == FaceCondition::Kind::Outflow && g.n(f / 2) < 3)
+      throw InputError(fmt::format("LBM outflow face {} needs at least 3 cells along {} (it copies from the layer "
+                                   "inside it), the lattice has {}",
+                                   face_name(f), "xyz"[f / 2], g.n(f / 2)));
   // 1. Ghost cells: walls are solid cells owned by the face object, open faces are Open.
   for (int z = -g.gz; z < g.nz + g.gz; ++z)
     for (int y = -1; y <= g.ny; ++y)
@@ -18,8 +28,7 @@ void Solver<L, T>::finalize() {
         if (g.is_interior(x, y, z)) continue;
         const CellIndex i = g.index(x, y, z);
         const int f = g.ghost_face(x, y, z);
-        const auto kind = faces_[f].kind;
-        const bool open = kind == FaceCondition::Kind::Velocity || kind == FaceCondition::Kind::Pressure;
+        const bool open = is_open(faces_[f].kind);
         type_[i] = open ? CellType::Open : CellType::Solid;
         object_[i] = open ? -1 : std::int16_t(f);
       }
@@ -28,7 +37,25 @@ void Solver<L, T>::finalize() {
   bcells_.clear();
   links_.clear();
   open_.clear();
+  outflow_cells_.clear();
+  bulk_donors_.clear();
   for (auto& o : objects_) o.links = 0;
+
+  // 2. Outflow donors: the fluid cell x + n one layer inside each fluid node x of an outflow face,
+  //    one row of the donor buffer each (a donor shared by the two faces of a 3-cell axis once).
+  std::unordered_map<CellIndex, std::int32_t> donor_row;
+  for (int f = 0; f < kNumFaces; ++f) {
+    if (faces_[f].kind != FaceCondition::Kind::Outflow) continue;
+    const int a = f / 2, sign = f % 2 == 0 ? 1 : -1;
+    for (int z = 0; z < g.nz; ++z)
+      for (int y = 0; y < g.ny; ++y)
+        for (int x = 0; x < g.nx; ++x) {
+          const int c[3] = {x, y, z};
+          if (c[a] != (sign > 0 ? 0 : g.n(a) - 1) || type_[g.index(x, y, z)] != CellType::Fluid) continue;
+          const CellIndex d = g.index(x + (a == 0) * sign, y + (a == 1) * sign, z + (a == 2) * sign);
+          if (type_[d] == CellType::Fluid) donor_row.emplace(d, std::int32_t(donor_row.size()));
+        }
+  }
 
   for (int z = 0; z < g.nz; ++z)
     for (int y = 0; y < g.ny; ++y) {
@@ -48,8 +75,7 @@ void Solver<L, T>::finalize() {
         for (int a = 0; a < L::D; ++a) {
           const int c = a == 0 ? x : a == 1 ? y : z;
           for (int side = 0; side < 2; ++side) {
-            const auto kind = faces_[2 * a + side].kind;
-            if (kind != FaceCondition::Kind::Velocity && kind != FaceCondition::Kind::Pressure) continue;
+            if (!is_open(faces_[2 * a + side].kind)) continue;
             if (c != (side == 0 ? 0 : g.n(a) - 1)) continue;
             if (open_axis >= 0)
               throw InputError(fmt::format("LBM cell ({}, {}, {}) lies on two open faces ({} and {}); make one of the "
@@ -78,6 +104,9 @@ void Solver<L, T>::finalize() {
                                          x, y, z));
         }
         const bool bulk = b.link_mask == 0 && b.open_mask == 0;
+        // A bulk donor stays in the bulk; its populations are copied before each step.
+        const auto donor = donor_row.find(i);
+        if (bulk && donor != donor_row.end()) bulk_donors_.push_back(BulkDonor{i, x, y, z, donor->second});
         // Periodic x needs no split: the bulk kernel streams the first and last cells of a
         // row through the ghost columns (bulk_sweep.cpp), so whole rows stay one span.
         if (!bulk) close_run(x);
@@ -85,6 +114,7 @@ void Solver<L, T>::finalize() {
           if (run_start < 0) run_start = x;
           continue;
         }
+        if (donor != donor_row.end()) b.capture = donor->second;
         // Boundary cell: links to solids, then its open-face data.
         b.first_link = std::int32_t(links_.size());
         for (int q = 1; q < Q; ++q) {
@@ -114,10 +144,24 @@ void Solver<L, T>::finalize() {
           nd.axis = std::int8_t(open_axis);
           nd.sign = std::int8_t(open_sign);
           nd.pressure = fc.kind == FaceCondition::Kind::Pressure;
-          nd.rho = T(fc.density);
-          const Vec3 u = fc.profile ? fc.profile(x, y, z) : fc.velocity;
-          for (int a = 0; a < 3; ++a) nd.u[a] = T(a < L::D ? u[a] : 0.0);
-          if (nd.pressure) nd.u[open_axis] = 0;  // the normal velocity follows from the density
+          nd.face = std::int8_t(2 * open_axis + (open_sign > 0 ? 0 : 1));
+          if (fc.kind == FaceCondition::Kind::Outflow) {
+            nd.kind = fc.outflow == FaceCondition::Outflow::Convective ? OpenKind::Convective : OpenKind::ZeroGradient;
+            const int n[3] = {open_axis == 0 ? open_sign : 0, open_axis == 1 ? open_sign : 0,
+                              open_axis == 2 ? open_sign : 0};
+            const auto d = donor_row.find(g.index(x + n[0], y + n[1], z + n[2]));
+            nd.donor = d == donor_row.end() ? -1 : d->second;  // -1: solid donor
+            nd.density_free = fc.outflow_density_free;
+            nd.ghost = g.index(x - n[0], y - n[1], z - n[2]);
+            b.outflow = true;
+            outflow_cells_.push_back(std::int32_t(bcells_.size()));
+          } else {
+            nd.kind = nd.pressure ? OpenKind::Pressure : OpenKind::Velocity;
+            nd.rho = T(fc.density);
+            const Vec3 u = fc.profile ? fc.profile(x, y, z) : fc.velocity;
+            for (int a = 0; a < 3; ++a) nd.u[a] = T(a < L::D ? u[a] : 0.0);
+            if (nd.pressure) nd.u[open_axis] = 0;  // the normal velocity follows from the density
+          }
           b.open = std::int32_t(open_.size());
           open_.push_back(nd);
         }
@@ -128,6 +172,8 @@ void Solver<L, T>::finalize() {
   num_bulk_cells_ = 0;
   for (auto& sp : spans_) num_bulk_cells_ += sp.n;
   link_saved_.assign(links_.size(), T(0));
+  donor_g_.assign(std::size_t(Q) * donor_row.size(), T(0));
+  convective_u_.fill(T(0));
   link_force_.assign(3 * links_.size(), 0.0);
   compute_link_velocities();
 }
