@@ -87,7 +87,7 @@ StabilityCheck Units::check(double u, int resolution, const std::string& resolut
       case UnitsMode::Tau:
         return fmt::format("set {} = {} or more (same lbm.tau), or {}", resolution_key, n_needed, time_fix(1 / f));
       case UnitsMode::TimeStep:
-        return fmt::format("set {} s or less, or {} = {} or more with lbm.time_step scaled by (old/new resolution)^2",
+        return fmt::format("set {} or less, or {} = {} or more with lbm.time_step scaled by (old/new resolution)^2",
                            time_fix(1 / f), resolution_key, n_needed);
       default: return fmt::format("set {} or less", time_fix(1 / f));
     }

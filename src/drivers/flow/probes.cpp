@@ -132,67 +132,82 @@ ProbeStencil probe_stencil(const Vec3& p, int nx, int ny, int nz, std::span<cons
       return s;
     }
   }
-  // 2. Weighted least squares over the fluid nodes within kFitRadius: a quadratic in the
-  // offsets from the point, so the fitted value at the point is the constant coefficient.
-  std::vector<std::array<int, 3>> nodes;
-  std::vector<double> wts;
-  const double r2max = kFitRadius * kFitRadius, h = kFitRadius + 0.5;
-  std::array<int, 3> from{0, 0, 0}, to{0, 0, 0};
-  for (int a = 0; a < dims; ++a) {
-    from[a] = std::max(0, int(std::floor(p[a] - kFitRadius)));
-    to[a] = std::min(n[a] - 1, int(std::ceil(p[a] + kFitRadius)));
-  }
-  for (int z = from[2]; z <= to[2]; ++z)
-    for (int y = from[1]; y <= to[1]; ++y)
-      for (int x = from[0]; x <= to[0]; ++x) {
-        if (!fluid(x, y, z)) continue;
-        const Vec3 d(x - p.x(), y - p.y(), dims == 3 ? z - p.z() : 0.0);
-        const double r2 = d.squaredNorm();
-        if (r2 > r2max) continue;
-        nodes.push_back({x, y, z});
-        const double t = 1 - r2 / (h * h);  // Wendland-like taper: near nodes count most
-        wts.push_back(t * t);
+  // 2. Weighted least squares over the fluid nodes within kFitRadius (widened by up to one
+  // cell where these do not determine a quadratic, e.g. half a cell from a wall): a quadratic
+  // in the offsets from the point, so the fitted value at the point is the constant coefficient.
+  for (const double radius : {kFitRadius, kFitRadius + 0.5, kFitRadius + 1.0}) {
+    const bool widest = radius == kFitRadius + 1.0;
+    std::vector<std::array<int, 3>> nodes;
+    std::vector<double> wts;
+    const double r2max = radius * radius, h = radius + 0.5;
+    std::array<int, 3> from{0, 0, 0}, to{0, 0, 0};
+    for (int a = 0; a < dims; ++a) {
+      from[a] = std::max(0, int(std::floor(p[a] - radius)));
+      to[a] = std::min(n[a] - 1, int(std::ceil(p[a] + radius)));
+    }
+    for (int z = from[2]; z <= to[2]; ++z)
+      for (int y = from[1]; y <= to[1]; ++y)
+        for (int x = from[0]; x <= to[0]; ++x) {
+          if (!fluid(x, y, z)) continue;
+          const Vec3 d(x - p.x(), y - p.y(), dims == 3 ? z - p.z() : 0.0);
+          const double r2 = d.squaredNorm();
+          if (r2 > r2max) continue;
+          nodes.push_back({x, y, z});
+          const double t = 1 - r2 / (h * h);  // Wendland-like taper: near nodes count most
+          wts.push_back(t * t);
+        }
+    if (nodes.empty()) {
+      if (widest)
+        throw InputError(fmt::format("no fluid node within {} cells of the probe at lattice point ({:.3g}, {:.3g}, "
+                                     "{:.3g})",
+                                     radius, p.x(), p.y(), p.z()));
+      continue;
+    }
+    // Terms per axis by the number of distinct node coordinates along it (a single plane on a
+    // 2D or thin lattice carries no z terms).
+    std::array<int, 3> distinct{0, 0, 0};
+    for (int a = 0; a < 3; ++a) {
+      std::vector<int> c;
+      for (auto& nd : nodes) c.push_back(nd[a]);
+      std::sort(c.begin(), c.end());
+      distinct[a] = int(std::unique(c.begin(), c.end()) - c.begin());
+    }
+    bool full = true;  // every axis of the lattice can carry its quadratic term
+    for (int a = 0; a < dims; ++a) full = full && distinct[a] >= 3;
+    if (!full && !widest) continue;
+    for (int order = 2; order >= 0; --order) {
+      // Basis: 1; x_a (distinct >= 2); x_a^2 (>= 3); x_a x_b (both >= 2) -- up to `order`.
+      std::vector<std::function<double(const Vec3&)>> basis{[](const Vec3&) { return 1.0; }};
+      for (int a = 0; a < 3 && order >= 1; ++a)
+        if (distinct[a] >= 2) basis.push_back([a](const Vec3& d) { return d[a]; });
+      for (int a = 0; a < 3 && order >= 2; ++a) {
+        if (distinct[a] >= 3) basis.push_back([a](const Vec3& d) { return d[a] * d[a]; });
+        for (int b = a + 1; b < 3; ++b)
+          if (distinct[a] >= 2 && distinct[b] >= 2) basis.push_back([a, b](const Vec3& d) { return d[a] * d[b]; });
       }
-  if (nodes.empty())
-    throw InputError(fmt::format("no fluid node within {} cells of the probe at lattice point ({:.3g}, {:.3g}, {:.3g})",
-                                 kFitRadius, p.x(), p.y(), p.z()));
-  // Terms per axis by the number of distinct node coordinates along it (a single plane on a
-  // 2D or thin lattice carries no z terms).
-  std::array<int, 3> distinct{0, 0, 0};
-  for (int a = 0; a < 3; ++a) {
-    std::vector<int> c;
-    for (auto& nd : nodes) c.push_back(nd[a]);
-    std::sort(c.begin(), c.end());
-    distinct[a] = int(std::unique(c.begin(), c.end()) - c.begin());
-  }
-  for (int order = 2; order >= 0; --order) {
-    // Basis: 1; x_a (distinct >= 2); x_a^2 (>= 3); x_a x_b (both >= 2) -- up to `order`.
-    std::vector<std::function<double(const Vec3&)>> basis{[](const Vec3&) { return 1.0; }};
-    for (int a = 0; a < 3 && order >= 1; ++a)
-      if (distinct[a] >= 2) basis.push_back([a](const Vec3& d) { return d[a]; });
-    for (int a = 0; a < 3 && order >= 2; ++a) {
-      if (distinct[a] >= 3) basis.push_back([a](const Vec3& d) { return d[a] * d[a]; });
-      for (int b = a + 1; b < 3; ++b)
-        if (distinct[a] >= 2 && distinct[b] >= 2) basis.push_back([a, b](const Vec3& d) { return d[a] * d[b]; });
+      const int m = int(nodes.size()), q = int(basis.size());
+      if (m < q) continue;
+      Eigen::MatrixXd B(m, q);
+      for (int k = 0; k < m; ++k) {
+        const Vec3 d(nodes[k][0] - p.x(), nodes[k][1] - p.y(), dims == 3 ? nodes[k][2] - p.z() : 0.0);
+        const double sw = std::sqrt(wts[k]);
+        for (int c = 0; c < q; ++c) B(k, c) = sw * basis[c](d);
+      }
+      Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(B);
+      cod.setThreshold(1e-10);
+      if (cod.rank() < q) {
+        if (order == 2 && !widest) break;  // try a wider radius first
+        continue;
+      }
+      const Eigen::MatrixXd pinv = cod.pseudoInverse();
+      for (int k = 0; k < m; ++k) {
+        s.node.push_back(index(nodes[k][0], nodes[k][1], nodes[k][2]));
+        s.weight.push_back(pinv(0, k) * std::sqrt(wts[k]));
+      }
+      s.method = fmt::format("{} least squares over {} fluid nodes within {} cells",
+                             order == 2 ? "quadratic" : order == 1 ? "linear" : "constant", m, radius);
+      return s;
     }
-    const int m = int(nodes.size()), q = int(basis.size());
-    if (m < q) continue;
-    Eigen::MatrixXd B(m, q);
-    for (int k = 0; k < m; ++k) {
-      const Vec3 d(nodes[k][0] - p.x(), nodes[k][1] - p.y(), dims == 3 ? nodes[k][2] - p.z() : 0.0);
-      const double sw = std::sqrt(wts[k]);
-      for (int c = 0; c < q; ++c) B(k, c) = sw * basis[c](d);
-    }
-    Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> cod(B);
-    cod.setThreshold(1e-10);
-    if (cod.rank() < q) continue;
-    const Eigen::MatrixXd pinv = cod.pseudoInverse();
-    for (int k = 0; k < m; ++k) {
-      s.node.push_back(index(nodes[k][0], nodes[k][1], nodes[k][2]));
-      s.weight.push_back(pinv(0, k) * std::sqrt(wts[k]));
-    }
-    s.method = fmt::format("{} least squares over {} fluid nodes", order == 2 ? "quadratic" : order == 1 ? "linear" : "constant", m);
-    return s;
   }
   throw InputError("probe fit failed");  // unreachable: the constant fit needs one node
 }
