@@ -55,7 +55,8 @@ void declare_lbm_params(ParamTable& t, const LbmDefaults& d) {
   t.real("run.end_time", d.end_time, "s", "simulated time at which the run stops").positive();
   t.real("run.steady_tolerance", d.steady_tolerance, "-",
          fmt::format("stop at steady state: once the mean of the monitored result over a window of one period of the "
-                     "slowest acoustic mode (4 L / c_s, L the longest non-periodic side; at least {} samples) differs "
+                     "slowest acoustic mode (4 L / c_s, L the longest non-periodic side; as many whole periods as hold "
+                     "{} samples) differs "
                      "(relative) by less than this from the mean {} windows earlier, at every alignment within the last "
                      "window, after the inflow ramp; the result is then within about this of its long-run value if it "
                      "settles with a time constant up to ~{} windows. A vortex street does not stop. 0: run to "
@@ -364,8 +365,12 @@ RunStatus Runner<L, T>::run() {
   const int acoustic_extent = std::max(dom_.periodic[0] ? 0 : dom_.nx, dom_.periodic[1] ? 0 : dom_.ny) > 0
                                   ? std::max(dom_.periodic[0] ? 0 : dom_.nx, dom_.periodic[1] ? 0 : dom_.ny)
                                   : std::max(dom_.nx, dom_.ny);
+  // The smallest whole number of periods that holds kSteadyMinSamples samples (a window
+  // of 10 coarse samples that is not a whole number of periods would let the ringing through).
+  const double acoustic_period = 4.0 * std::sqrt(3.0) * acoustic_extent;  // steps
+  const double periods = std::max(1.0, std::ceil(double(kSteadyMinSamples * sample_every) / acoustic_period));
   const long steady_window =
-      std::max(kSteadyMinSamples, std::lround(4.0 * std::sqrt(3.0) * acoustic_extent / double(sample_every)));
+      std::max(kSteadyMinSamples, std::lround(periods * acoustic_period / double(sample_every)));
 
   // Names end in their SI unit (time_s, ..._Pa, ..._m_per_s); dimensionless ones have none.
   std::vector<std::string> columns = {"step", "time_s"};
@@ -470,10 +475,11 @@ RunStatus Runner<L, T>::run() {
       if (std::isfinite(drift)) steady_drift_ = drift;
       if (drift < steady_tol) {
         steady = true;
-        stop_reason = fmt::format("steady state: the mean of {} over {} samples ({:.4g} s, one period of the slowest "
-                                  "acoustic mode) changed by {:.3g} (relative) over the last {} windows, below "
+        stop_reason = fmt::format("steady state: the mean of {} over {} samples ({:.4g} s, {:g} period(s) of the "
+                                  "slowest acoustic mode) changed by {:.3g} (relative) over the last {} windows, below "
                                   "run.steady_tolerance = {}",
-                                  columns[c], steady_window, double(steady_window * sample_every) * units_.dt(), drift,
+                                  columns[c], steady_window, double(steady_window * sample_every) * units_.dt(),
+                                  periods, drift,
                                   kSteadyLag, steady_tol);
         log::info("{}", stop_reason);
       }
