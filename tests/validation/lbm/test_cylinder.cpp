@@ -99,7 +99,7 @@ resolution = 20
 time_step = 0.01
 [run]
 end_time = 1000
-steady_tolerance = 1.0e-7
+steady_tolerance = 1.0e-5
 [output]
 samples = 400
 vtk = false
