@@ -15,6 +15,7 @@
 #include "core/interrupt.hpp"
 #include "core/log.hpp"
 #include "drivers/driver.hpp"
+#include "drivers/flow/flow_runner.hpp"
 #include "fracflow/version.hpp"
 #include "io/run_folder.hpp"
 #include "io/scenario.hpp"
@@ -225,9 +226,11 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (*check) {
+      const drivers::FlowCheckReport derived;  // what a flow driver's validate() derives (dt, tau, Mach...)
       auto l = batch::load_scenario_for_run(scenario, sets);
       fmt::print("{}: valid; driver '{}' ({})\n\n{}", scenario.empty() ? "built-in default scenario" : scenario,
                  l->driver->name, l->driver->summary, l->config.describe());
+      if (!derived.text().empty()) fmt::print("\n{}", derived.text());
       return 0;
     }
     apply_threads(threads);

@@ -305,7 +305,9 @@ std::string Config::resolved_toml() const {
   for (auto& [k, s] : expanded_keys()) {
     auto it = values_.find(k);
     if (it != values_.end()) o += fmt::format("{} = {}\n", toml_key(k), format_value(it->second.first));
-    else if (s->default_value) o += fmt::format("{} = {}\n", toml_key(k), format_value(*s->default_value));
+    else if (s->default_value)
+      o += fmt::format("{}{} = {}\n", s->fallback_default ? "# (default, not set) " : "", toml_key(k),
+                       format_value(*s->default_value));
   }
   return o;
 }

@@ -30,6 +30,10 @@ struct ParamSpec {
   bool min_open = false, max_open = false;  // open interval ends (min < v rather than min <= v)
   std::vector<std::string> choices;         // allowed strings (String / StringList), empty = any
   std::size_t list_min = 0, list_max = std::numeric_limits<std::size_t>::max();  // list sizes
+  // The default is a fallback that another key can replace (lbm.tau against lbm.time_step):
+  // resolved_toml() writes it as a comment when it was not set, so a scenario read back (the
+  // saved scenario of a resumed run) leaves it unset, as the user did.
+  bool fallback_default = false;
 
   // Fluent setters used where the table is declared.
   ParamSpec& range(double lo, double hi) { min = lo; max = hi; return *this; }
@@ -42,6 +46,7 @@ struct ParamSpec {
   ParamSpec& one_of(std::vector<std::string> c) { choices = std::move(c); return *this; }
   ParamSpec& size(std::size_t n) { list_min = list_max = n; return *this; }
   ParamSpec& size_between(std::size_t a, std::size_t b) { list_min = a; list_max = b; return *this; }
+  ParamSpec& fallback() { fallback_default = true; return *this; }
 
   std::string allowed() const;  // human-readable "what is allowed"
   bool matches(const std::string& k) const;

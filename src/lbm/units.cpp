@@ -13,6 +13,19 @@ constexpr double kMachWarn = 0.1, kMachError = 0.3, kTauWarn = 0.01, kTauLarge =
 const double kCs = 1.0 / std::sqrt(3.0);
 }  // namespace
 
+const char* units_mode_key(UnitsMode m) {
+  switch (m) {
+    case UnitsMode::Tau: return "lbm.tau";
+    case UnitsMode::TimeStep: return "lbm.time_step";
+    case UnitsMode::Mach: return "lbm.mach";
+    case UnitsMode::TargetError: return "lbm.target_error";
+  }
+  return "lbm.tau";
+}
+
+double expected_compressibility_error(double mach) { return kCompressibilityCoefficient * mach * mach; }
+double mach_for_error(double error) { return std::sqrt(error / kCompressibilityCoefficient); }
+
 Units Units::from_tau(double dx, double tau, double nu, double rho) {
   if (!(dx > 0) || !(nu > 0) || !(rho > 0)) throw InputError("LBM units need a positive cell size, viscosity and density");
   Units u;
@@ -36,24 +49,48 @@ Units Units::from_time_step(double dx, double dt, double nu, double rho) {
   return u;
 }
 
-StabilityCheck Units::check(double u, int resolution, const std::string& resolution_key, bool tau_mode,
+Units Units::from_mach(double dx, double mach, double u, double nu, double rho) {
+  if (!(mach > 0) || !(u > 0)) throw InputError("LBM units from a Mach number need a positive Mach number and speed");
+  return from_time_step(dx, mach * kCs * dx / u, nu, rho);
+}
+
+StabilityCheck Units::check(double u, int resolution, const std::string& resolution_key, UnitsMode mode,
                             const std::string& collision) const {
   StabilityCheck r;
   const bool bgk = collision == "bgk";
   const std::string model = bgk ? "BGK (lbm.collision = \"bgk\")" : "TRT (lbm.collision = \"trt\")";
   const double ulb = to_lattice_velocity(std::abs(u));
   const double ma = ulb / kCs;
-  // Fixes for the Mach number: with tau fixed u_lb scales as 1/N; with dt fixed as dt.
+  // The fix that scales tau - 1/2 by f (f < 1 lowers the Mach number by f too at a fixed
+  // resolution, whatever the key: tau - 1/2 = 3 nu dt / dx^2 and u_lb = u dt / dx), in the
+  // key of the mode in use.
+  auto time_fix = [&](double f) {
+    const double tau_new = 0.5 + (tau_ - 0.5) * f, ma_new = ma * f;
+    switch (mode) {
+      case UnitsMode::Tau: return fmt::format("lbm.tau = {:.4g}", tau_new);
+      case UnitsMode::TimeStep: return fmt::format("lbm.time_step = {:.4g} s (tau becomes {:.4g})", dt_ * f, tau_new);
+      case UnitsMode::Mach:
+        return fmt::format("lbm.mach = {:.3g} (tau becomes {:.4g}, expected compressibility error {:.2g})", ma_new,
+                           tau_new, expected_compressibility_error(ma_new));
+      case UnitsMode::TargetError:
+        return fmt::format("lbm.target_error = {:.3g} (Mach {:.3g}, tau becomes {:.4g})",
+                           expected_compressibility_error(ma_new), ma_new, tau_new);
+    }
+    return std::string();
+  };
+  // Fixes for the Mach number: with tau fixed u_lb scales as 1/N; with dt fixed as dt; with
+  // the Mach number fixed only its own key changes it.
   auto mach_fix = [&](double target) {
     const double f = ma / target;
     const int n_needed = int(std::ceil(resolution * f));
-    if (tau_mode) {
-      const double tau_needed = 0.5 + (tau_ - 0.5) / f;
-      return fmt::format("set {} = {} or more (same lbm.tau), or lbm.tau = {:.4g}", resolution_key, n_needed, tau_needed);
+    switch (mode) {
+      case UnitsMode::Tau:
+        return fmt::format("set {} = {} or more (same lbm.tau), or {}", resolution_key, n_needed, time_fix(1 / f));
+      case UnitsMode::TimeStep:
+        return fmt::format("set {} or less, or {} = {} or more with lbm.time_step scaled by (old/new resolution)^2",
+                           time_fix(1 / f), resolution_key, n_needed);
+      default: return fmt::format("set {} or less", time_fix(1 / f));
     }
-    return fmt::format("set lbm.time_step = {:.4g} s or less (tau becomes {:.4g}), or {} = {} or more with "
-                       "lbm.time_step scaled by (old/new resolution)^2",
-                       dt_ / f, 0.5 + (tau_ - 0.5) / f, resolution_key, n_needed);
   };
   if (!(tau_ > 0.5)) {
     const double dt_needed = (0.55 - 0.5) * dx_ * dx_ / (3 * nu_);
@@ -68,32 +105,35 @@ StabilityCheck Units::check(double u, int resolution, const std::string& resolut
     return r;
   }
   if (ma > kMachWarn)
-    r.warnings.push_back(fmt::format("Mach number {:.3g} (lattice speed {:.3g}) is above {}: compressibility errors of "
-                                     "order Ma^2 = {:.2g}; {}",
-                                     ma, ulb, kMachWarn, ma * ma, mach_fix(kMachWarn)));
+    r.warnings.push_back(fmt::format("Mach number {:.3g} (lattice speed {:.3g}) is above {}: expected compressibility "
+                                     "error {:.2g} (C Ma^2); {}",
+                                     ma, ulb, kMachWarn, expected_compressibility_error(ma), mach_fix(kMachWarn)));
   if (tau_ - 0.5 < kTauWarn) {
     // Larger tau at fixed Mach needs more cells: u_lb = Re_cell (tau - 1/2)/3 with Re_cell ~ 1/N.
     const double tau_target = 0.5 + kTauWarn * 5;
     const double f = (tau_target - 0.5) / (tau_ - 0.5);
-    std::string fix = tau_mode ? fmt::format("set lbm.tau = {:.3g} (allowed: above 0.5)", tau_target)
-                               : fmt::format("set lbm.time_step = {:.4g} s (tau = {:.3g})", dt_ * f, tau_target);
     const std::string risk = bgk ? "BGK is at its stability limit there and its walls are inaccurate (TRT, "
                                    "lbm.collision = \"trt\", tolerates it better)"
                                  : "TRT stays stable only while the flow is well resolved, and the viscosity it carries "
                                    "is close to zero";
-    r.warnings.push_back(fmt::format("relaxation time tau = {:.5g} is within {} of 1/2 with the {} collision: {}; {} "
-                                     "and {} = {} or more to keep the Mach number",
-                                     tau_, kTauWarn, model, risk, fix, resolution_key, int(std::ceil(resolution * f))));
+    const int n_needed = int(std::ceil(resolution * f));
+    const bool mach_modes = mode == UnitsMode::Mach || mode == UnitsMode::TargetError;
+    const std::string fix = mach_modes ? fmt::format("set {} = {} or more (same Mach number: tau - 1/2 grows with the "
+                                                     "resolution), or {} (less accurate)",
+                                                     resolution_key, n_needed, time_fix(f))
+                                       : fmt::format("set {} (allowed: above 0.5) and {} = {} or more to keep the Mach "
+                                                     "number",
+                                                     time_fix(f), resolution_key, n_needed);
+    r.warnings.push_back(fmt::format("relaxation time tau = {:.5g} is within {} of 1/2 with the {} collision: {}; {}",
+                                     tau_, kTauWarn, model, risk, fix));
   }
   if (tau_ > kTauLarge) {
     const double tau_target = 2.0, f = (tau_target - 0.5) / (tau_ - 0.5);
-    std::string fix = tau_mode ? fmt::format("set lbm.tau = {}", tau_target)
-                               : fmt::format("set lbm.time_step = {:.4g} s (tau = {})", dt_ * f, tau_target);
     const std::string risk = bgk ? "BGK walls slip (an error growing as tau^2)"
                                  : "open-face corners can become unstable with TRT";
-    r.warnings.push_back(fmt::format("relaxation time tau = {:.4g} is large with the {} collision: {}; {} (the Mach "
+    r.warnings.push_back(fmt::format("relaxation time tau = {:.4g} is large with the {} collision: {}; set {} (the Mach "
                                      "number only drops)",
-                                     tau_, model, risk, fix));
+                                     tau_, model, risk, time_fix(f)));
   }
   return r;
 }

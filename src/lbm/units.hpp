@@ -5,10 +5,25 @@
 // force of [S003]; a 3D lattice force takes one more L_r (N). Pressures are reported relative
 // to the reference state (p - p_0 = c_s^2 (rho_lb - 1) P_r).
 #pragma once
+#include <cmath>
 #include <string>
 #include <vector>
 
 namespace ff::lbm {
+
+// The scenario key that fixed the time step (check()'s advice names the keys of this mode).
+enum class UnitsMode { Tau, TimeStep, Mach, TargetError };
+const char* units_mode_key(UnitsMode m);  // "lbm.tau", "lbm.time_step", "lbm.mach", "lbm.target_error"
+
+// Expected relative error of forces and pressures from the compressibility of the LBM at the
+// Mach number Ma = u_lb / c_s of the characteristic speed: the weakly compressible scheme
+// recovers Navier-Stokes up to O(Ma^2) terms (Krueger et al., The Lattice Boltzmann Method,
+// 2017, Sec. 4.5), so the error is C Ma^2.
+// Calibrated on the DFG 2D-1 grid study in docs/lbm.md.
+inline constexpr double kCompressibilityCoefficient = 1.0;
+double expected_compressibility_error(double mach);
+// The Mach number whose expected compressibility error is `error` (inverse of the above).
+double mach_for_error(double error);
 
 // Outcome of a stability check: warnings (the run goes on) or an error (it must not start).
 struct StabilityCheck {
@@ -23,6 +38,8 @@ class Units {
   static Units from_tau(double dx, double tau, double nu, double rho);
   // From the cell size [m] and a time step [s]: tau = 1/2 + 3 nu dt / dx^2.
   static Units from_time_step(double dx, double dt, double nu, double rho);
+  // From the cell size [m] and the Mach number of a speed u [m/s]: dt = Ma c_s dx / u.
+  static Units from_mach(double dx, double mach, double u, double nu, double rho);
 
   double dx() const { return dx_; }
   double dt() const { return dt_; }
@@ -35,6 +52,8 @@ class Units {
   double velocity_factor() const { return dx_ / dt_; }                   // u_r  [m/s]
   double pressure_factor() const { return rho_ * dx_ * dx_ / (dt_ * dt_); }  // P_r [Pa]
   double force_factor() const { return rho_ * dx_ * dx_ * dx_ / (dt_ * dt_); }  // F_r [N/m]
+
+  double mach(double u) const { return to_lattice_velocity(std::abs(u)) * std::sqrt(3.0); }  // u_lb / c_s
 
   double to_lattice_length(double m) const { return m / dx_; }
   double to_lattice_time(double s) const { return s / dt_; }
@@ -51,10 +70,10 @@ class Units {
   // Mach number and relaxation-time checks for a characteristic speed u [m/s] (METHODS §4.2:
   // tau > 1/2 needed, tau - 1/2 >= 0.01 advisable; Ma = u_lb / c_s below 0.1 advisable, above
   // 0.3 the compressibility error is unacceptable). `resolution` is the number of cells across
-  // the characteristic length, named `resolution_key` in the scenario; `tau_mode` says whether
-  // the scenario fixed tau (else the time step); `collision` is lbm.collision ("trt" or "bgk"),
+  // the characteristic length, named `resolution_key` in the scenario; `mode` says which key
+  // fixed the time step (the fixes change that key or the resolution); `collision` is lbm.collision ("trt" or "bgk"),
   // named in the messages, whose limits differ. Each message names a key and a value that fixes it.
-  StabilityCheck check(double u, int resolution, const std::string& resolution_key, bool tau_mode,
+  StabilityCheck check(double u, int resolution, const std::string& resolution_key, UnitsMode mode,
                        const std::string& collision) const;
 
   // The table printed at the start of a run.

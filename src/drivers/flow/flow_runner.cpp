@@ -6,6 +6,8 @@
 #include <cmath>
 
 #include "core/error.hpp"
+#include "drivers/flow/probes.hpp"
+#include "drivers/flow/steady.hpp"
 #include "core/log.hpp"
 #include "core/progress.hpp"
 #include "drivers/run_control.hpp"
@@ -36,21 +38,42 @@ void declare_lbm_params(ParamTable& t, const LbmDefaults& d) {
       .one_of({"compressible", "incompressible"});
   t.real("lbm.trt_magic", 3.0 / 16.0, "-", "TRT magic parameter Lambda (3/16 puts bounce-back walls exactly mid-link)")
       .positive();
-  t.real("lbm.tau", d.tau, "-", "relaxation time; gives dt = (tau - 1/2) dx^2 / (3 nu) unless lbm.time_step is set")
-      .open_range(0.5, 1e6);
-  t.real("lbm.time_step", 0.0, "s", "time step; 0: derived from lbm.tau").non_negative();
+  t.real("lbm.tau", d.tau, "-",
+         "relaxation time: dt = (tau - 1/2) dx^2 / (3 nu); used when none of lbm.time_step, lbm.mach and "
+         "lbm.target_error is set (set at most one of the four)")
+      .open_range(0.5, 1e6)
+      .fallback();
+  t.real("lbm.time_step", 0.0, "s", "time step; tau = 1/2 + 3 nu dt / dx^2 follows (0: not set)").non_negative();
+  t.real("lbm.mach", 0.0, "-",
+         fmt::format("Mach number Ma = u_lb / c_s of the case's characteristic speed U: dt = Ma c_s dx / U, tau follows; "
+                     "expected relative compressibility error of forces and pressures C Ma^2 (C = {}) (0: not set)",
+                     lbm::kCompressibilityCoefficient))
+      .range(0, 1);
+  t.real("lbm.target_error", 0.0, "-",
+         fmt::format("expected relative compressibility error C Ma^2 (C = {}) the run may make: the driver picks "
+                     "Ma = sqrt(target / C), then dt and tau as for lbm.mach (0: not set)",
+                     lbm::kCompressibilityCoefficient))
+      .range(0, 1);
   t.integer("lbm.resolution", d.resolution, "cells", "cells across the characteristic length of the case").at_least(2);
   t.real("fluid.density", d.density, "kg/m^3", "fluid density").positive();
   t.real("fluid.viscosity", d.viscosity, "m^2/s", "kinematic viscosity").positive();
   t.real("run.end_time", d.end_time, "s", "simulated time at which the run stops").positive();
   t.real("run.steady_tolerance", d.steady_tolerance, "-",
-         "stop once the monitored result changes by less than this (relative) over 3 samples; 0: run to run.end_time")
+         fmt::format("stop at steady state: once the mean of the monitored result over a window of one period of the "
+                     "slowest acoustic mode (4 L / c_s, L the longest non-periodic side; as many whole periods as hold "
+                     "{} samples) differs "
+                     "(relative) by less than this from the mean {} windows earlier, at every alignment within the last "
+                     "window, after the inflow ramp; the result is then within about this of its long-run value if it "
+                     "settles with a time constant up to ~{} windows. A vortex street does not stop. 0: run to "
+                     "run.end_time",
+                     kSteadyMinSamples, kSteadyLag, kSteadyLag))
       .non_negative();
   t.real("run.inflow_ramp_time", d.inflow_ramp_time, "s",
          "inflow velocities rise from zero as sin^2 over this time; 0: full inflow from the start; -1: automatic, "
          "20 domain lengths at the lattice sound speed (5 periods of the slowest acoustic mode between a velocity "
          "inlet and a pressure outlet, which an impulsive start leaves ringing almost undamped)")
       .at_least(-1);
+  declare_probe_params(t);
   t.integer("output.samples", 200, "-", "rows of series.csv over run.end_time").at_least(1);
   t.integer("output.snapshots", 10, "-", "VTK snapshots over run.end_time (plus the first and last)").non_negative();
   t.integer("output.checkpoints", 0, "-",
@@ -59,14 +82,57 @@ void declare_lbm_params(ParamTable& t, const LbmDefaults& d) {
       .non_negative();
 }
 
-lbm::Units make_units(const Config& cfg, double dx) {
+FlowUnits make_units(const Config& cfg, double dx, double u) {
   const double nu = cfg.real("fluid.viscosity"), rho = cfg.real("fluid.density");
-  if (cfg.has("lbm.time_step") && cfg.real("lbm.time_step") > 0) {
-    if (cfg.has("lbm.tau"))
-      cfg.fail("lbm.tau", "set either lbm.tau or lbm.time_step, not both (one follows from the other and the viscosity)");
-    return lbm::Units::from_time_step(dx, cfg.real("lbm.time_step"), nu, rho);
+  // lbm.tau counts as set when the scenario sets it (its default is a fallback, which a saved
+  // scenario.toml keeps as a comment); the other three when they are above 0.
+  std::vector<lbm::UnitsMode> set;
+  if (cfg.has("lbm.tau")) set.push_back(lbm::UnitsMode::Tau);
+  for (auto m : {lbm::UnitsMode::TimeStep, lbm::UnitsMode::Mach, lbm::UnitsMode::TargetError})
+    if (cfg.real(lbm::units_mode_key(m)) > 0) set.push_back(m);
+  if (set.size() > 1)
+    cfg.fail(lbm::units_mode_key(set[1]),
+             fmt::format("{} and {} are both set: set at most one of lbm.tau, lbm.time_step, lbm.mach and "
+                         "lbm.target_error (each fixes the time step; the others follow from it, the cell size and "
+                         "the viscosity)",
+                         lbm::units_mode_key(set[0]), lbm::units_mode_key(set[1])));
+  FlowUnits f;
+  f.mode = set.empty() ? lbm::UnitsMode::Tau : set[0];
+  f.by_default = set.empty();
+  switch (f.mode) {
+    case lbm::UnitsMode::Tau: f.units = lbm::Units::from_tau(dx, cfg.real("lbm.tau"), nu, rho); break;
+    case lbm::UnitsMode::TimeStep: f.units = lbm::Units::from_time_step(dx, cfg.real("lbm.time_step"), nu, rho); break;
+    case lbm::UnitsMode::Mach: f.units = lbm::Units::from_mach(dx, cfg.real("lbm.mach"), u, nu, rho); break;
+    case lbm::UnitsMode::TargetError:
+      f.units = lbm::Units::from_mach(dx, lbm::mach_for_error(cfg.real("lbm.target_error")), u, nu, rho);
+      break;
   }
-  return lbm::Units::from_tau(dx, cfg.real("lbm.tau"), nu, rho);
+  f.mach = f.units.mach(u);
+  f.expected_error = lbm::expected_compressibility_error(f.mach);
+  return f;
+}
+
+std::string describe_flow_units(const FlowUnits& fu, const FlowCase& fc) {
+  const auto& u = fu.units;
+  const std::string from = fu.mode != lbm::UnitsMode::Tau ? fmt::format("{}; lbm.tau is not used", fu.key())
+                           : fu.by_default                 ? "lbm.tau, its default"
+                                                           : "lbm.tau";
+  return fmt::format("time step dt = {:.6g} s and relaxation time tau = {:.6g} (from {}), cell size dx = {:.6g} m; Mach "
+                     "number {:.3g} of the characteristic speed {:.4g} m/s ({:.4g} lattice units); expected relative "
+                     "compressibility error {:.2g} ({} Ma^2)",
+                     u.dt(), u.tau(), from, u.dx(), fu.mach, fc.characteristic_speed(),
+                     u.to_lattice_velocity(fc.characteristic_speed()), fu.expected_error,
+                     lbm::kCompressibilityCoefficient);
+}
+
+namespace {
+FlowCheckReport* g_check_report = nullptr;
+}
+
+FlowCheckReport::FlowCheckReport() { g_check_report = this; }
+FlowCheckReport::~FlowCheckReport() { g_check_report = nullptr; }
+void FlowCheckReport::append(const std::string& s) {
+  if (g_check_report) g_check_report->text_ += s;
 }
 
 namespace {
@@ -93,7 +159,10 @@ template <class L, class T>
 class Runner {
  public:
   Runner(const Config& cfg, const RunOptions& opt, FlowCase& fc, std::string_view driver)
-      : cfg_(cfg), opt_(opt), fc_(fc), driver_(driver), units_(make_units(cfg, fc.cell_size())) {}
+      : cfg_(cfg), opt_(opt), fc_(fc), driver_(driver),
+        fu_(make_units(cfg, fc.cell_size(), fc.characteristic_speed())), units_(fu_.units),
+        probes_(read_probes(cfg, L::D == 3, L::D == 3 ? double(cfg.integer("lbm.depth_cells")) * fc.cell_size() : 0.0),
+                fc.cell_size()) {}
 
   RunStatus run();
 
@@ -110,7 +179,10 @@ class Runner {
   const RunOptions& opt_;
   FlowCase& fc_;
   std::string driver_;
+  FlowUnits fu_;
   lbm::Units units_;
+  Probes probes_;
+  double steady_drift_ = -1;  // last drift of the steady-state test (-1: not evaluated)
   DomainSpec dom_;
   std::unique_ptr<lbm::Solver<L, T>> sol_;
   int nz_ = 1;
@@ -254,11 +326,10 @@ void Runner<L, T>::unstable(const std::string& what) {
 template <class L, class T>
 RunStatus Runner<L, T>::run() {
   RunControl control(cfg_, opt_);
-  const bool tau_mode = !(cfg_.real("lbm.time_step") > 0);
   {
-    const auto chk = units_.check(fc_.characteristic_speed(), fc_.resolution(), fc_.resolution_key(), tau_mode,
+    const auto chk = units_.check(fc_.characteristic_speed(), fc_.resolution(), fc_.resolution_key(), fu_.mode,
                                   cfg_.string("lbm.collision"));
-    if (!chk.error.empty()) cfg_.fail(tau_mode ? "lbm.tau" : "lbm.time_step", chk.error);
+    if (!chk.error.empty()) cfg_.fail(fu_.key(), chk.error);
     build();
     log::info("{}", units_.describe(L::D));
     log::info("lattice {} {} x {} x {} ({} precision, {}): {} fluid cells, {} on boundaries, {} solid links",
@@ -268,9 +339,7 @@ RunStatus Runner<L, T>::run() {
                 for (auto& o : sol_->objects()) n += o.links;
                 return n;
               }());
-    log::info("Mach number {:.3g} (characteristic speed {:.4g} m/s = {:.4g} lattice units)",
-              std::sqrt(3.0) * units_.to_lattice_velocity(fc_.characteristic_speed()), fc_.characteristic_speed(),
-              units_.to_lattice_velocity(fc_.characteristic_speed()));
+    log::info("{}", describe_flow_units(fu_, fc_));
     for (auto& w : chk.warnings) log::warn("{}", w);
   }
   begin_output(opt_);  // the lattice is built and checked: from here on files go into out_dir
@@ -298,10 +367,21 @@ RunStatus Runner<L, T>::run() {
   if (ramp_steps > 0)
     log::info("inflow ramped up over {} steps ({:.4g} s)", ramp_steps, double(ramp_steps) * units_.dt());
   const auto steady_col = fc_.steady_column();
+  // Steady-state window (steady.hpp): one period of the slowest acoustic mode, 4 L / c_s.
+  const int acoustic_extent = std::max(dom_.periodic[0] ? 0 : dom_.nx, dom_.periodic[1] ? 0 : dom_.ny) > 0
+                                  ? std::max(dom_.periodic[0] ? 0 : dom_.nx, dom_.periodic[1] ? 0 : dom_.ny)
+                                  : std::max(dom_.nx, dom_.ny);
+  // The smallest whole number of periods that holds kSteadyMinSamples samples (a window
+  // of 10 coarse samples that is not a whole number of periods would let the ringing through).
+  const double acoustic_period = 4.0 * std::sqrt(3.0) * acoustic_extent;  // steps
+  const double periods = std::max(1.0, std::ceil(double(kSteadyMinSamples * sample_every) / acoustic_period));
+  const long steady_window =
+      std::max(kSteadyMinSamples, std::lround(periods * acoustic_period / double(sample_every)));
 
   // Names end in their SI unit (time_s, ..._Pa, ..._m_per_s); dimensionless ones have none.
   std::vector<std::string> columns = {"step", "time_s"};
   for (auto& c : fc_.columns()) columns.push_back(c);
+  probes_.columns(columns);
   ncols_ = columns.size();
   history_.reserve(std::size_t(n_samples) * ncols_);
   CsvWriter series;
@@ -327,8 +407,7 @@ RunStatus Runner<L, T>::run() {
 
   Progress progress(driver_, opt_.progress_interval_s);
   LongRunNotice long_run(double(steps_total - sol_->time_step()),
-                         fmt::format("run.end_time, a smaller {} or a larger {}", fc_.resolution_key(),
-                                     tau_mode ? "lbm.tau" : "lbm.time_step"),
+                         fmt::format("run.end_time, a smaller {} or a larger {}", fc_.resolution_key(), fu_.key()),
                          sol_->time_step());
   if (!opt_.resume) {  // resumable from the start (kill -9 before the first interval)
     write_checkpoint(cp_dir);
@@ -352,6 +431,12 @@ RunStatus Runner<L, T>::run() {
     }
     return false;
   };
+  // A resumed run already at or past --max-steps stops before stepping (else it would run on
+  // to the next poll or sample).
+  if (opt_.max_steps > 0 && sol_->time_step() >= opt_.max_steps && stop_now(sol_->time_step())) {
+    series.close();
+    return status;
+  }
   while (sol_->time_step() < steps_total) {
     const long next_sample = std::min((sol_->time_step() / sample_every + 1) * sample_every, steps_total);
     bool stopped = false;
@@ -378,19 +463,32 @@ RunStatus Runner<L, T>::run() {
     row_.push_back(double(s.step));
     row_.push_back(s.time);
     fc_.measure(s, row_);
+    probes_.measure(s, row_);
     series.row(row_);
     history_.insert(history_.end(), row_.begin(), row_.end());
     const long k = long(history_.size() / ncols_);
     const bool last = sol_->time_step() >= steps_total;
     bool steady = false;
-    if (steady_col && steady_tol > 0 && k >= 4 && sol_->time_step() > ramp_steps + 3 * sample_every) {
+    if (steady_col && steady_tol > 0) {
+      // Samples after the inflow ramp (steady.hpp): the drift of the window mean.
       const std::size_t c = std::size_t(*steady_col) + 2;
-      steady = true;
-      for (long j = k - 3; j < k; ++j) {
-        const double a = history_[std::size_t(j) * ncols_ + c], b = history_[std::size_t(j - 1) * ncols_ + c];
-        if (!(std::abs(a - b) <= steady_tol * std::max(std::abs(a), 1e-300))) steady = false;
+      const long first = (ramp_steps + sample_every - 1) / sample_every;  // first sample at or after the ramp
+      const long n = k - first;
+      const double* h = history_.data();
+      const std::size_t nc = ncols_;
+      const double drift =
+          steady_drift([&](long i) { return h[std::size_t(first + i) * nc + c]; }, n, steady_window);
+      if (std::isfinite(drift)) steady_drift_ = drift;
+      if (drift < steady_tol) {
+        steady = true;
+        stop_reason = fmt::format("steady state: the mean of {} over {} samples ({:.4g} s, {:g} period(s) of the "
+                                  "slowest acoustic mode) changed by {:.3g} (relative) over the last {} windows, below "
+                                  "run.steady_tolerance = {}",
+                                  columns[c], steady_window, double(steady_window * sample_every) * units_.dt(),
+                                  periods, drift,
+                                  kSteadyLag, steady_tol);
+        log::info("{}", stop_reason);
       }
-      if (steady) stop_reason = fmt::format("steady state ({} changed by less than {} over 3 samples)", columns[c], steady_tol);
     }
     const bool done = last || steady;
     if (vtk_every > 0 && (k % vtk_every == 0 || done)) write_vtk(s);
@@ -426,9 +524,15 @@ void Runner<L, T>::summary(const FlowSample& last, const std::string& stop_reaso
                   {"cells", {dom_.nx, dom_.ny, nz_}},
                   {"fluid_cells", sol_->num_fluid_cells()},
                   {"boundary_cells", sol_->num_boundary_cells()}};
+  j["steady_state"] = {{"tolerance", cfg_.real("run.steady_tolerance")},
+                       {"final_drift", steady_drift_ < 0 ? nlohmann::json(nullptr) : nlohmann::json(steady_drift_)}};
   j["units"] = {{"dx_m", units_.dx()},
                 {"dt_s", units_.dt()},
                 {"tau", units_.tau()},
+                {"chosen_by", fu_.by_default ? std::string("lbm.tau (default)") : std::string(fu_.key())},
+                {"mach", fu_.mach},
+                {"expected_compressibility_error", fu_.expected_error},
+                {"compressibility_coefficient", lbm::kCompressibilityCoefficient},
                 {"nu_lattice", units_.nu_lb()},
                 {"velocity_factor_m_per_s", units_.velocity_factor()},
                 {"pressure_factor_Pa", units_.pressure_factor()},
@@ -447,6 +551,28 @@ void Runner<L, T>::summary(const FlowSample& last, const std::string& stop_reaso
   for (std::size_t i = 0; i + ncols_ <= history_.size(); i += ncols_)
     rows.emplace_back(history_.begin() + std::ptrdiff_t(i), history_.begin() + std::ptrdiff_t(i + ncols_));
   fc_.finish(last, rows, opt_.out_dir, plots, results);
+  if (!probes_.empty() && !rows.empty()) {  // final values: the last row of series.csv
+    const auto& r = rows.back();
+    std::size_t at = ncols_ - (probes_.set().points.size() * (L::D == 3 ? 4 : 3) + (probes_.set().delta_p ? 1 : 0));
+    nlohmann::json pj = nlohmann::json::object();
+    for (std::size_t i = 0; i < probes_.set().points.size(); ++i) {
+      const auto& p = probes_.set().points[i];
+      nlohmann::json e = {{"x_m", p.position.x()}, {"y_m", p.position.y()}};
+      if (L::D == 3) e["z_m"] = p.position.z();
+      e["p_Pa"] = r[at++];
+      e["ux_m_per_s"] = r[at++];
+      e["uy_m_per_s"] = r[at++];
+      if (L::D == 3) e["uz_m_per_s"] = r[at++];
+      if (i < probes_.stencils().size()) e["interpolation"] = probes_.stencils()[i].method;
+      pj[p.name] = e;
+    }
+    results["probes"] = pj;
+    if (probes_.set().delta_p) {
+      results["delta_p_Pa"] = r[at];
+      results["delta_p_probes"] = {probes_.set().points[(*probes_.set().delta_p)[0]].name,
+                                   probes_.set().points[(*probes_.set().delta_p)[1]].name};
+    }
+  }
   j["results"] = results;
   j["parameters"] = params_json(cfg_);  // typed, as the DEM drivers write them
   add_run_record(j, opt_);
@@ -464,7 +590,7 @@ RunStatus run_typed(const Config& cfg, const RunOptions& opt, FlowCase& fc, std:
 RunStatus run_flow(const Config& cfg, const RunOptions& opt, FlowCase& fc, std::string_view driver) {
   const bool d3 = cfg.string("lbm.lattice") == "D3Q19";
   const bool dbl = cfg.string("lbm.precision") == "double";
-  validate_flow(cfg, fc);  // the checks `fracflow check` makes too
+  validate_flow(cfg, fc);  // the checks `fracflow check` makes too (units, probes)
   if (d3) return dbl ? run_typed<lbm::D3Q19, double>(cfg, opt, fc, driver) : run_typed<lbm::D3Q19, float>(cfg, opt, fc, driver);
   return dbl ? run_typed<lbm::D2Q9, double>(cfg, opt, fc, driver) : run_typed<lbm::D2Q9, float>(cfg, opt, fc, driver);
 }

@@ -3,6 +3,7 @@
 // summary.json and plots, checks stability, stops at steady state, end time, wall-clock limit
 // or ABORT file, and resumes bit for bit.
 #pragma once
+#include <string>
 #include <string_view>
 
 #include "drivers/driver.hpp"
@@ -21,10 +22,39 @@ struct LbmDefaults {
   double inflow_ramp_time = 0;  // s
 };
 
-// Declares lbm.*, fluid.*, run.* and output.* keys of the flow drivers.
+// Declares lbm.*, fluid.*, run.*, probes.* and output.* keys of the flow drivers.
 void declare_lbm_params(ParamTable& t, const LbmDefaults& d);
-// Units for a cell size [m] from lbm.tau or lbm.time_step, fluid.viscosity and fluid.density.
-lbm::Units make_units(const Config& cfg, double dx);
+
+// The units of a flow run and the key that chose the time step: lbm.tau, lbm.time_step,
+// lbm.mach or lbm.target_error (at most one set; none: lbm.tau's default).
+struct FlowUnits {
+  lbm::Units units;
+  lbm::UnitsMode mode = lbm::UnitsMode::Tau;
+  double mach = 0;            // Ma = u_lb / c_s of the case's characteristic speed
+  double expected_error = 0;  // lbm::expected_compressibility_error(mach)
+  bool by_default = false;    // none of the four keys set: lbm.tau's default
+  const char* key() const { return lbm::units_mode_key(mode); }
+};
+// Units for a cell size dx [m] and the characteristic speed u [m/s] of the case.
+FlowUnits make_units(const Config& cfg, double dx, double u);
+// One paragraph: dt, tau, Mach number, expected compressibility error and the key in use.
+std::string describe_flow_units(const FlowUnits& fu, const FlowCase& fc);
+
+// `fracflow check` prints what a flow scenario derives (dt, tau, Mach number, expected error,
+// warnings): while one of these lives, validate_flow() appends its report to it. One at a
+// time, for the CLI's check (a process-wide hook, so that no driver file has to pass it on).
+class FlowCheckReport {
+ public:
+  FlowCheckReport();
+  ~FlowCheckReport();
+  FlowCheckReport(const FlowCheckReport&) = delete;
+  FlowCheckReport& operator=(const FlowCheckReport&) = delete;
+  const std::string& text() const { return text_; }
+  static void append(const std::string& s);  // no-op when none lives
+
+ private:
+  std::string text_;
+};
 
 RunStatus run_flow(const Config& cfg, const RunOptions& opt, FlowCase& fc, std::string_view driver_name);
 

@@ -20,7 +20,7 @@ lid_velocity = 1.0e-3
 viscosity = 1.0e-6
 [run]
 end_time = 1.0e4
-steady_tolerance = 1.0e-6
+steady_tolerance = 1.0e-5
 [output]
 vtk = false
 plots = false

@@ -46,7 +46,7 @@ viscosity = 1.0e-6
 [lbm]
 tau = 1.0
 [run]
-steady_tolerance = 1.0e-7
+steady_tolerance = 1.0e-5
 [output]
 samples = 2000
 vtk = false
@@ -99,7 +99,7 @@ resolution = 20
 time_step = 0.01
 [run]
 end_time = 1000
-steady_tolerance = 1.0e-7
+steady_tolerance = 1.0e-5
 [output]
 samples = 400
 vtk = false
