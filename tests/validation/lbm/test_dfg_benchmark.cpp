@@ -13,7 +13,7 @@
 //   D = 20: c_D 5.651 (+1.1%), c_L 0.00999 (-3.9%), L_a 0.0847 (in), Delta p 0.1181 (+0.4%)
 //   D = 40: c_D 5.635 (+0.8%), c_L 0.01039 (-0.1%), L_a 0.0851 (in), Delta p 0.1187 (+0.9%)
 // Margins: D = 10 (default suite): 3% (c_D), 8% (c_L), 5% (L_a, Delta p); D = 20 (label long):
-// 1.5%, 1.5%, 1% and 6%.
+// 1.5% (c_D), 6% (c_L), 1.5% (L_a), 1% (Delta p).
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
