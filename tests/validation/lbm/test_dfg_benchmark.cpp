@@ -21,6 +21,7 @@
 #include <string>
 
 #include "flow_driver_runner.hpp"
+#include "lbm/analysis.hpp"
 
 namespace {
 
@@ -84,6 +85,32 @@ void check_2d1(int cells, double m_cd, double m_cl, double m_la, double m_dp) {
 }
 
 }  // namespace
+
+// The time-series tools behind the 2D-2 quantities, on a sampled sine v = sin(2 pi f t) + 0.3:
+// its extremes over whole periods (1.3 and -0.7 within the sampling error 1 - cos(pi f dt)),
+// the time of the last maximum (t = (k + 1/4) / f) and, half a period later, the minimum read
+// off by linear interpolation.
+TEST(DfgBenchmark, SeriesToolsOnASine) {
+  const double f = 3.0, dt = 1e-3;
+  std::vector<double> t, v;
+  for (int i = 0; i <= 3000; ++i) {
+    t.push_back(i * dt);
+    v.push_back(std::sin(2 * M_PI * f * t.back()) + 0.3);
+  }
+  const auto o = ff::lbm::analyse_oscillation(t, v, 0.5);
+  EXPECT_NEAR(o.frequency, f, 1e-6);
+  const auto e = ff::lbm::extremes(t, v, o.first_up, o.last_up);
+  const double tol = 1 - std::cos(M_PI * f * dt);
+  EXPECT_NEAR(e.max, 1.3, tol);
+  EXPECT_NEAR(e.min, -0.7, tol);
+  const double k = std::round(e.t_max * f - 0.25);
+  EXPECT_NEAR(e.t_max, (k + 0.25) / f, dt);
+  EXPECT_NEAR(ff::lbm::interpolate_series(t, v, e.t_max + 0.5 / o.frequency), -0.7, 2 * tol + 2 * M_PI * f * dt * 1e-3);
+  EXPECT_TRUE(std::isnan(ff::lbm::interpolate_series(t, v, 3.5)));
+  // Linear data are interpolated exactly.
+  const std::vector<double> lt = {0, 1, 3}, lv = {1, 3, 7};
+  EXPECT_DOUBLE_EQ(ff::lbm::interpolate_series(lt, lv, 2.0), 5.0);
+}
 
 #ifdef FRACFLOW_LONG_TESTS
 TEST(DfgBenchmarkLong, Case2d1) { check_2d1(20, 0.015, 0.06, 0.015, 0.01); }
