@@ -41,7 +41,7 @@ struct DomainSpec {
   Vec3 body_force = Vec3::Zero();                  // lattice force density
   // Initial state (default rest); z is 0 on D2Q9.
   std::function<void(int x, int y, int z, double& rho, Vec3& u)> init;
-  bool walled_z() const { return nz > 0; }
+  bool is_box() const { return nz > 0; }
 };
 
 // Macroscopic state at one sampling step, SI units, on the whole lattice: nx*ny*nz values,

@@ -126,7 +126,7 @@ void Runner<L, T>::build() {
   dom_ = fc_.domain(units_);
   // A 2D description is extruded along a periodic z axis (D3Q19) or has none (D2Q9); a 3D box
   // brings its own depth and z faces.
-  const bool box = dom_.walled_z();
+  const bool box = dom_.is_box();
   if (box && L::D != 3)
     throw InputError(fmt::format("{}: this case builds a 3D box ({} x {} x {} cells); set lbm.lattice = \"D3Q19\"",
                                  driver_, dom_.nx, dom_.ny, dom_.nz));
@@ -186,7 +186,7 @@ void Runner<L, T>::sample(FlowSample& s) {
   s.torque.resize(dom_.objects.size());
   // 2D description: loads per unit depth (N/m, N; the extruded depth is nz_ cells). 3D box:
   // total loads (N, N m).
-  const bool box = dom_.walled_z();
+  const bool box = dom_.is_box();
   s.depth_m = box ? nz_ * units_.dx() : 0.0;
   const double fscale = box ? units_.to_si_force(1.0, 3) : units_.to_si_force(1.0, 2) / nz_;
   for (std::size_t k = 0; k < dom_.objects.size(); ++k) {
