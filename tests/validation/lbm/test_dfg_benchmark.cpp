@@ -14,6 +14,12 @@
 //   D = 40: c_D 5.635 (+0.8%), c_L 0.01039 (-0.1%), L_a 0.0851 (in), Delta p 0.1187 (+0.9%)
 // Margins: D = 10 (default suite): 3% (c_D), 8% (c_L), 5% (L_a, Delta p); D = 20 (label long):
 // 1.5% (c_D), 6% (c_L), 1.5% (L_a), 1% (Delta p).
+//
+// Label long also runs 2D-2 (U_m = 1.5 m/s, Re = 100; intervals c_D,max 3.22-3.24, c_L,max
+// 0.99-1.01, St 0.295-0.305, Delta p(t0 + 1/(2f)) 2.46-2.50 Pa) at D = 20, Mach 0.087, tau 0.52:
+// measured c_D,max 3.381 (+4.3%), c_L,max 1.024 (+1.4%), St 0.2996 (in), Delta p 2.4925 (in) over
+// 11 periods (543 s on 2 busy cores); margins 5%, 3%, 1%, 1%. And 3D-1Z (duct 2.5 x 0.41 x 0.41,
+// U_m = 0.45 m/s, Re = 20; c_D 6.05-6.25, c_L 0.008-0.010, Delta p 0.165-0.175 Pa) at D = 10.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
@@ -114,6 +120,41 @@ TEST(DfgBenchmark, SeriesToolsOnASine) {
 
 #ifdef FRACFLOW_LONG_TESTS
 TEST(DfgBenchmarkLong, Case2d1) { check_2d1(20, 0.015, 0.06, 0.015, 0.01); }
+
+TEST(DfgBenchmarkLong, Case2d2) {
+  const auto j = ff::testing::run_flow_driver(
+      "dfg_2d2_20", kDfg2d1,
+      {"inlet.velocity=1.5", "cylinder.initial_perturbation=0.05", "lbm.resolution=20", "lbm.time_step=1.6666666667e-4",
+       "run.end_time=10", "output.samples=4000"});
+  const auto& r = j["results"];
+  std::printf("DFG 2D-2, D = 20 cells, Mach %.3f, tau %.4f, %.1f s wall, %d periods:\n",
+              double(j["units"]["mach_characteristic"]), double(j["units"]["tau"]), double(j["wall_time_s"]),
+              int(r["shedding_periods_averaged"]));
+  EXPECT_NEAR(double(r["reynolds"]), 100.0, 1e-9);
+  ASSERT_TRUE(bool(r["shedding"]));
+  EXPECT_GE(int(r["shedding_periods_averaged"]), 8);
+  expect_in({"c_D,max", 3.22, 3.24}, r["cd_max_periods"], 0.05);
+  expect_in({"c_L,max", 0.99, 1.01}, r["cl_max_periods"], 0.03);
+  expect_in({"St", 0.295, 0.305}, r["strouhal"], 0.01);
+  ASSERT_FALSE(r["dp_half_period_after_cl_max_Pa"].is_null());
+  expect_in({"dp [Pa]", 2.46, 2.50}, r["dp_half_period_after_cl_max_Pa"], 0.01);
+}
+
+// As examples/dfg_3d1z.toml.
+TEST(DfgBenchmarkLong, Case3d1z) {
+  const auto j = ff::testing::run_flow_driver(
+      "dfg_3d1z_10", kDfg2d1,
+      {"channel.length=2.5", "channel.depth=0.41", "cylinder.x=0.5", "inlet.velocity=0.45", "lbm.lattice=\"D3Q19\"",
+       "lbm.resolution=10", "lbm.time_step=1.1111111111e-3", "run.end_time=16", "output.samples=320"});
+  const auto& r = j["results"];
+  std::printf("DFG 3D-1Z, D = 10 cells, Mach %.3f, tau %.4f, %.1f s wall:\n", double(j["units"]["mach_characteristic"]),
+              double(j["units"]["tau"]), double(j["wall_time_s"]));
+  EXPECT_NEAR(double(r["reynolds"]), 20.0, 1e-9);
+  ASSERT_FALSE(bool(r["shedding"]));
+  expect_in({"c_D", 6.05, 6.25}, r["cd_final"], 0.03);
+  expect_in({"c_L", 0.008, 0.010}, r["cl_final"], 0.10);
+  expect_in({"dp [Pa]", 0.165, 0.175}, r["dp_final_Pa"], 0.03);
+}
 #else
 TEST(DfgBenchmark, Case2d1Coarse) { check_2d1(10, 0.03, 0.08, 0.05, 0.05); }
 #endif
