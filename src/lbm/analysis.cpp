@@ -73,4 +73,25 @@ double time_average(std::span<const double> t, std::span<const double> v, double
   return span > 0 ? area / span : 0.0;
 }
 
+Extremes extremes(std::span<const double> t, std::span<const double> v, double t0, double t1) {
+  Extremes e{INFINITY, -INFINITY, NAN};
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    if (t[i] < t0 || t[i] > t1) continue;
+    e.min = std::min(e.min, v[i]);
+    if (v[i] >= e.max) {
+      e.max = v[i];
+      e.t_max = t[i];
+    }
+  }
+  if (!(e.t_max == e.t_max)) return Extremes{NAN, NAN, NAN};
+  return e;
+}
+
+double interpolate_series(std::span<const double> t, std::span<const double> v, double s) {
+  if (t.empty() || s < t.front() || s > t.back()) return NAN;
+  for (std::size_t i = 1; i < t.size(); ++i)
+    if (s <= t[i]) return t[i] > t[i - 1] ? v[i - 1] + (v[i] - v[i - 1]) * (s - t[i - 1]) / (t[i] - t[i - 1]) : v[i];
+  return v.back();
+}
+
 }  // namespace ff::lbm

@@ -23,4 +23,15 @@ Oscillation analyse_oscillation(std::span<const double> t, std::span<const doubl
 // with the crossings of an Oscillation it averages over whole periods.
 double time_average(std::span<const double> t, std::span<const double> v, double t0, double t1);
 
+// Smallest and largest sample of v(t) with t0 <= t <= t1, and the time of the largest (the
+// last one on ties); NaN if no sample lies in the window.
+struct Extremes {
+  double min = 0, max = 0;
+  double t_max = 0;
+};
+Extremes extremes(std::span<const double> t, std::span<const double> v, double t0, double t1);
+
+// v at time s, linear interpolation between samples; NaN outside [t.front(), t.back()].
+double interpolate_series(std::span<const double> t, std::span<const double> v, double s);
+
 }  // namespace ff::lbm

@@ -1,9 +1,16 @@
 // flow/cylinder: a circular cylinder between two plates ([S003] Sec. 3.3): Zou-He inflow on
-// x- (uniform or parabolic), Zou-He pressure outlet on x+, no-slip plates on y-/y+.
+// x- (uniform or parabolic), an outlet on x+ (Zou-He pressure, zero-gradient or convective),
+// no-slip plates on y-/y+; with channel.depth > 0 a D3Q19 duct with walls on z-/z+ too, the
+// cylinder spanning it (the DFG 3D-1Z geometry of Schaefer & Turek 1996, Fig. 3).
 // Results: drag and lift coefficients Cd = 2 F_x / (rho U^2 D), Cl = 2 F_y / (rho U^2 D)
-// (forces per unit depth), Strouhal number St = f D / U from the lift history, and the wall
-// correction factor lambda = F_x / (mu u_max) of [S003] Eq. 16.
+// (forces per unit depth; in the duct total forces over rho U^2 D W / 2, W the depth), Strouhal
+// number St = f D / U from the lift history, the wall correction factor lambda = F_x / (mu u_max)
+// of [S003] Eq. 16, and the DFG benchmark quantities (Schaefer & Turek 1996, Sec. 2): pressure
+// difference between the front and back points of the cylinder, recirculation length L_a, and
+// for vortex shedding the extremes of Cd and Cl and Delta p half a period after the maximum lift.
 #include <fmt/format.h>
+
+#include <Eigen/Dense>
 
 #include <cmath>
 
@@ -30,6 +37,10 @@ void declare(ParamTable& t) {
   declare_lbm_params(t, d);
   t.real("channel.height", 0.16, "m", "distance H between the plates").positive();
   t.real("channel.length", 0.4, "m", "length from the inlet to the outlet").positive();
+  t.real("channel.depth", 0.0, "m",
+         "0: a 2D channel (D3Q19 extrudes it along a periodic z axis of lbm.depth_cells cells); > 0: a D3Q19 duct "
+         "this deep with no-slip walls on z-/z+, the cylinder spanning it (DFG 3D-1Z)")
+      .non_negative();
   t.string("channel.sides", "walls",
            "y boundaries: walls (no-slip plates, [S003] 3.3) or periodic (a row of cylinders H apart, which "
            "approximates a cylinder in unbounded flow when H >> D)")
@@ -52,21 +63,34 @@ void declare(ParamTable& t) {
            "inflow boundary: zou_he (Zou & He 1997, velocity imposed on the first nodes) or bounce_back (moving-wall "
            "bounce-back half a cell upstream, [S003] Eq. 8)")
       .one_of({"zou_he", "bounce_back"});
-  t.string("inlet.profile", "uniform", "inflow profile: uniform, or parabolic (Poiseuille)").one_of({"uniform", "parabolic"});
+  t.string("inlet.profile", "uniform",
+           "inflow profile: uniform, or parabolic (Poiseuille; in a duct 16 U y z (H - y)(W - z) / (H W)^2)")
+      .one_of({"uniform", "parabolic"});
+  t.string("outlet.condition", "pressure",
+           "outflow boundary: pressure (Zou-He, p = 0 on the last nodes), zero_gradient (populations extrapolated "
+           "from the interior) or convective (convected out with the mean outflow velocity)")
+      .one_of({"pressure", "zero_gradient", "convective"});
   t.real("inlet.velocity", 0.01, "m/s", "inflow velocity: the uniform value, or the maximum of the parabola").positive();
 }
 
 class CylinderCase : public FlowCase {
  public:
   explicit CylinderCase(const Config& cfg)
-      : H_(cfg.real("channel.height")), len_(cfg.real("channel.length")), D_(cfg.real("cylinder.diameter")),
+      : H_(cfg.real("channel.height")), len_(cfg.real("channel.length")), W_(cfg.real("channel.depth")),
+        D_(cfg.real("cylinder.diameter")),
         xc_(cfg.real("cylinder.x")), yc_(cfg.real("cylinder.y") < 0 ? 0.5 * H_ : cfg.real("cylinder.y")),
         U_(cfg.real("inlet.velocity")), rho_(cfg.real("fluid.density")), nu_(cfg.real("fluid.viscosity")),
         kick_(cfg.real("cylinder.initial_perturbation")), ramp_(cfg.real("run.inflow_ramp_time") != 0),
         n_(int(cfg.integer("lbm.resolution"))),
         parabolic_(cfg.string("inlet.profile") == "parabolic"), inlet_bb_(cfg.string("inlet.condition") == "bounce_back"),
         periodic_(cfg.string("channel.sides") == "periodic"), image_(cfg.string("obstacles.image")),
-        threshold_(int(cfg.integer("obstacles.threshold"))) {
+        threshold_(int(cfg.integer("obstacles.threshold"))), outlet_(cfg.string("outlet.condition")) {
+    if (W_ > 0 && cfg.string("lbm.lattice") != "D3Q19")
+      cfg.fail("channel.depth", "a duct with walls in z (channel.depth > 0) needs lbm.lattice = \"D3Q19\"; 0 gives a 2D channel");
+    if (W_ > 0 && cfg.has("lbm.depth_cells"))
+      cfg.fail("lbm.depth_cells", "the duct's depth comes from channel.depth; remove lbm.depth_cells");
+    if (W_ > 0 && periodic_)
+      cfg.fail("channel.sides", "a duct (channel.depth > 0) has walls on all four sides; use channel.sides = \"walls\"");
     if (periodic_ && parabolic_)
       cfg.fail("inlet.profile", "a parabolic inflow needs plates: use channel.sides = \"walls\" or a uniform inflow");
     const std::string w = cfg.string("cylinder.wall");
@@ -88,11 +112,21 @@ class CylinderCase : public FlowCase {
   int resolution() const override { return n_; }
   // The inflow speed (the maximum of a parabola) sets the Mach number, as usual for bluff bodies.
   double characteristic_speed() const override { return U_; }
-  // Reference velocity of Cd, Cl, Re and St: the uniform inflow, or the mean of the parabola.
-  double u_ref() const { return parabolic_ ? 2.0 / 3.0 * U_ : U_; }
+  bool duct() const { return W_ > 0; }
+  // Reference velocity of Cd, Cl, Re and St: the uniform inflow, or the mean of the parabola
+  // (2/3 U across plates, 4/9 U over the duct's cross-section).
+  double u_ref() const { return parabolic_ ? (duct() ? 4.0 / 9.0 : 2.0 / 3.0) * U_ : U_; }
   // Largest velocity of the undisturbed (developed) channel flow, for lambda ([S003] Eq. 16).
   double u_max() const { return parabolic_ ? U_ : 1.5 * U_; }
-  double inflow(double y) const { return parabolic_ ? 4 * U_ * y * (H_ - y) / (H_ * H_) : U_; }
+  // Inflow profile; z only in the duct (Schaefer & Turek 1996: U(0, y, z) = 16 Um y z (H-y)(H-z)/H^4).
+  double inflow(double y, double z = -1) const {
+    if (!parabolic_) return U_;
+    const double a = 4 * U_ * y * (H_ - y) / (H_ * H_);
+    return duct() && z >= 0 ? 4 * a * z * (W_ - z) / (W_ * W_) : a;
+  }
+  // Length the forces are divided by in Cd, Cl: 1 m of depth in 2D (forces per unit depth),
+  // the span W of the cylinder in the duct (total forces).
+  double span() const { return duct() ? W_ : 1.0; }
 
   DomainSpec domain(const lbm::Units& u) override {
     units_ = u;
@@ -100,20 +134,34 @@ class CylinderCase : public FlowCase {
     DomainSpec d;
     d.nx = int(std::lround(len_ / dx));
     d.ny = int(std::lround(H_ / dx));
-    d.periodic = {false, periodic_};
+    d.nz = duct() ? std::max(1, int(std::lround(W_ / dx))) : 0;
+    d.periodic = {false, periodic_, false};
     d.faces[0].kind = inlet_bb_ ? lbm::FaceCondition::Kind::Wall : lbm::FaceCondition::Kind::Velocity;
-    // A plug profile is singular where it meets the no-slip plates: the two Zou-He inflow nodes
-    // next to the plates get half the speed (the mean over their half cell); at full speed these
-    // corner nodes drive TRT unstable at large tau.
-    const int ny = d.ny;
-    d.faces[0].profile = [this, dx, ny](int, int y, int) {
-      const double corner = !parabolic_ && !inlet_bb_ && !periodic_ && (y == 0 || y == ny - 1) ? 0.5 : 1.0;
-      return Vec3(corner * units_.to_lattice_velocity(inflow((y + 0.5) * dx)), 0, 0);
+    // A plug profile is singular where it meets the no-slip walls: the Zou-He inflow nodes next
+    // to a wall get half the speed (the mean over their half cell); at full speed these corner
+    // nodes drive TRT unstable at large tau.
+    const int ny = d.ny, nz = d.nz;
+    const bool box = duct();
+    d.faces[0].profile = [this, dx, ny, nz, box](int, int y, int z) {
+      double corner = 1.0;
+      if (!parabolic_ && !inlet_bb_) {
+        if (!periodic_ && (y == 0 || y == ny - 1)) corner *= 0.5;
+        if (box && (z == 0 || z == nz - 1)) corner *= 0.5;
+      }
+      return Vec3(corner * units_.to_lattice_velocity(inflow((y + 0.5) * dx, box ? (z + 0.5) * dx : -1)), 0, 0);
     };
-    d.faces[1].kind = lbm::FaceCondition::Kind::Pressure;
-    d.faces[1].density = 1;
+    using K = lbm::FaceCondition;
+    if (outlet_ == "pressure") {
+      d.faces[1].kind = K::Kind::Pressure;
+      d.faces[1].density = 1;
+    } else {  // the solver implements the open outflow faces (lbm/solver.hpp)
+      d.faces[1].kind = K::Kind::Outflow;
+      d.faces[1].outflow = outlet_ == "convective" ? K::Outflow::Convective : K::Outflow::ZeroGradient;
+      d.faces[1].convective_velocity = 0;  // the face's mean normal velocity
+    }
+    // z faces of the duct keep the default: no-slip walls.
     // Lattice coordinates: cell (i, j) has its centre at ((i + 1/2) dx, (j + 1/2) dx).
-    const Vec3 c(xc_ / dx - 0.5, yc_ / dx - 0.5, 0);
+    const Vec3 c(xc_ / dx - 0.5, yc_ / dx - 0.5, box ? 0.5 * nz - 0.5 : 0.0);
     const double r = 0.5 * D_ / dx;
     DomainSpec::Object cyl;
     cyl.name = "cylinder";
@@ -121,42 +169,151 @@ class CylinderCase : public FlowCase {
     cyl.center = c;
     cyl.shape = lbm::Circle{c, r};
     d.objects.push_back(cyl);
+    std::vector<std::uint8_t> image_solid;
     if (!image_.empty()) {
       DomainSpec::Object img;
       img.name = "image obstacles";
       img.center = c;
       img.cells = lbm::solid_cells(obstacles_, d.nx, d.ny, threshold_);
+      image_solid.assign(std::size_t(d.nx) * d.ny, 0);
+      for (auto& k : img.cells) image_solid[std::size_t(k[0]) + std::size_t(d.nx) * k[1]] = 1;
       d.objects.push_back(img);
     }
+    // Delta p probes on the front and back points of the cylinder (the mid-plane of the duct).
+    auto solid = [&](int x, int y) {
+      return lbm::inside(*cyl.shape, Vec3(x, y, 0)) ||
+             (!image_solid.empty() && image_solid[std::size_t(x) + std::size_t(d.nx) * y]);
+    };
+    const double zc = box ? 0.5 * nz - 0.5 : 0.0;  // lattice z of the mid-plane
+    front_ = surface_probe(Vec3(c.x() - r, c.y(), zc), d.nx, d.ny, box ? nz : 1, solid);
+    back_ = surface_probe(Vec3(c.x() + r, c.y(), zc), d.nx, d.ny, box ? nz : 1, solid);
     const double kick = kick_ * u.to_lattice_velocity(u_ref());
-    d.init = [this, dx, c, r, kick](int x, int y, double&, Vec3& v) {
-      v = ramp_ ? Vec3::Zero() : Vec3(units_.to_lattice_velocity(inflow((y + 0.5) * dx)), 0, 0);
+    d.init = [this, dx, c, r, kick, box](int x, int y, int z, double&, Vec3& v) {
+      v = ramp_ ? Vec3::Zero() : Vec3(units_.to_lattice_velocity(inflow((y + 0.5) * dx, box ? (z + 0.5) * dx : -1)), 0, 0);
       const double ex = x - (c.x() + 2 * r), ey = y - c.y();
       v.y() += kick * std::exp(-(ex * ex + ey * ey) / (r * r));
     };
     return d;
   }
 
-  // Forces per unit depth with their unit; the coefficients are dimensionless.
-  std::vector<std::string> columns() const override { return {"Fx_N_per_m", "Fy_N_per_m", "Cd", "Cl"}; }
+  // The pressure at a point p (lattice coordinates) on the cylinder's surface, as a fixed linear
+  // combination of the pressures of nearby fluid nodes: value at p of the second-order
+  // polynomial fitted by weighted least squares (Gaussian weights, width 1.5 cells) to the fluid
+  // nodes within 3 cells (2D: 6 coefficients in x, y; duct: 10 in x, y, z). Set up once, so the
+  // time loop only forms a dot product.
+  struct Probe {
+    std::vector<std::size_t> cells;  // FlowSample indices
+    std::vector<double> coef;
+  };
+  template <class Solid>
+  static Probe surface_probe(const Vec3& p, int nx, int ny, int nz, const Solid& solid) {
+    constexpr double kRadius = 3.0, kWidth = 1.5;
+    const bool d3 = nz > 1;
+    const int nb = d3 ? 10 : 6;
+    std::vector<std::array<int, 3>> nodes;
+    for (int z = 0; z < nz; ++z)
+      for (int y = int(std::floor(p.y() - kRadius)); y <= int(std::ceil(p.y() + kRadius)); ++y)
+        for (int x = int(std::floor(p.x() - kRadius)); x <= int(std::ceil(p.x() + kRadius)); ++x) {
+          if (x < 0 || y < 0 || x >= nx || y >= ny || solid(x, y)) continue;
+          const Vec3 e = Vec3(x, y, d3 ? z : p.z()) - p;
+          if (e.norm() <= kRadius) nodes.push_back({x, y, z});
+        }
+    Eigen::MatrixXd A(Eigen::Index(nodes.size()), nb);
+    Eigen::VectorXd w(Eigen::Index(nodes.size()));
+    for (std::size_t k = 0; k < nodes.size(); ++k) {
+      const double ex = nodes[k][0] - p.x(), ey = nodes[k][1] - p.y(), ez = d3 ? nodes[k][2] - p.z() : 0.0;
+      const auto i = Eigen::Index(k);
+      w(i) = std::exp(-(ex * ex + ey * ey + ez * ez) / (kWidth * kWidth));
+      A(i, 0) = 1;
+      A(i, 1) = ex;
+      A(i, 2) = ey;
+      A(i, 3) = ex * ex;
+      A(i, 4) = ex * ey;
+      A(i, 5) = ey * ey;
+      if (d3) {
+        A(i, 6) = ez;
+        A(i, 7) = ez * ez;
+        A(i, 8) = ex * ez;
+        A(i, 9) = ey * ez;
+      }
+    }
+    Probe pr;
+    if (Eigen::Index(nodes.size()) < nb) return pr;  // too coarse a lattice: no value
+    // p(p) = e_0^T (A^T W A)^-1 A^T W values.
+    const Eigen::MatrixXd AtW = A.transpose() * w.asDiagonal();
+    const Eigen::MatrixXd M = AtW * A;
+    const Eigen::VectorXd row = M.ldlt().solve(Eigen::VectorXd::Unit(nb, 0));
+    const Eigen::VectorXd coef = AtW.transpose() * row;
+    for (std::size_t k = 0; k < nodes.size(); ++k) {
+      pr.cells.push_back(std::size_t(nodes[k][0]) +
+                         std::size_t(nx) * (std::size_t(nodes[k][1]) + std::size_t(ny) * std::size_t(nodes[k][2])));
+      pr.coef.push_back(coef(Eigen::Index(k)));
+    }
+    return pr;
+  }
+  static double probe_value(const Probe& pr, std::span<const double> f) {
+    if (pr.cells.empty()) return NAN;
+    double v = 0;
+    for (std::size_t k = 0; k < pr.cells.size(); ++k) v += pr.coef[k] * f[pr.cells[k]];
+    return v;
+  }
+
+  // Recirculation length L_a = x_r - (x_c + D/2) from the last sample: x_r is where u_x on the
+  // line y = y_c (mid-plane of the duct) behind the cylinder changes from negative to positive
+  // (linear interpolation in y between rows, in x between nodes). 0 without a recirculation zone.
+  double recirculation_length(const FlowSample& s) const {
+    const double dx = units_.dx();
+    const double yl = yc_ / dx - 0.5;
+    const int y0 = std::clamp(int(std::floor(yl)), 0, s.ny - 2);
+    const double ay = yl - y0;
+    const int za = duct() ? (s.nz - 1) / 2 : 0, zb = duct() ? s.nz / 2 : 0;
+    auto ux = [&](int x) {
+      double v = 0;
+      for (int z : {za, zb})
+        v += 0.5 * ((1 - ay) * s.velocity[s.at(x, y0, z)].x() + ay * s.velocity[s.at(x, y0 + 1, z)].x());
+      return v;
+    };
+    auto solid = [&](int x) { return s.solid[s.at(x, y0, za)] || s.solid[s.at(x, y0 + 1, za)]; };
+    const double x_back = xc_ + 0.5 * D_;
+    int x = int(std::floor(x_back / dx - 0.5));
+    while (x < s.nx && solid(x)) ++x;
+    if (x >= s.nx - 1 || ux(x) >= 0) return 0.0;
+    for (; x + 1 < s.nx; ++x) {
+      const double a = ux(x), b = ux(x + 1);
+      if (a < 0 && b >= 0) {
+        const double xr = (x + 0.5 + a / (a - b)) * dx;
+        return xr - x_back;
+      }
+    }
+    return 0.0;
+  }
+
+  // Forces per unit depth (2D) or total forces (duct) with their unit; the coefficients are
+  // dimensionless; Delta p = p(front) - p(back) of the cylinder.
+  std::vector<std::string> columns() const override {
+    if (duct()) return {"Fx_N", "Fy_N", "Cd", "Cl", "dp_front_back_Pa"};
+    return {"Fx_N_per_m", "Fy_N_per_m", "Cd", "Cl", "dp_front_back_Pa"};
+  }
   void measure(const FlowSample& s, std::vector<double>& row) const override {
     const Vec3 F = s.force[0];
-    const double q = 0.5 * rho_ * u_ref() * u_ref() * D_;
-    row.insert(row.end(), {F.x(), F.y(), F.x() / q, F.y() / q});
+    const double q = 0.5 * rho_ * u_ref() * u_ref() * D_ * span();
+    const double dp = probe_value(front_, s.pressure) - probe_value(back_, s.pressure);
+    row.insert(row.end(), {F.x(), F.y(), F.x() / q, F.y() / q, dp});
   }
   std::optional<int> steady_column() const override { return 2; }
   std::string progress_text(const std::vector<double>& row) const override {
-    return fmt::format("Cd {:.4f}  Cl {:+.4f}", row[4], row[5]);
+    return fmt::format("Cd {:.4f}  Cl {:+.4f}  dp {:.4g} Pa", row[4], row[5], row[6]);
   }
 
   void finish(const FlowSample& last, const std::vector<std::vector<double>>& hist, const fs::path& out, bool plots,
               nlohmann::json& res) const override {
-    std::vector<double> t, cd, cl, fx;
+    std::vector<double> t, cd, cl, fx, dp;
     for (auto& r : hist) {
       t.push_back(r[1]);
       fx.push_back(r[2]);
       cd.push_back(r[4]);
       cl.push_back(r[5]);
+      dp.push_back(r[6]);
     }
     // Statistics over the second half of the time after the inflow reached full speed (the
     // first half of it is the start-up of the wake).
@@ -166,12 +323,20 @@ class CylinderCase : public FlowCase {
     const bool shedding = lift.cycles >= 2 && (lift.max - lift.min) > 1e-3;
     const double cd_mean = shedding ? lbm::time_average(t, cd, lift.first_up, lift.last_up) : cd.back();
     const double re = u_ref() * D_ / nu_;
+    auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
     res["reynolds"] = re;
     res["blockage_D_over_H"] = D_ / H_;
     res["reference_velocity_m_per_s"] = u_ref();
+    res["geometry"] = duct() ? "duct" : "2d";
+    res["depth_m"] = W_;  // 0: 2D, forces per unit depth
+    res["force_unit"] = duct() ? "N" : "N/m";
+    res["coefficient_area_m2_per_m"] = D_ * span();  // D (per unit depth) or D W (duct), in Cd = 2 F / (rho U^2 A)
+    res["outlet_condition"] = outlet_;
     res["cd_mean"] = cd_mean;
     res["averaging_from_s"] = t_from;
     res["cd_final"] = cd.back();
+    res["cl_final"] = cl.back();
+    res["dp_final_Pa"] = num(dp.back());
     res["cd_min"] = drag.min;
     res["cd_max"] = drag.max;
     res["cl_amplitude"] = 0.5 * (lift.max - lift.min);
@@ -184,14 +349,41 @@ class CylinderCase : public FlowCase {
                                            "(2 needed), Cl amplitude {:.3g}",
                                            lift.cycles, t_from, t.back(), 0.5 * (lift.max - lift.min));
     res["shedding_periods_averaged"] = shedding ? lift.cycles : 0;
-    res["lambda_wall_factor"] = fx.back() / (rho_ * nu_ * u_max());  // [S003] Eq. 16
+    // The DFG benchmark quantities (Schaefer & Turek 1996): steady flow: the final values and
+    // the recirculation length; vortex shedding: extremes and means over the whole periods
+    // between the first and last upward crossings of the mean lift, and Delta p at t0 + 1/(2f),
+    // t0 the time of the (last) maximum lift in those periods.
+    if (shedding) {
+      const auto cdx = lbm::extremes(t, cd, lift.first_up, lift.last_up);
+      const auto clx = lbm::extremes(t, cl, lift.first_up, lift.last_up);
+      const double t_dp = clx.t_max + 0.5 / lift.frequency;
+      res["cd_max_periods"] = cdx.max;
+      res["cd_min_periods"] = cdx.min;
+      res["cl_max_periods"] = clx.max;
+      res["cl_min_periods"] = clx.min;
+      res["cl_mean_periods"] = lbm::time_average(t, cl, lift.first_up, lift.last_up);
+      res["period_s"] = 1.0 / lift.frequency;
+      res["cl_max_time_s"] = clx.t_max;
+      res["dp_half_period_after_cl_max_time_s"] = t_dp;
+      res["dp_half_period_after_cl_max_Pa"] =
+          t_dp <= t.back() ? num(lbm::interpolate_series(t, dp, t_dp)) : nlohmann::json(nullptr);
+      res["recirculation_length_m"] = nullptr;
+      res["recirculation_length_reason"] = "vortex shedding: no steady recirculation zone";
+    } else {
+      res["recirculation_length_m"] = recirculation_length(last);
+    }
+    res["lambda_wall_factor"] = fx.back() / span() / (rho_ * nu_ * u_max());  // [S003] Eq. 16, per unit depth
     res["wall_scheme"] = scheme_ == lbm::WallScheme::Bouzidi ? "bouzidi" : scheme_ == lbm::WallScheme::Yu ? "yu" : "halfway";
     if (shedding)
-      log::info("cylinder Re = {:.4g}: mean Cd = {:.4f}, Cl amplitude = {:.4f}, St = {:.4f} (over {} shedding periods)", re,
-                cd_mean, 0.5 * (lift.max - lift.min), lift.frequency * D_ / u_ref(), lift.cycles);
+      log::info("cylinder Re = {:.4g}: mean Cd = {:.4f}, Cd max = {:.4f}, Cl max = {:.4f}, St = {:.4f} (over {} shedding "
+                "periods), Delta p(t0 + T/2) = {:.4g} Pa",
+                re, cd_mean, double(res["cd_max_periods"]), double(res["cl_max_periods"]), lift.frequency * D_ / u_ref(),
+                lift.cycles, res["dp_half_period_after_cl_max_Pa"].is_null() ? NAN : double(res["dp_half_period_after_cl_max_Pa"]));
     else
-      log::info("cylinder Re = {:.4g}: Cd = {:.4f}, lambda = F/(mu u_max) = {:.4f} (steady, no shedding)", re, cd.back(),
-                fx.back() / (rho_ * nu_ * u_max()));
+      log::info("cylinder Re = {:.4g}: Cd = {:.4f}, Cl = {:.5f}, Delta p = {:.4g} Pa, L_a = {:.4g} m, lambda = {:.4f} "
+                "(steady, no shedding)",
+                re, cd.back(), cl.back(), dp.back(), double(res["recirculation_length_m"]),
+                double(res["lambda_wall_factor"]));
     if (!plots) return;
     PlotSpec p;
     p.title = fmt::format("Cylinder in a channel, Re = {:.4g}: force coefficients", re);
@@ -202,24 +394,26 @@ class CylinderCase : public FlowCase {
     p.y2 = {"Cl"};
     p.y2label = "lift coefficient Cl";
     PlotSpec f;
-    f.title = "Cylinder in a channel: force per unit depth";
+    f.title = duct() ? "Cylinder in a duct: force" : "Cylinder in a channel: force per unit depth";
     f.x = "time_s";
     f.xlabel = "time [s]";
-    f.y = {"Fx_N_per_m", "Fy_N_per_m"};
-    f.ylabel = "force [N/m]";
+    f.y = duct() ? std::vector<std::string>{"Fx_N", "Fy_N"} : std::vector<std::string>{"Fx_N_per_m", "Fy_N_per_m"};
+    f.ylabel = duct() ? "force [N]" : "force [N/m]";
     const PlotJob jobs[] = {{out / "series.csv", out / "plots" / "force_coefficients.png", p},
                             {out / "series.csv", out / "plots" / "forces.png", f}};
     plot_series(jobs);
   }
 
  private:
-  double H_, len_, D_, xc_, yc_, U_, rho_, nu_, kick_;
+  double H_, len_, W_, D_, xc_, yc_, U_, rho_, nu_, kick_;
   bool ramp_;  // the inflow is ramped up: start from rest
   int n_;
   bool parabolic_, inlet_bb_, periodic_;
   std::string image_;
   lbm::GreyImage obstacles_;  // of image_, when set
   int threshold_;
+  std::string outlet_;
+  Probe front_, back_;  // Delta p probes (set by domain())
   lbm::WallScheme scheme_ = lbm::WallScheme::Bouzidi;
   lbm::Units units_;
 };

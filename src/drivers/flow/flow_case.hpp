@@ -22,39 +22,49 @@
 
 namespace ff::drivers {
 
-// The lattice problem in lattice units (a 2D description; D3Q19 runs extrude it along a
-// periodic z axis of lbm.depth_cells cells).
+// The lattice problem in lattice units. A 2D description (nz = 0) runs on D2Q9, or on D3Q19
+// extruded along a periodic z axis of lbm.depth_cells cells; nz > 0 describes a 3D box (D3Q19
+// only) whose z faces are periodic or conditions of their own (e.g. the walls of a duct).
 struct DomainSpec {
   int nx = 1, ny = 1;
-  std::array<bool, 2> periodic{};                  // x, y
-  std::array<lbm::FaceCondition, 4> faces;         // x-, x+, y-, y+ (ignored on periodic axes)
+  int nz = 0;                                      // 0: 2D description (extruded, periodic z)
+  std::array<bool, 3> periodic{};                  // x, y, z (z ignored when nz = 0)
+  std::array<lbm::FaceCondition, 6> faces;         // x-, x+, y-, y+, z-, z+ (ignored on periodic axes)
   struct Object {
     std::string name;
     lbm::WallScheme scheme = lbm::WallScheme::HalfwayBounceBack;
     Vec3 center = Vec3::Zero();
     std::optional<lbm::Shape> shape;               // solid cells and link fractions
-    std::vector<std::array<int, 2>> cells;         // extra solid cells (mask, image)
+    std::vector<std::array<int, 2>> cells;         // extra solid cells (mask, image), through all z
   };
   std::vector<Object> objects;
   Vec3 body_force = Vec3::Zero();                  // lattice force density
-  std::function<void(int x, int y, double& rho, Vec3& u)> init;  // initial state (default rest)
+  // Initial state (default rest); z is 0 on D2Q9.
+  std::function<void(int x, int y, int z, double& rho, Vec3& u)> init;
+  bool is_box() const { return nz > 0; }
 };
 
-// Macroscopic state at one sampling step, SI units, on the z = 0 plane of the lattice.
+// Macroscopic state at one sampling step, SI units, on the whole lattice: nx*ny*nz values,
+// x fastest, then y, then z (nz = 1 on D2Q9).
 struct FlowSample {
   long step = 0;
   double time = 0;                   // s
-  int nx = 0, ny = 0;
-  std::span<const double> pressure;  // Pa relative to the reference state, nx*ny, x fastest
+  int nx = 0, ny = 0, nz = 1;
+  std::span<const double> pressure;  // Pa relative to the reference state
   std::span<const Vec3> velocity;    // m/s
   std::span<const std::uint8_t> solid;
-  // Per solid object (same order as DomainSpec::objects): force and torque per unit depth
-  // (N/m and N), at time t - dt/2.
+  // Units of the loads below. 2D description (depth_m = 0): per unit depth, force N/m and
+  // torque N (per metre of the extruded depth). 3D box (depth_m > 0, the box's z extent in m):
+  // totals, force N and torque N m.
+  double depth_m = 0;
+  // Per solid object (same order as DomainSpec::objects), at time t - dt/2.
   std::vector<Vec3> force, torque;
-  std::array<Vec3, 4> face_force{};  // walls x-, x+, y-, y+ (N/m)
+  std::array<Vec3, 6> face_force{};  // walls x-, x+, y-, y+, z-, z+
   double ramp_end_time = 0;          // s: the inflow has its full speed from here on
   double max_mach = 0;
-  std::size_t at(int x, int y) const { return std::size_t(x) + std::size_t(nx) * std::size_t(y); }
+  std::size_t at(int x, int y, int z = 0) const {
+    return std::size_t(x) + std::size_t(nx) * (std::size_t(y) + std::size_t(ny) * std::size_t(z));
+  }
 };
 
 class FlowCase {

@@ -201,8 +201,15 @@ class Runner {
 template <class L, class T>
 void Runner<L, T>::build() {
   dom_ = fc_.domain(units_);
-  nz_ = L::D == 3 ? int(cfg_.integer("lbm.depth_cells")) : 1;
-  lbm::Grid g(L::D, dom_.nx, dom_.ny, nz_, {dom_.periodic[0], dom_.periodic[1], true});
+  // A 2D description is extruded along a periodic z axis (D3Q19) or has none (D2Q9); a 3D box
+  // brings its own depth and z faces.
+  const bool box = dom_.is_box();
+  if (box && L::D != 3)
+    throw InputError(fmt::format("{}: this case builds a 3D box ({} x {} x {} cells); set lbm.lattice = \"D3Q19\"",
+                                 driver_, dom_.nx, dom_.ny, dom_.nz));
+  nz_ = L::D == 3 ? (box ? dom_.nz : int(cfg_.integer("lbm.depth_cells"))) : 1;
+  const bool pz = !box || dom_.periodic[2];
+  lbm::Grid g(L::D, dom_.nx, dom_.ny, nz_, {dom_.periodic[0], dom_.periodic[1], pz});
   lbm::SolverSettings s;
   s.collision = cfg_.string("lbm.collision") == "bgk" ? lbm::CollisionModel::Bgk : lbm::CollisionModel::Trt;
   s.tau = units_.tau();
@@ -210,8 +217,8 @@ void Runner<L, T>::build() {
   s.incompressible = cfg_.string("lbm.equilibrium") == "incompressible";
   s.body_force = dom_.body_force;
   sol_ = std::make_unique<lbm::Solver<L, T>>(g, s);
-  for (int f = 0; f < 4; ++f)
-    if (!dom_.periodic[f / 2]) sol_->set_face(f, dom_.faces[f]);
+  for (int f = 0; f < 2 * L::D; ++f)
+    if (!g.periodic[f / 2]) sol_->set_face(f, dom_.faces[f]);
   for (auto& o : dom_.objects) {
     const int id = sol_->add_object(o.name, o.scheme, o.center);
     if (o.shape) sol_->add_shape(id, *o.shape);
@@ -220,8 +227,8 @@ void Runner<L, T>::build() {
   }
   sol_->finalize();
   auto init = dom_.init;
-  sol_->initialize([&](int x, int y, int, double& rho, Vec3& u) {
-    if (init) init(x, y, rho, u);
+  sol_->initialize([&](int x, int y, int z, double& rho, Vec3& u) {
+    if (init) init(x, y, z, rho, u);
   });
   const std::size_t n = std::size_t(dom_.nx) * dom_.ny * nz_;
   pressure_.assign(n, 0.0);
@@ -248,26 +255,31 @@ void Runner<L, T>::sample(FlowSample& s) {
   s.time = double(s.step) * units_.dt();
   s.nx = g.nx;
   s.ny = g.ny;
-  const std::size_t plane = std::size_t(g.nx) * g.ny;
-  s.pressure = std::span<const double>(pressure_.data(), plane);
-  s.velocity = std::span<const Vec3>(velocity_.data(), plane);
-  s.solid = std::span<const std::uint8_t>(solid_.data(), plane);
+  s.nz = nz_;
+  s.pressure = std::span<const double>(pressure_);
+  s.velocity = std::span<const Vec3>(velocity_);
+  s.solid = std::span<const std::uint8_t>(solid_);
   const auto& objs = sol_->objects();
   s.force.resize(dom_.objects.size());
   s.torque.resize(dom_.objects.size());
-  auto per_depth = [&](const Vec3& f) { return units_.to_si_force(1.0, 2) / nz_ * f; };
+  // 2D description: loads per unit depth (N/m, N; the extruded depth is nz_ cells). 3D box:
+  // total loads (N, N m).
+  const bool box = dom_.is_box();
+  s.depth_m = box ? nz_ * units_.dx() : 0.0;
+  const double fscale = box ? units_.to_si_force(1.0, 3) : units_.to_si_force(1.0, 2) / nz_;
   for (std::size_t k = 0; k < dom_.objects.size(); ++k) {
     const auto& o = objs[lbm::Solver<L, T>::kFirstUserObject + k];
-    s.force[k] = per_depth(o.force);
-    s.torque[k] = units_.to_si_force(1.0, 2) * units_.dx() / nz_ * o.torque;
+    s.force[k] = fscale * o.force;
+    s.torque[k] = fscale * units_.dx() * o.torque;
   }
-  for (int f = 0; f < 4; ++f) s.face_force[f] = per_depth(objs[f].force);
+  for (int f = 0; f < 6; ++f) s.face_force[f] = fscale * objs[f].force;
   s.max_mach = std::sqrt(3.0) * sol_->max_speed();
   s.ramp_end_time = ramp_end_time_;
 }
 
 template <class L, class T>
 void Runner<L, T>::write_vtk(const FlowSample& s) {
+  // The whole box: nx x ny x nz cells (the sample buffers hold all of them).
   const auto& g = sol_->grid();
   const std::string file = fmt::format("flow_{:06d}.vti", st_.vtk_index++);
   const VtkArray arrays[] = {vtk_array("pressure", std::span<const double>(pressure_)),

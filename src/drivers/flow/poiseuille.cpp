@@ -63,14 +63,14 @@ class PoiseuilleCase : public FlowCase {
       d.faces[0].density = 1 + drho / 2;
       d.faces[1].density = 1 - drho / 2;
       const int nx = d.nx;
-      d.init = [drho, nx](int x, int, double& rho, Vec3&) { rho = 1 + drho / 2 - drho * x / std::max(1, nx - 1); };
+      d.init = [drho, nx](int x, int, int, double& rho, Vec3&) { rho = 1 + drho / 2 - drho * x / std::max(1, nx - 1); };
     } else {
       d.faces[0].kind = lbm::FaceCondition::Kind::Velocity;
       d.faces[0].profile = [this, dx](int, int y, int) {
         return Vec3(units_.to_lattice_velocity(analytic((y + 0.5) * dx)), 0, 0);
       };
       d.faces[1].kind = lbm::FaceCondition::Kind::Pressure;
-      d.init = [this, dx](int, int y, double&, Vec3& v) { v = Vec3(units_.to_lattice_velocity(analytic((y + 0.5) * dx)), 0, 0); };
+      d.init = [this, dx](int, int y, int, double&, Vec3& v) { v = Vec3(units_.to_lattice_velocity(analytic((y + 0.5) * dx)), 0, 0); };
     }
     return d;
   }
