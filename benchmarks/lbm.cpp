@@ -2,9 +2,9 @@
 // a memory-bandwidth roofline a reader can trust.
 //
 // Cases, each in D2Q9 (2000^2) and D3Q19 (128^3), double and single precision, BGK and TRT; the
-// population arrays (144-353 MB) are 4.5-11 times the 32 MB L3 of the project's machines, so
-// every row is memory-bound (at 1000^2 the D2Q9 arrays, 35 and 70 MB, were partly served from
-// the L3 and beat the roofline). --quick runs lattices that fit in the cache; the table says so.
+// population arrays (139-353 MB) are 4.3-11 times the 32 MB L3 of the project's machines, so
+// no row can be served partly from the cache (at 1000^2 the D2Q9 arrays were 35 and 70 MB).
+// --quick runs lattices that fit in the cache; the table says so.
 //   box      fully periodic, every cell a bulk cell: the kernel alone;
 //   channel  what real runs look like: no-slip walls on the side faces, a lattice of solid
 //            cylinders (2D) or spheres (3D) with Bouzidi links covering 10-15% of the cells,
