@@ -26,7 +26,8 @@
 // blocks (about 0.1 s of LBM steps, three passes over the arrays for the bandwidths), and the
 // configurations are interleaved: each round runs one block of every configuration in turn,
 // so a noisy period hits them all alike. The median block is the figure; the best block
-// (closest to an idle machine) is printed beside it. Compare rows of one run only.
+// (closest to an idle machine) is printed beside it. Compare rows of one run only. Holding every
+// configuration at once costs memory: about 5.5 GB (--quick: 1.2 GB, mostly the 768 MB of bandwidth arrays).
 //
 // Usage: lbm [--quick] [--threads 1,2] [--repeat 3]
 #include <omp.h>
