@@ -19,7 +19,11 @@ const char* units_mode_key(UnitsMode m);  // "lbm.tau", "lbm.time_step", "lbm.ma
 // Mach number Ma = u_lb / c_s of the characteristic speed: the weakly compressible scheme
 // recovers Navier-Stokes up to O(Ma^2) terms (Krueger et al., The Lattice Boltzmann Method,
 // 2017, Sec. 4.5), so the error is C Ma^2.
-// Calibrated on the DFG 2D-1 grid study in docs/lbm.md.
+// Measured (docs/lbm.md, "Accuracy"): DFG 2D-1 drag with the compressible equilibrium moves by
+// 1.04 Ma^2 (D = 20 and 40 cells, Ma 0.026-0.052); the incompressible equilibrium removes that
+// steady error (|C| < 0.1, within the noise), but shedding flow keeps a time-step/compressibility
+// error: DFG 2D-2 at D = 40, Ma 0.05 -> 0.1, c_D,max 0.58 Ma^2 and c_L,max 2.2 Ma^2. C = 1 is thus
+// the steady figure and a lower bound of the factor for lift amplitudes.
 inline constexpr double kCompressibilityCoefficient = 1.0;
 double expected_compressibility_error(double mach);
 // The Mach number whose expected compressibility error is `error` (inverse of the above).

@@ -32,7 +32,7 @@ void declare(ParamTable& t) {
   d.resolution = 16;
   d.tau = 0.53;
   d.end_time = 80;
-  d.steady_tolerance = 1e-7;
+  d.steady_tolerance = 1e-5;  // drift of window means (steady.hpp); 1e-7 is below the acoustic noise
   d.inflow_ramp_time = -1;
   declare_lbm_params(t, d);
   t.real("channel.height", 0.16, "m", "distance H between the plates").positive();

@@ -171,7 +171,7 @@ TEST(RunResults, CylinderWithoutSheddingHasNullStrouhalWithReason) {
   EXPECT_FALSE(res["shedding"].get<bool>());
   EXPECT_TRUE(res["strouhal"].is_null()) << res.dump(2);
   EXPECT_TRUE(has(res["strouhal_reason"].get<std::string>(), "no vortex shedding")) << res.dump(2);
-  EXPECT_EQ(first_line(out / "series.csv"), "step,time_s,Fx_N_per_m,Fy_N_per_m,Cd,Cl");
+  EXPECT_EQ(first_line(out / "series.csv"), "step,time_s,Fx_N_per_m,Fy_N_per_m,Cd,Cl,dp_front_back_Pa");
   fs::remove_all(out);
 }
 
