@@ -23,8 +23,12 @@ const char* units_mode_key(UnitsMode m) {
   return "lbm.tau";
 }
 
-double expected_compressibility_error(double mach) { return kCompressibilityCoefficient * mach * mach; }
-double mach_for_error(double error) { return std::sqrt(error / kCompressibilityCoefficient); }
+double compressibility_coefficient(bool incompressible, bool unsteady) {
+  if (unsteady) return 2.2;
+  return incompressible ? 0.1 : 1.0;
+}
+double expected_compressibility_error(double mach, double coefficient) { return coefficient * mach * mach; }
+double mach_for_error(double error, double coefficient) { return std::sqrt(error / coefficient); }
 
 Units Units::from_tau(double dx, double tau, double nu, double rho) {
   if (!(dx > 0) || !(nu > 0) || !(rho > 0)) throw InputError("LBM units need a positive cell size, viscosity and density");
@@ -55,7 +59,7 @@ Units Units::from_mach(double dx, double mach, double u, double nu, double rho) 
 }
 
 StabilityCheck Units::check(double u, int resolution, const std::string& resolution_key, UnitsMode mode,
-                            const std::string& collision) const {
+                            const std::string& collision, double error_coefficient) const {
   StabilityCheck r;
   const bool bgk = collision == "bgk";
   const std::string model = bgk ? "BGK (lbm.collision = \"bgk\")" : "TRT (lbm.collision = \"trt\")";
@@ -71,10 +75,10 @@ StabilityCheck Units::check(double u, int resolution, const std::string& resolut
       case UnitsMode::TimeStep: return fmt::format("lbm.time_step = {:.4g} s (tau becomes {:.4g})", dt_ * f, tau_new);
       case UnitsMode::Mach:
         return fmt::format("lbm.mach = {:.3g} (tau becomes {:.4g}, expected compressibility error {:.2g})", ma_new,
-                           tau_new, expected_compressibility_error(ma_new));
+                           tau_new, expected_compressibility_error(ma_new, error_coefficient));
       case UnitsMode::TargetError:
         return fmt::format("lbm.target_error = {:.3g} (Mach {:.3g}, tau becomes {:.4g})",
-                           expected_compressibility_error(ma_new), ma_new, tau_new);
+                           expected_compressibility_error(ma_new, error_coefficient), ma_new, tau_new);
     }
     return std::string();
   };
@@ -106,8 +110,9 @@ StabilityCheck Units::check(double u, int resolution, const std::string& resolut
   }
   if (ma > kMachWarn)
     r.warnings.push_back(fmt::format("Mach number {:.3g} (lattice speed {:.3g}) is above {}: expected compressibility "
-                                     "error {:.2g} (C Ma^2); {}",
-                                     ma, ulb, kMachWarn, expected_compressibility_error(ma), mach_fix(kMachWarn)));
+                                     "error {:.2g} ({:.2g} Ma^2); {}",
+                                     ma, ulb, kMachWarn, expected_compressibility_error(ma, error_coefficient), error_coefficient,
+                                     mach_fix(kMachWarn)));
   if (tau_ - 0.5 < kTauWarn) {
     // Larger tau at fixed Mach needs more cells: u_lb = Re_cell (tau - 1/2)/3 with Re_cell ~ 1/N.
     const double tau_target = 0.5 + kTauWarn * 5;

@@ -18,16 +18,19 @@ const char* units_mode_key(UnitsMode m);  // "lbm.tau", "lbm.time_step", "lbm.ma
 // Expected relative error of forces and pressures from the compressibility of the LBM at the
 // Mach number Ma = u_lb / c_s of the characteristic speed: the weakly compressible scheme
 // recovers Navier-Stokes up to O(Ma^2) terms (Krueger et al., The Lattice Boltzmann Method,
-// 2017, Sec. 4.5), so the error is C Ma^2.
-// Measured (docs/lbm.md, "Accuracy"): DFG 2D-1 drag with the compressible equilibrium moves by
-// 1.04 Ma^2 (D = 20 and 40 cells, Ma 0.026-0.052); the incompressible equilibrium removes that
-// steady error (|C| < 0.1, within the noise), but shedding flow keeps a time-step/compressibility
-// error: DFG 2D-2 at D = 40, Ma 0.05 -> 0.1, c_D,max 0.58 Ma^2 and c_L,max 2.2 Ma^2. C = 1 is thus
-// the steady figure and a lower bound of the factor for lift amplitudes.
-inline constexpr double kCompressibilityCoefficient = 1.0;
-double expected_compressibility_error(double mach);
+// 2017, Sec. 4.5), so the error is C Ma^2. C depends on the equilibrium and on whether the flow
+// settles; measured on the DFG cylinder (docs/lbm.md, "Accuracy on the DFG benchmark"):
+//  - compressible equilibrium, steady flow: 2D-1 drag moves by 1.04 Ma^2 (D = 20, 40 cells,
+//    Ma 0.026-0.052): the pressure drop raises rho and the dynamic viscosity rho nu -> C = 1;
+//  - incompressible equilibrium (He & Luo 1997), steady flow: drag 0.03 Ma^2, Delta p 0.08 Ma^2
+//    (D = 40, Ma 0.025 -> 0.05) -> C = 0.1;
+//  - vortex shedding, either equilibrium: at a fixed resolution dt scales with Ma, and the
+//    amplitudes carry the time-step error: 2D-2 at D = 40, Ma 0.05 -> 0.1, c_D,max 0.58 Ma^2,
+//    St 0.3 Ma^2, c_L,max 2.2 Ma^2 -> C = 2.2.
+double compressibility_coefficient(bool incompressible, bool unsteady);
+double expected_compressibility_error(double mach, double coefficient);
 // The Mach number whose expected compressibility error is `error` (inverse of the above).
-double mach_for_error(double error);
+double mach_for_error(double error, double coefficient);
 
 // Outcome of a stability check: warnings (the run goes on) or an error (it must not start).
 struct StabilityCheck {
@@ -77,8 +80,9 @@ class Units {
   // the characteristic length, named `resolution_key` in the scenario; `mode` says which key
   // fixed the time step (the fixes change that key or the resolution); `collision` is lbm.collision ("trt" or "bgk"),
   // named in the messages, whose limits differ. Each message names a key and a value that fixes it.
+  // `error_coefficient` is C of the expected error C Ma^2 the advice quotes.
   StabilityCheck check(double u, int resolution, const std::string& resolution_key, UnitsMode mode,
-                       const std::string& collision) const;
+                       const std::string& collision, double error_coefficient) const;
 
   // The table printed at the start of a run.
   std::string describe(int dim) const;

@@ -80,6 +80,12 @@ class FlowCase {
   virtual DomainSpec domain(const lbm::Units& u) = 0;
   virtual std::vector<std::string> columns() const = 0;  // after the runner's "step", "time"
   virtual void measure(const FlowSample& s, std::vector<double>& row) const = 0;
+  // Warnings about the case on this lattice (e.g. a length that is not a whole number of
+  // cells); `check` prints them and the run logs them.
+  virtual std::vector<std::string> warnings() const { return {}; }
+  // True when the case expects a time-periodic flow (a vortex street): the expected
+  // compressibility error is then larger (lbm::compressibility_coefficient).
+  virtual bool unsteady() const { return false; }
   // Column (index into columns()) whose relative change decides steady state; none: run to end.
   virtual std::optional<int> steady_column() const { return std::nullopt; }
   // Results into `summary`, extra files and plots into `out` (history = all series rows,

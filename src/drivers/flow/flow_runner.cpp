@@ -46,13 +46,13 @@ void declare_lbm_params(ParamTable& t, const LbmDefaults& d) {
   t.real("lbm.time_step", 0.0, "s", "time step; tau = 1/2 + 3 nu dt / dx^2 follows (0: not set)").non_negative();
   t.real("lbm.mach", 0.0, "-",
          fmt::format("Mach number Ma = u_lb / c_s of the case's characteristic speed U: dt = Ma c_s dx / U, tau follows; "
-                     "expected relative compressibility error of forces and pressures C Ma^2 (C = {}) (0: not set)",
-                     lbm::kCompressibilityCoefficient))
+                     "expected relative compressibility error of forces and pressures C Ma^2 (C = 1 with the "
+                     "compressible equilibrium, 0.1 with the incompressible one, 2.2 for a vortex street with either: "
+                     "measured, docs/lbm.md) (0: not set)"))
       .range(0, 1);
   t.real("lbm.target_error", 0.0, "-",
-         fmt::format("expected relative compressibility error C Ma^2 (C = {}) the run may make: the driver picks "
-                     "Ma = sqrt(target / C), then dt and tau as for lbm.mach (0: not set)",
-                     lbm::kCompressibilityCoefficient))
+         fmt::format("expected relative compressibility error C Ma^2 (C as for lbm.mach) the run may make: the "
+                     "driver picks Ma = sqrt(target / C), then dt and tau as for lbm.mach (0: not set)"))
       .range(0, 1);
   t.integer("lbm.resolution", d.resolution, "cells", "cells across the characteristic length of the case").at_least(2);
   t.real("fluid.density", d.density, "kg/m^3", "fluid density").positive();
@@ -82,7 +82,7 @@ void declare_lbm_params(ParamTable& t, const LbmDefaults& d) {
       .non_negative();
 }
 
-FlowUnits make_units(const Config& cfg, double dx, double u) {
+FlowUnits make_units(const Config& cfg, double dx, double u, bool unsteady) {
   const double nu = cfg.real("fluid.viscosity"), rho = cfg.real("fluid.density");
   // lbm.tau counts as set when the scenario sets it (its default is a fallback, which a saved
   // scenario.toml keeps as a comment); the other three when they are above 0.
@@ -97,6 +97,10 @@ FlowUnits make_units(const Config& cfg, double dx, double u) {
                          "the viscosity)",
                          lbm::units_mode_key(set[0]), lbm::units_mode_key(set[1])));
   FlowUnits f;
+  const bool incompressible = cfg.string("lbm.equilibrium") == "incompressible";
+  f.coefficient = lbm::compressibility_coefficient(incompressible, unsteady);
+  f.error_model = unsteady ? "vortex shedding expected"
+                           : fmt::format("{} equilibrium, steady flow", incompressible ? "incompressible" : "compressible");
   f.mode = set.empty() ? lbm::UnitsMode::Tau : set[0];
   f.by_default = set.empty();
   switch (f.mode) {
@@ -104,11 +108,11 @@ FlowUnits make_units(const Config& cfg, double dx, double u) {
     case lbm::UnitsMode::TimeStep: f.units = lbm::Units::from_time_step(dx, cfg.real("lbm.time_step"), nu, rho); break;
     case lbm::UnitsMode::Mach: f.units = lbm::Units::from_mach(dx, cfg.real("lbm.mach"), u, nu, rho); break;
     case lbm::UnitsMode::TargetError:
-      f.units = lbm::Units::from_mach(dx, lbm::mach_for_error(cfg.real("lbm.target_error")), u, nu, rho);
+      f.units = lbm::Units::from_mach(dx, lbm::mach_for_error(cfg.real("lbm.target_error"), f.coefficient), u, nu, rho);
       break;
   }
   f.mach = f.units.mach(u);
-  f.expected_error = lbm::expected_compressibility_error(f.mach);
+  f.expected_error = lbm::expected_compressibility_error(f.mach, f.coefficient);
   return f;
 }
 
@@ -119,10 +123,9 @@ std::string describe_flow_units(const FlowUnits& fu, const FlowCase& fc) {
                                                            : "lbm.tau";
   return fmt::format("time step dt = {:.6g} s and relaxation time tau = {:.6g} (from {}), cell size dx = {:.6g} m; Mach "
                      "number {:.3g} of the characteristic speed {:.4g} m/s ({:.4g} lattice units); expected relative "
-                     "compressibility error {:.2g} ({} Ma^2)",
+                     "compressibility error {:.2g} ({} Ma^2: {})",
                      u.dt(), u.tau(), from, u.dx(), fu.mach, fc.characteristic_speed(),
-                     u.to_lattice_velocity(fc.characteristic_speed()), fu.expected_error,
-                     lbm::kCompressibilityCoefficient);
+                     u.to_lattice_velocity(fc.characteristic_speed()), fu.expected_error, fu.coefficient, fu.error_model);
 }
 
 namespace {
@@ -160,7 +163,7 @@ class Runner {
  public:
   Runner(const Config& cfg, const RunOptions& opt, FlowCase& fc, std::string_view driver)
       : cfg_(cfg), opt_(opt), fc_(fc), driver_(driver),
-        fu_(make_units(cfg, fc.cell_size(), fc.characteristic_speed())), units_(fu_.units),
+        fu_(make_units(cfg, fc.cell_size(), fc.characteristic_speed(), fc.unsteady())), units_(fu_.units),
         probes_(read_probes(cfg, L::D == 3, L::D == 3 ? double(cfg.integer("lbm.depth_cells")) * fc.cell_size() : 0.0),
                 fc.cell_size()) {}
 
@@ -340,7 +343,7 @@ RunStatus Runner<L, T>::run() {
   RunControl control(cfg_, opt_);
   {
     const auto chk = units_.check(fc_.characteristic_speed(), fc_.resolution(), fc_.resolution_key(), fu_.mode,
-                                  cfg_.string("lbm.collision"));
+                                  cfg_.string("lbm.collision"), fu_.coefficient);
     if (!chk.error.empty()) cfg_.fail(fu_.key(), chk.error);
     build();
     log::info("{}", units_.describe(L::D));
@@ -353,6 +356,7 @@ RunStatus Runner<L, T>::run() {
               }());
     log::info("{}", describe_flow_units(fu_, fc_));
     for (auto& w : chk.warnings) log::warn("{}", w);
+    for (auto& w : fc_.warnings()) log::warn("{}", w);
   }
   begin_output(opt_);  // the lattice is built and checked: from here on files go into out_dir
   const long steps_total = std::max(1L, std::lround(cfg_.real("run.end_time") / units_.dt()));
@@ -544,7 +548,7 @@ void Runner<L, T>::summary(const FlowSample& last, const std::string& stop_reaso
                 {"chosen_by", fu_.by_default ? std::string("lbm.tau (default)") : std::string(fu_.key())},
                 {"mach", fu_.mach},
                 {"expected_compressibility_error", fu_.expected_error},
-                {"compressibility_coefficient", lbm::kCompressibilityCoefficient},
+                {"compressibility_coefficient", fu_.coefficient},
                 {"nu_lattice", units_.nu_lb()},
                 {"velocity_factor_m_per_s", units_.velocity_factor()},
                 {"pressure_factor_Pa", units_.pressure_factor()},

@@ -31,12 +31,15 @@ struct FlowUnits {
   lbm::Units units;
   lbm::UnitsMode mode = lbm::UnitsMode::Tau;
   double mach = 0;            // Ma = u_lb / c_s of the case's characteristic speed
-  double expected_error = 0;  // lbm::expected_compressibility_error(mach)
+  double coefficient = 1;     // C of the expected error C Ma^2 (lbm::compressibility_coefficient)
+  double expected_error = 0;  // C Ma^2
+  std::string error_model;    // why this C: equilibrium and regime
   bool by_default = false;    // none of the four keys set: lbm.tau's default
   const char* key() const { return lbm::units_mode_key(mode); }
 };
-// Units for a cell size dx [m] and the characteristic speed u [m/s] of the case.
-FlowUnits make_units(const Config& cfg, double dx, double u);
+// Units for a cell size dx [m] and the characteristic speed u [m/s] of the case; `unsteady`:
+// the case expects a time-periodic flow (FlowCase::unsteady), which sets the error model.
+FlowUnits make_units(const Config& cfg, double dx, double u, bool unsteady);
 // One paragraph: dt, tau, Mach number, expected compressibility error and the key in use.
 std::string describe_flow_units(const FlowUnits& fu, const FlowCase& fc);
 

@@ -16,12 +16,27 @@ void validate_flow(const Config& cfg, const FlowCase& fc) {
   if (!d3 && cfg.has("lbm.depth_cells") && cfg.integer("lbm.depth_cells") != 1)
     cfg.fail("lbm.depth_cells", "only D3Q19 has a depth; set lbm.lattice = \"D3Q19\" or remove lbm.depth_cells");
   // At most one of lbm.tau, lbm.time_step, lbm.mach, lbm.target_error; then the limits.
-  const FlowUnits fu = make_units(cfg, fc.cell_size(), fc.characteristic_speed());
+  const FlowUnits fu = make_units(cfg, fc.cell_size(), fc.characteristic_speed(), fc.unsteady());
   const auto chk = fu.units.check(fc.characteristic_speed(), fc.resolution(), fc.resolution_key(), fu.mode,
-                                  cfg.string("lbm.collision"));
+                                  cfg.string("lbm.collision"), fu.coefficient);
   if (!chk.error.empty()) cfg.fail(fu.key(), chk.error);
   const int nz = d3 ? int(cfg.integer("lbm.depth_cells")) : 1;
   const ProbeSet probes = read_probes(cfg, d3, nz * fc.cell_size());
+  // A probe column must not repeat one of the case's (e.g. probes "front" and "back" with
+  // probes.delta_p give dp_front_back_Pa, which flow/cylinder writes itself).
+  {
+    std::vector<std::string> cols = {"step", "time_s"};
+    for (auto& c : fc.columns()) cols.push_back(c);
+    const std::size_t own = cols.size();
+    Probes(probes, fc.cell_size()).columns(cols);
+    for (std::size_t i = own; i < cols.size(); ++i)
+      for (std::size_t j = 0; j < i; ++j)
+        if (cols[i] == cols[j])
+          cfg.fail(j < own ? "probes.names" : "probes.delta_p",
+                   fmt::format("the probe column '{}' repeats a column {} already writes to series.csv: rename the "
+                               "probe(s) in probes.names",
+                               cols[i], j < own ? "the driver" : "another probe"));
+  }
   if (!probes.empty()) {
     // The lattice's extent and solids from the case's domain (no solver is built). domain()
     // only caches the units in the case, which run() sets again.
@@ -40,6 +55,7 @@ void validate_flow(const Config& cfg, const FlowCase& fc) {
   std::string report = "Derived LBM units: " + describe_flow_units(fu, fc) + "\n";
   if (!probes.empty()) report += fmt::format("{} probe(s) checked against the lattice\n", probes.points.size());
   for (auto& w : chk.warnings) report += "warning: " + w + "\n";
+  for (auto& w : fc.warnings()) report += "warning: " + w + "\n";
   FlowCheckReport::append(report);
 }
 

@@ -35,28 +35,28 @@ TEST(LbmUnits, ConversionFactors) {
 
 TEST(LbmUnits, StabilityChecksNameTheFix) {
   const Units u = Units::from_tau(1e-3, 0.6, 1e-3, 1000);  // u_r = 30 m/s
-  EXPECT_TRUE(u.check(0.3, 50, "lbm.resolution", UnitsMode::Tau, "trt").warnings.empty());  // Ma 0.017
+  EXPECT_TRUE(u.check(0.3, 50, "lbm.resolution", UnitsMode::Tau, "trt", 1.0).warnings.empty());  // Ma 0.017
   // Ma = 0.17: a warning naming a resolution that brings it below 0.1.
-  const auto w = u.check(3.0, 50, "lbm.resolution", UnitsMode::Tau, "trt");
+  const auto w = u.check(3.0, 50, "lbm.resolution", UnitsMode::Tau, "trt", 1.0);
   ASSERT_EQ(w.warnings.size(), 1u);
   EXPECT_TRUE(w.error.empty());
   EXPECT_NE(w.warnings[0].find("lbm.resolution = 87 or more"), std::string::npos) << w.warnings[0];
   // Ma = 0.52: an error.
-  const auto e = u.check(9.0, 50, "lbm.resolution", UnitsMode::Tau, "trt");
+  const auto e = u.check(9.0, 50, "lbm.resolution", UnitsMode::Tau, "trt", 1.0);
   EXPECT_NE(e.error.find("Mach number"), std::string::npos);
   // In time-step mode the fix is a smaller time step.
   const Units d = Units::from_time_step(1e-3, u.dt(), 1e-3, 1000);
-  EXPECT_NE(d.check(3.0, 50, "lbm.resolution", UnitsMode::TimeStep, "trt").warnings[0].find("set lbm.time_step = "), std::string::npos);
+  EXPECT_NE(d.check(3.0, 50, "lbm.resolution", UnitsMode::TimeStep, "trt", 1.0).warnings[0].find("set lbm.time_step = "), std::string::npos);
   // tau close to 1/2, or large: a warning.
-  EXPECT_EQ(Units::from_tau(1e-3, 0.505, 1e-6, 1000).check(0.01, 50, "lbm.resolution", UnitsMode::Tau, "trt").warnings.size(), 1u);
-  const auto big = Units::from_tau(1e-3, 4.0, 1e-6, 1000).check(1e-6, 50, "lbm.resolution", UnitsMode::Tau, "trt");
+  EXPECT_EQ(Units::from_tau(1e-3, 0.505, 1e-6, 1000).check(0.01, 50, "lbm.resolution", UnitsMode::Tau, "trt", 1.0).warnings.size(), 1u);
+  const auto big = Units::from_tau(1e-3, 4.0, 1e-6, 1000).check(1e-6, 50, "lbm.resolution", UnitsMode::Tau, "trt", 1.0);
   ASSERT_EQ(big.warnings.size(), 1u);
   EXPECT_NE(big.warnings[0].find("set lbm.tau = 2"), std::string::npos) << big.warnings[0];
 }
 
 TEST(LbmUnits, TauAtOrBelowHalfIsAnError) {
   Units u = Units::from_tau(1e-3, 0.5, 1e-6, 1000);
-  const auto c = u.check(1e-6, 20, "lbm.resolution", UnitsMode::Tau, "trt");
+  const auto c = u.check(1e-6, 20, "lbm.resolution", UnitsMode::Tau, "trt", 1.0);
   EXPECT_NE(c.error.find("above 1/2"), std::string::npos) << c.error;
   EXPECT_NE(c.error.find("set lbm.time_step = "), std::string::npos) << c.error;
 }
@@ -66,7 +66,7 @@ TEST(LbmUnits, TauAtOrBelowHalfIsAnError) {
 TEST(LbmUnits, TauNearHalfWarningNamesTheCollisionModelAndAnAllowedTau) {
   const Units u = Units::from_tau(1e-3, 0.505, 1e-6, 1000);
   for (const std::string model : {"trt", "bgk"}) {
-    const auto c = u.check(0.001, 50, "lbm.resolution", UnitsMode::Tau, model);
+    const auto c = u.check(0.001, 50, "lbm.resolution", UnitsMode::Tau, model, 1.0);
     ASSERT_EQ(c.warnings.size(), 1u) << model;
     const std::string& w = c.warnings[0];
     const std::string in_use = model == "trt" ? "with the TRT (lbm.collision = \"trt\") collision"
@@ -79,11 +79,11 @@ TEST(LbmUnits, TauNearHalfWarningNamesTheCollisionModelAndAnAllowedTau) {
     ASSERT_NE(at, std::string::npos) << w;
     const double tau = std::stod(w.substr(at + 14));
     EXPECT_GT(tau, 0.5 + 0.01) << w;  // allowed (> 1/2) and out of the warning's range
-    EXPECT_TRUE(Units::from_tau(1e-3, tau, 1e-6, 1000).check(0.001, 50, "lbm.resolution", UnitsMode::Tau, model).warnings.empty());
+    EXPECT_TRUE(Units::from_tau(1e-3, tau, 1e-6, 1000).check(0.001, 50, "lbm.resolution", UnitsMode::Tau, model, 1.0).warnings.empty());
   }
   // In time-step mode the fix is a time step, for the model in use.
   const Units d = Units::from_time_step(1e-3, u.dt(), 1e-6, 1000);
-  const auto w = d.check(0.001, 50, "lbm.resolution", UnitsMode::TimeStep, "bgk").warnings.at(0);
+  const auto w = d.check(0.001, 50, "lbm.resolution", UnitsMode::TimeStep, "bgk", 1.0).warnings.at(0);
   EXPECT_NE(w.find("BGK (lbm.collision = \"bgk\")"), std::string::npos) << w;
   EXPECT_NE(w.find("set lbm.time_step = "), std::string::npos) << w;
 }

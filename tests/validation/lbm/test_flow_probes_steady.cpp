@@ -164,12 +164,15 @@ TEST(FlowProbes, EveryDriverWithProbesResumesBitForBit) {
                        {"probes.names=[\"centre\",\"corner\"]", "probes.x=[0.05,0.0]", "probes.y=[0.05,0.1]"});
   // The DFG probe points: front and back of the cylinder surface.
   expect_probes_resume("probes_resume_cylinder", kCylinder,
-                       {"run.end_time=100", "probes.names=[\"front\",\"back\"]", "probes.x=[0.025,0.035]",
-                        "probes.y=[0.021,0.021]", "probes.delta_p=[\"front\",\"back\"]"});
+                       {"run.end_time=100", "probes.names=[\"fore\",\"aft\"]", "probes.x=[0.025,0.035]",
+                        "probes.y=[0.021,0.021]", "probes.delta_p=[\"fore\",\"aft\"]"});
   const auto j = read_summary("probes_resume_cylinder_whole");
   EXPECT_GT(j["results"]["delta_p_Pa"].get<double>(), 0) << "stagnation pressure ahead, wake behind";
-  EXPECT_DOUBLE_EQ(j["results"]["delta_p_Pa"].get<double>(), j["results"]["probes"]["front"]["p_Pa"].get<double>() -
-                                                                 j["results"]["probes"]["back"]["p_Pa"].get<double>());
+  EXPECT_DOUBLE_EQ(j["results"]["delta_p_Pa"].get<double>(), j["results"]["probes"]["fore"]["p_Pa"].get<double>() -
+                                                                 j["results"]["probes"]["aft"]["p_Pa"].get<double>());
+  // flow/cylinder's own Delta p uses the same surface stencils.
+  EXPECT_NEAR(j["results"]["dp_final_Pa"].get<double>(), j["results"]["delta_p_Pa"].get<double>(),
+              1e-9 * std::abs(j["results"]["delta_p_Pa"].get<double>()));
   // D3Q19: uz columns, z defaults to mid-depth.
   expect_probes_resume("probes_resume_d3q19", kPoiseuille,
                        {"lbm.lattice=\"D3Q19\"", "lbm.depth_cells=2", "probes.names=[\"a\"]", "probes.x=[0.5e-3]",
@@ -199,6 +202,40 @@ TEST(FlowProbes, ProbesOutsideOrInsideASolidAreRefusedBeforeTheRun) {
   refused({"probes.names=[\"a\"]", "probes.x=[0.05]", "probes.y=[0.02]", "probes.delta_p=[\"a\",\"z\"]"},
           "probes.delta_p", "'z'");
   refused({"probes.names=[\"a\"]", "probes.x=[0.05]", "probes.y=[0.02]", "probes.z=[0.0]"}, "probes.z", "D3Q19");
+  // dp_front_back_Pa is flow/cylinder's own column.
+  refused({"probes.names=[\"front\",\"back\"]", "probes.x=[0.025,0.035]", "probes.y=[0.021,0.021]",
+           "probes.delta_p=[\"front\",\"back\"]"},
+          "probes.names", "'dp_front_back_Pa' repeats a column");
+}
+
+// The expected-error model (lbm/units.hpp, docs/lbm.md): C by equilibrium and regime, as
+// measured on the DFG cylinder; lbm.target_error inverts it; flow/cylinder expects a vortex
+// street above Re 47; check warns when the channel is not a whole number of cells.
+TEST(FlowUnits, ErrorModelFollowsTheEquilibriumAndTheRegime) {
+  using ff::lbm::compressibility_coefficient;
+  EXPECT_EQ(compressibility_coefficient(false, false), 1.0);
+  EXPECT_EQ(compressibility_coefficient(true, false), 0.1);
+  EXPECT_EQ(compressibility_coefficient(true, true), 2.2);
+  EXPECT_EQ(compressibility_coefficient(false, true), 2.2);
+  EXPECT_NEAR(ff::lbm::mach_for_error(ff::lbm::expected_compressibility_error(0.07, 2.2), 2.2), 0.07, 1e-15);
+  const ff::Driver& d = ff::find_driver("flow/cylinder");
+  const ff::ParamTable table = ff::parameter_table(d);
+  auto report = [&](const std::string& scenario, const std::vector<std::string>& sets) {
+    ff::drivers::FlowCheckReport r;
+    d.validate(ff::load_scenario(table, "c.toml", scenario, sets));
+    return r.text();
+  };
+  // kCylinder: Re = 0.01 * 0.01 / 1e-5 = 10, steady, incompressible equilibrium.
+  const std::string steady = report(kCylinder, {});
+  EXPECT_NE(steady.find("0.1 Ma^2: incompressible equilibrium, steady flow"), std::string::npos) << steady;
+  EXPECT_NE(report(kCylinder, {"lbm.equilibrium=\"compressible\""}).find("1 Ma^2: compressible equilibrium"),
+            std::string::npos);
+  const std::string street = report(kShedding, {});
+  EXPECT_NE(street.find("2.2 Ma^2: vortex shedding expected"), std::string::npos) << street;
+  EXPECT_EQ(steady.find("whole number of cells"), std::string::npos) << steady;
+  // 0.04 m on cells of 0.01/7 m is 28 cells; 0.041 m is 28.7.
+  const std::string rounded = report(kCylinder, {"channel.height=0.041", "lbm.resolution=7"});
+  EXPECT_NE(rounded.find("channel.height = 0.041 m is 28.7 cells"), std::string::npos) << rounded;
 }
 
 TEST(FlowUnits, MachAndTargetErrorChooseTheTimeStep) {
@@ -210,10 +247,13 @@ TEST(FlowUnits, MachAndTargetErrorChooseTheTimeStep) {
   EXPECT_EQ(m["units"]["chosen_by"], "lbm.mach");
   EXPECT_NEAR(m["units"]["mach"].get<double>(), 0.05, 1e-12);
   EXPECT_NEAR(m["units"]["dt_s"].get<double>(), 0.05 * cs * dx / 1e-3, 1e-12);
-  EXPECT_NEAR(m["units"]["expected_compressibility_error"].get<double>(),
-              ff::lbm::kCompressibilityCoefficient * 0.05 * 0.05, 1e-15);
+  // The cavity settles, and the flow drivers use the incompressible equilibrium: C = 0.1.
+  const double C = ff::lbm::compressibility_coefficient(true, false);
+  EXPECT_EQ(C, 0.1);
+  EXPECT_EQ(m["units"]["compressibility_coefficient"].get<double>(), C);
+  EXPECT_NEAR(m["units"]["expected_compressibility_error"].get<double>(), C * 0.05 * 0.05, 1e-15);
   const auto e = run_flow_driver("units_error", cavity,
-                                 {"lbm.target_error=" + std::to_string(ff::lbm::kCompressibilityCoefficient * 0.0025),
+                                 {"lbm.target_error=" + std::to_string(C * 0.0025),
                                   "run.end_time=20"});
   EXPECT_EQ(e["units"]["chosen_by"], "lbm.target_error");
   EXPECT_NEAR(e["units"]["mach"].get<double>(), 0.05, 1e-9);
@@ -221,7 +261,7 @@ TEST(FlowUnits, MachAndTargetErrorChooseTheTimeStep) {
   // Nothing set: lbm.tau's default.
   const ff::Driver& d = ff::find_driver("flow/cavity");
   const ff::ParamTable table = ff::parameter_table(d);
-  const auto fu = ff::drivers::make_units(ff::load_scenario(table, "c.toml", cavity, {}), dx, 1e-3);
+  const auto fu = ff::drivers::make_units(ff::load_scenario(table, "c.toml", cavity, {}), dx, 1e-3, false);
   EXPECT_TRUE(fu.by_default);
   EXPECT_EQ(fu.mode, ff::lbm::UnitsMode::Tau);
   EXPECT_EQ(fu.units.tau(), 0.7);
