@@ -151,7 +151,7 @@ TEST(DfgBenchmarkLong, Case2d2) {
 // with the incompressible equilibrium). Measured: c_D 6.1853 (in), c_L 0.00951 (in), Delta p
 // 0.16118 Pa (-2.3%), 460 s on 1 of 2 busy cores, steady stop. The issue asks c_D and c_L inside
 // their intervals; Delta p is held to its interval widened by 3%: at D = 10 the surface
-// extrapolation of the stagnation pressure is still coarse (2D-1 at D = 10: Delta p -4.4%,
+// extrapolation of the stagnation pressure is still coarse (2D-1 at D = 10: Delta p 5.5% below its interval,
 // at D = 20: -0.3%).
 TEST(DfgBenchmarkLong, Case3d1z) {
   const auto j = ff::testing::run_flow_driver(
