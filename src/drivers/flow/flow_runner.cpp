@@ -28,7 +28,9 @@ namespace ff::drivers {
 
 void declare_lbm_params(ParamTable& t, const LbmDefaults& d) {
   t.string("lbm.lattice", "D2Q9", "velocity set; D3Q19 extrudes the 2D case along a periodic z axis").one_of({"D2Q9", "D3Q19"});
-  t.integer("lbm.depth_cells", 1, "cells", "D3Q19 only: cells along the periodic z axis").at_least(1);
+  // A fallback: flow/cylinder's duct takes its depth from channel.depth and refuses this key when
+  // set, so the saved scenario of a duct run must not set it (resume reads that file).
+  t.integer("lbm.depth_cells", 1, "cells", "D3Q19 only: cells along the periodic z axis").at_least(1).fallback();
   t.string("lbm.precision", "double", "storage and arithmetic precision of the populations").one_of({"double", "float"});
   t.string("lbm.collision", "trt", "collision: two-relaxation-time (Ginzburg et al. 2008) or BGK").one_of({"trt", "bgk"});
   t.string("lbm.equilibrium", "incompressible",

@@ -35,9 +35,46 @@ probes.y = [0.021, 0.021]
 probes.delta_p = ["fore", "aft"]
 )";
 
+// A D3Q19 duct (channel.depth > 0): its depth comes from channel.depth, and lbm.depth_cells is
+// refused there; the saved scenario must not set it, or resume refuses its own run.
+const char* kDuct = R"(driver = "flow/cylinder"
+channel.height = 0.04
+channel.length = 0.08
+channel.depth = 0.02
+cylinder.diameter = 0.01
+cylinder.x = 0.03
+cylinder.y = 0.021
+inlet.velocity = 0.01
+inlet.profile = "parabolic"
+fluid.viscosity = 1.0e-5
+lbm.lattice = "D3Q19"
+lbm.resolution = 4
+lbm.time_step = 0.04
+run.end_time = 20
+output.samples = 20
+output.snapshots = 0
+output.plots = false
+)";
+
 using ff::test::run_program;
 
 }  // namespace
+
+TEST(FlowCli, ADuctRunResumesFromItsSavedScenario) {
+  const ff::test::TestScratch s("flowcli");
+  const fs::path scen = s.path / "duct.toml";
+  std::ofstream(scen) << kDuct;
+  const fs::path whole = s.path / "whole", cut = s.path / "cut";
+  auto r = run_program("run " + scen.string() + " --out " + whole.string() + " --quiet");
+  ASSERT_EQ(r.code, 0) << r.output;
+  r = run_program("run " + scen.string() + " --out " + cut.string() + " --quiet --max-steps 250");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_FALSE(fs::exists(cut / "summary.json")) << "stopped before the end";
+  EXPECT_NE(ff::test::read_bytes(cut / "scenario.toml").find("# (default, not set) lbm.depth_cells"), std::string::npos);
+  r = run_program("resume " + cut.string() + " --quiet");
+  ASSERT_EQ(r.code, 0) << r.output;
+  ff::test::expect_same_results(whole, cut, "duct interrupted by --max-steps 250 and resumed through the program");
+}
 
 TEST(FlowCli, MaxStepsStopsAndATimeStepRunResumesBitForBit) {
   const ff::test::TestScratch s("flowcli");
