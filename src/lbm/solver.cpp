@@ -213,8 +213,16 @@ void Solver<L, T>::step(bool sample) {
   const bool odd = (time_ & 1) != 0;
   save_interpolation_inputs(odd);
   save_outflow_inputs(odd);
+  const bool psm = psm_ && psm_->active();
+  if (psm && psm_kinds_stale_)
+    throw Error("internal: LBM geometry finalized after set_particles(): set the particles again before stepping");
+  if (psm) psm_->save_bulk(f_.data(), odd);
   bulk_sweep(odd, sample);
   boundary_sweep(odd, sample);
+  if (psm) {
+    psm_->apply_bulk(f_.data(), odd, relax_, settings_.body_force.squaredNorm() > 0, settings_.incompressible);
+    psm_->reduce();
+  }
   reduce_forces();
   ++time_;
 }
@@ -374,7 +382,10 @@ void Solver<L, T>::update_boundary_cell(std::size_t i, bool odd, bool sample) {
   }
   // An outflow donor hands its gathered populations g_q(x, t+1) to the node outside it.
   if (b.capture >= 0) std::copy(g, g + Q, &donor_g_[std::size_t(Q) * b.capture]);
-  // 4. Collide.
+  // 4. Collide (a cell covered by particles keeps its pre-collision populations for the PSM).
+  const std::int32_t psm_slot = psm_ && psm_->active() ? psm_->slot(b.cell) : -1;
+  T gpre[Q];
+  if (psm_slot >= 0) std::copy(g, g + Q, gpre);
   T drho, u[3];
   const bool force = settings_.body_force.squaredNorm() > 0;
   auto run = [&]<CollisionModel M, bool kIncomp>() {
@@ -389,6 +400,7 @@ void Solver<L, T>::update_boundary_cell(std::size_t i, bool odd, bool sample) {
     if (trt) run.template operator()<CollisionModel::Trt, false>();
     else run.template operator()<CollisionModel::Bgk, false>();
   }
+  if (psm_slot >= 0) psm_->apply(psm_slot, gpre, g, relax_, force, settings_.incompressible);
   // 5. Store: even -> own cell, swapped slot; odd -> neighbour x + c_q, regular slot.
   f_[b.cell] = g[0];
   for (int q = 1; q < Q; ++q) {
@@ -405,6 +417,37 @@ void Solver<L, T>::update_boundary_cell(std::size_t i, bool odd, bool sample) {
     drho_[b.cell] = drho;
     for (int a = 0; a < 3; ++a) u_[a][b.cell] = u[a];
   }
+}
+
+template <class L, class T>
+void Solver<L, T>::set_particles(const ParticleSet& p) {
+  if (!psm_) psm_ = std::make_unique<Psm<L, T>>(grid_, settings_.tau);
+  if (psm_kinds_stale_) {
+    // 1: bulk fluid, 2: boundary fluid, 0: solid or ghost (never covered).
+    auto& kind = psm_->cell_kinds();
+    kind.assign(std::size_t(n_()), 0);
+    for (int z = 0; z < grid_.nz; ++z)
+      for (int y = 0; y < grid_.ny; ++y)
+        for (int x = 0; x < grid_.nx; ++x) {
+          const CellIndex i = grid_.index(x, y, z);
+          if (type_[i] == CellType::Fluid) kind[std::size_t(i)] = 1;
+        }
+    for (const BoundaryCell& b : bcells_) kind[std::size_t(b.cell)] = 2;
+    psm_kinds_stale_ = false;
+  }
+  psm_->set_particles(p);
+}
+
+template <class L, class T>
+const std::vector<Vec3>& Solver<L, T>::particle_forces() const {
+  static const std::vector<Vec3> none;
+  return psm_ ? psm_->forces() : none;
+}
+
+template <class L, class T>
+const std::vector<Vec3>& Solver<L, T>::particle_torques() const {
+  static const std::vector<Vec3> none;
+  return psm_ ? psm_->torques() : none;
 }
 
 // Sums the link forces per object in link order: the same result on any thread count.
