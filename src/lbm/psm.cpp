@@ -13,6 +13,11 @@ namespace ff::lbm {
 
 namespace {
 
+// Below this many covered bulk cells the PSM passes run on one thread: a PSM cell costs a few bulk
+// cell updates, and a parallel region per pass costs more than it saves on small sets (and spins
+// for long on an oversubscribed machine).
+constexpr std::int64_t kParallelMinCells = 4096;
+
 // Volume of {xi in [0,1]^k : m . xi <= a} for m_i > 0 (inclusion-exclusion over the corners of
 // the cube: each corner v cuts off the simplex (a - m.v)^k / (k! prod m), signed by its parity).
 double box_below_plane(const double* m, int k, double a) {
@@ -164,7 +169,7 @@ template <class L, class T>
 void Psm<L, T>::save_bulk(const T* f, bool odd) {
   const CellIndex N = grid_.padded_size();
   const std::int64_t nb = std::int64_t(bulk_.size());
-#pragma omp parallel for schedule(static) if (nb > 2048)
+#pragma omp parallel for schedule(static) if (nb > kParallelMinCells)
   for (std::int64_t k = 0; k < nb; ++k) {
     const CellIndex i = cells_[std::size_t(bulk_[std::size_t(k)])].cell;
     const auto x = grid_.coords(i);
@@ -181,7 +186,7 @@ template <class L, class T>
 void Psm<L, T>::apply_bulk(T* f, bool odd, const Relax<T>& r, bool force, bool incomp) {
   const CellIndex N = grid_.padded_size();
   const std::int64_t nb = std::int64_t(bulk_.size());
-#pragma omp parallel for schedule(static) if (nb > 2048)
+#pragma omp parallel for schedule(static) if (nb > kParallelMinCells)
   for (std::int64_t k = 0; k < nb; ++k) {
     const std::int32_t sl = bulk_[std::size_t(k)];
     const CellIndex i = cells_[std::size_t(sl)].cell;
