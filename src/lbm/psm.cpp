@@ -13,10 +13,6 @@ namespace ff::lbm {
 
 namespace {
 
-// Below this many covered bulk cells the PSM passes run on one thread: a PSM cell costs a few bulk
-// cell updates, and a parallel region per pass costs more than it saves on small sets (and spins
-// for long on an oversubscribed machine).
-constexpr std::int64_t kParallelMinCells = 4096;
 
 // Volume of {xi in [0,1]^k : m . xi <= a} for m_i > 0 (inclusion-exclusion over the corners of
 // the cube: each corner v cuts off the simplex (a - m.v)^k / (k! prod m), signed by its parity).
@@ -74,6 +70,41 @@ double psm_cell_fraction(int dim, const Vec3& d, double r) {
 }
 
 template <class L, class T>
+Psm<L, T>::Psm(const Grid& grid, double tau) : grid_(grid), tau_(tau) {
+  const CellIndex N = grid_.padded_size();
+  for (int q = 0; q < Q; ++q) {
+    const int o = L::opp[q];
+    const std::int64_t cq = L::c[q][0] + grid_.px * (L::c[q][1] + grid_.py * L::c[q][2]);
+    pre_[0][q] = q * N;
+    pre_[1][q] = q == 0 ? 0 : o * N - cq;
+    post_[0][q] = o * N;
+    post_[1][q] = q == 0 ? 0 : q * N + cq;
+  }
+}
+
+// AA pattern: g_q before the step is in f[q][x] (even) or f[opp q][x - c_q] (odd); the kernel
+// writes g*_q to f[opp q][x] (even) or f[q][x + c_q] (odd).
+template <class L, class T>
+void Psm<L, T>::slots(const BulkCell& b, bool odd, CellIndex* pre, CellIndex* post) const {
+  if (!b.edge) {
+    for (int q = 0; q < Q; ++q) {
+      pre[q] = b.cell + pre_[odd][q];
+      post[q] = b.cell + post_[odd][q];
+    }
+    return;
+  }
+  const CellIndex N = grid_.padded_size();
+  const auto x = grid_.coords(b.cell);
+  pre[0] = post[0] = b.cell;
+  for (int q = 1; q < Q; ++q) {
+    const int o = L::opp[q];
+    const auto& c = L::c[q];
+    pre[q] = odd ? o * N + grid_.neighbour(x[0], x[1], x[2], -c[0], -c[1], -c[2]) : q * N + b.cell;
+    post[q] = odd ? q * N + grid_.neighbour(x[0], x[1], x[2], c[0], c[1], c[2]) : o * N + b.cell;
+  }
+}
+
+template <class L, class T>
 void Psm<L, T>::set_particles(const ParticleSet& p) {
   const std::size_t np = p.size();
   if (p.position.size() != np || p.velocity.size() != np || p.omega.size() != np || (!p.id.empty() && p.id.size() != np))
@@ -83,6 +114,8 @@ void Psm<L, T>::set_particles(const ParticleSet& p) {
   if (np >= std::size_t(INT32_MAX)) throw InputError("PSM particle set: more than 2^31 - 1 particles");
   if (slot_.empty()) slot_.assign(std::size_t(grid_.padded_size()), -1);
   for (const Cell& c : cells_) slot_[std::size_t(c.cell)] = -1;
+  for (const std::int32_t sp : touched_) span_count_[std::size_t(sp)] = 0;
+  touched_.clear();
   cells_.clear();
   raw_.clear();
   const int D = L::D;
@@ -115,14 +148,15 @@ void Psm<L, T>::set_particles(const ParticleSet& p) {
           }
           if (!inside) continue;
           const CellIndex ci = grid_.index(c[0], c[1], c[2]);
-          if (kind_[std::size_t(ci)] == 0) continue;
+          const std::int32_t span = span_of_[std::size_t(ci)];
+          if (span == kNotFluid) continue;
           const Vec3 arm = D == 3 ? Vec3(x - X[0], y - X[1], z - X[2]) : Vec3(x - X[0], y - X[1], 0);
           const double eps = psm_cell_fraction(D, arm, r);
           if (eps <= 0) continue;
           std::int32_t& sl = slot_[std::size_t(ci)];
           if (sl < 0) {
             sl = std::int32_t(cells_.size());
-            cells_.push_back(Cell{ci, 0, 0, 0.0, T(0), kind_[std::size_t(ci)] == 2});
+            cells_.push_back(Cell{ci, 0, 0, 0.0, T(0), span == kBoundaryCell});
           }
           Entry e;
           e.slot = sl;
@@ -149,13 +183,30 @@ void Psm<L, T>::set_particles(const ParticleSet& p) {
     Cell& c = cells_[std::size_t(e.slot)];
     entries_[std::size_t(c.first + c.count++)] = e;
   }
-  bulk_.clear();
+  // Bulk cells grouped by the span that updates them (offsets in order of first touch).
+  for (const Cell& c : cells_) {
+    if (c.boundary) continue;
+    const std::int32_t sp = span_of_[std::size_t(c.cell)];
+    if (span_count_[std::size_t(sp)]++ == 0) touched_.push_back(sp);
+  }
+  std::int32_t nbulk = 0;
+  for (const std::int32_t sp : touched_) {
+    span_first_[std::size_t(sp)] = nbulk;
+    nbulk += span_count_[std::size_t(sp)];
+    span_count_[std::size_t(sp)] = 0;
+  }
+  bulk_.resize(std::size_t(nbulk));
   for (std::size_t i = 0; i < cells_.size(); ++i) {
     Cell& c = cells_[i];
     const double B = psm_weight(std::min(1.0, c.eps), tau_);
     c.B = T(B);
     for (std::int32_t k = c.first; k < c.first + c.count; ++k) entries_[std::size_t(k)].Bs = T(B * entries_[std::size_t(k)].eps / c.eps);
-    if (!c.boundary) bulk_.push_back(std::int32_t(i));
+    if (c.boundary) continue;
+    const auto x = grid_.coords(c.cell);
+    bool edge = false;
+    for (int a = 0; a < L::D; ++a) edge = edge || (grid_.periodic[a] && (x[a] == 0 || x[a] == grid_.n(a) - 1));
+    const std::int32_t sp = span_of_[std::size_t(c.cell)];
+    bulk_[std::size_t(span_first_[std::size_t(sp)] + span_count_[std::size_t(sp)]++)] = BulkCell{c.cell, std::int32_t(i), edge};
   }
   gpre_.resize(std::size_t(Q) * bulk_.size());
   entry_force_.assign(3 * entries_.size(), 0.0);
@@ -163,45 +214,50 @@ void Psm<L, T>::set_particles(const ParticleSet& p) {
   torque_.assign(np, Vec3::Zero());
 }
 
-// Slot of g_q of `cell` before the step: even f[q][x], odd f[opp q][x - c_q] (the kernel then
-// writes g*_{opp q} there).
 template <class L, class T>
-void Psm<L, T>::save_bulk(const T* f, bool odd) {
-  const CellIndex N = grid_.padded_size();
-  const std::int64_t nb = std::int64_t(bulk_.size());
-#pragma omp parallel for schedule(static) if (nb > kParallelMinCells)
-  for (std::int64_t k = 0; k < nb; ++k) {
-    const CellIndex i = cells_[std::size_t(bulk_[std::size_t(k)])].cell;
-    const auto x = grid_.coords(i);
+void Psm<L, T>::set_cell_spans(std::vector<std::int32_t> span_of_cell, std::size_t num_spans) {
+  for (const Cell& c : cells_) slot_[std::size_t(c.cell)] = -1;
+  cells_.clear();
+  entries_.clear();
+  bulk_.clear();
+  touched_.clear();
+  span_of_ = std::move(span_of_cell);
+  span_first_.assign(num_spans, 0);
+  span_count_.assign(num_spans, 0);
+}
+
+template <class L, class T>
+void Psm<L, T>::save_span(std::int64_t span, const T* f, bool odd) {
+  const std::int32_t k0 = span_first_[std::size_t(span)], k1 = k0 + span_count_[std::size_t(span)];
+  for (std::int32_t k = k0; k < k1; ++k) {
+    CellIndex pre[Q], post[Q];
+    slots(bulk_[std::size_t(k)], odd, pre, post);
     T* g = &gpre_[std::size_t(Q) * std::size_t(k)];
-    g[0] = f[i];
-    for (int q = 1; q < Q; ++q)
-      g[q] = odd ? f[L::opp[q] * N + grid_.neighbour(x[0], x[1], x[2], -L::c[q][0], -L::c[q][1], -L::c[q][2])]
-                 : f[q * N + i];
+    for (int q = 0; q < Q; ++q) g[q] = f[pre[q]];
   }
 }
 
-// After the sweep the kernel's g*_q sits in the slot of g_{opp q}.
 template <class L, class T>
-void Psm<L, T>::apply_bulk(T* f, bool odd, const Relax<T>& r, bool force, bool incomp) {
-  const CellIndex N = grid_.padded_size();
-  const std::int64_t nb = std::int64_t(bulk_.size());
-#pragma omp parallel for schedule(static) if (nb > kParallelMinCells)
-  for (std::int64_t k = 0; k < nb; ++k) {
-    const std::int32_t sl = bulk_[std::size_t(k)];
-    const CellIndex i = cells_[std::size_t(sl)].cell;
-    const auto x = grid_.coords(i);
-    CellIndex at[Q];
-    at[0] = i;
-    for (int q = 1; q < Q; ++q) {
-      const int o = L::opp[q];
-      at[q] = odd ? q * N + grid_.neighbour(x[0], x[1], x[2], L::c[q][0], L::c[q][1], L::c[q][2]) : o * N + i;
-    }
+void Psm<L, T>::apply_span(std::int64_t span, T* f, bool odd, const Relax<T>& r, bool force, bool incomp) {
+  const std::int32_t k0 = span_first_[std::size_t(span)], k1 = k0 + span_count_[std::size_t(span)];
+  for (std::int32_t k = k0; k < k1; ++k) {
+    CellIndex pre[Q], post[Q];
+    slots(bulk_[std::size_t(k)], odd, pre, post);
     T g[Q];
-    for (int q = 0; q < Q; ++q) g[q] = f[at[q]];
-    apply(sl, &gpre_[std::size_t(Q) * std::size_t(k)], g, r, force, incomp);
-    for (int q = 0; q < Q; ++q) f[at[q]] = g[q];
+    for (int q = 0; q < Q; ++q) g[q] = f[post[q]];
+    apply(bulk_[std::size_t(k)].slot, &gpre_[std::size_t(Q) * std::size_t(k)], g, r, force, incomp);
+    for (int q = 0; q < Q; ++q) f[post[q]] = g[q];
   }
+}
+
+// Shifted equilibrium (as equilibrium() in collision.hpp) with compile-time directions.
+template <class L, class T>
+FF_LBM_INLINE void psm_equilibrium(T rho, T rho_u, const T* u, T* geq) {
+  const T usq15 = T(1.5) * (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+  static_for<L::Q>([&](auto q) FF_LBM_LAMBDA_INLINE {
+    const T cu = cdot<L::c[q][0], L::c[q][1], L::c[q][2]>(u[0], u[1], u[2]);
+    geq[q] = T(L::w[q]) * ((rho - T(1)) + rho_u * (T(3) * cu + T(4.5) * cu * cu - usq15));
+  });
 }
 
 template <class L, class T>
@@ -209,28 +265,36 @@ void Psm<L, T>::apply(std::int32_t sl, const T* gpre, T* g, const Relax<T>& r, b
   const Cell& c = cells_[std::size_t(sl)];
   // Fluid moments of the pre-collision state (Guo's half force included, as in collide()).
   T drho = 0, j[3] = {0, 0, 0};
-  for (int q = 0; q < Q; ++q) {
+  static_for<Q>([&](auto q) FF_LBM_LAMBDA_INLINE {
     drho += gpre[q];
-    for (int a = 0; a < L::D; ++a) j[a] += T(L::c[q][a]) * gpre[q];
-  }
+    static_for<L::D>([&](auto a) FF_LBM_LAMBDA_INLINE {
+      if constexpr (L::c[q][a] > 0) j[a] += gpre[q];
+      if constexpr (L::c[q][a] < 0) j[a] -= gpre[q];
+    });
+  });
   if (force)
     for (int a = 0; a < L::D; ++a) j[a] += T(0.5) * r.force[a];
   const T rho = T(1) + drho;
+  const T rho_u = incomp ? T(1) : rho;
   const T inv = incomp ? T(1) : T(1) / rho;
   const T u[3] = {j[0] * inv, j[1] * inv, j[2] * inv};
   T geq_f[Q], geq_s[Q], sum[Q];
-  equilibrium<L, T>(rho, u, geq_f, incomp);
+  psm_equilibrium<L, T>(rho, rho_u, u, geq_f);
   for (int q = 0; q < Q; ++q) sum[q] = T(0);
   for (std::int32_t k = c.first; k < c.first + c.count; ++k) {
     const Entry& e = entries_[std::size_t(k)];
-    equilibrium<L, T>(rho, e.us, geq_s, incomp);
+    psm_equilibrium<L, T>(rho, rho_u, e.us, geq_s);
     double F[3] = {0, 0, 0};
-    for (int q = 0; q < Q; ++q) {
-      const int o = L::opp[q];
-      const T om = e.Bs * ((gpre[o] - gpre[q]) + (geq_s[q] - geq_f[o]));
+    const T Bs = e.Bs;
+    static_for<Q>([&](auto q) FF_LBM_LAMBDA_INLINE {
+      constexpr int o = L::opp[q];
+      const T om = Bs * ((gpre[o] - gpre[q]) + (geq_s[q] - geq_f[o]));
       sum[q] += om;
-      for (int a = 0; a < L::D; ++a) F[a] -= double(L::c[q][a]) * double(om);
-    }
+      static_for<L::D>([&](auto a) FF_LBM_LAMBDA_INLINE {
+        if constexpr (L::c[q][a] > 0) F[a] -= double(om);
+        if constexpr (L::c[q][a] < 0) F[a] += double(om);
+      });
+    });
     for (int a = 0; a < 3; ++a) entry_force_[3 * std::size_t(k) + std::size_t(a)] = F[a];
   }
   const T B = c.B, fluid = T(1) - B;

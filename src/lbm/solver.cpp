@@ -216,13 +216,9 @@ void Solver<L, T>::step(bool sample) {
   const bool psm = psm_ && psm_->active();
   if (psm && psm_kinds_stale_)
     throw Error("internal: LBM geometry finalized after set_particles(): set the particles again before stepping");
-  if (psm) psm_->save_bulk(f_.data(), odd);
-  bulk_sweep(odd, sample);
+  bulk_sweep(odd, sample);  // covered bulk cells: Psm::save_span / apply_span around their span
   boundary_sweep(odd, sample);
-  if (psm) {
-    psm_->apply_bulk(f_.data(), odd, relax_, settings_.body_force.squaredNorm() > 0, settings_.incompressible);
-    psm_->reduce();
-  }
+  if (psm) psm_->reduce();
   reduce_forces();
   ++time_;
 }
@@ -423,16 +419,12 @@ template <class L, class T>
 void Solver<L, T>::set_particles(const ParticleSet& p) {
   if (!psm_) psm_ = std::make_unique<Psm<L, T>>(grid_, settings_.tau);
   if (psm_kinds_stale_) {
-    // 1: bulk fluid, 2: boundary fluid, 0: solid or ghost (never covered).
-    auto& kind = psm_->cell_kinds();
-    kind.assign(std::size_t(n_()), 0);
-    for (int z = 0; z < grid_.nz; ++z)
-      for (int y = 0; y < grid_.ny; ++y)
-        for (int x = 0; x < grid_.nx; ++x) {
-          const CellIndex i = grid_.index(x, y, z);
-          if (type_[i] == CellType::Fluid) kind[std::size_t(i)] = 1;
-        }
-    for (const BoundaryCell& b : bcells_) kind[std::size_t(b.cell)] = 2;
+    std::vector<std::int32_t> span_of(std::size_t(n_()), Psm<L, T>::kNotFluid);
+    for (std::size_t s = 0; s < spans_.size(); ++s)
+      for (int k = 0; k < spans_[s].n; ++k)
+        span_of[std::size_t(grid_.index(spans_[s].x0 + k, spans_[s].y, spans_[s].z))] = std::int32_t(s);
+    for (const BoundaryCell& b : bcells_) span_of[std::size_t(b.cell)] = Psm<L, T>::kBoundaryCell;
+    psm_->set_cell_spans(std::move(span_of), spans_.size());
     psm_kinds_stale_ = false;
   }
   psm_->set_particles(p);
