@@ -27,14 +27,13 @@
 //
 // Cost: each step clears the cells of the previous particle set and visits each particle's
 // bounding box; nothing sweeps the lattice. Bulk cells that a particle covers keep the bulk
-// kernel: their pre-collision populations are saved before the sweep and the PSM update is
-// applied to the kernel's result afterwards, g_new = (1 - B) g* + B g + sum_s B_s Omega^s (the
-// kernel is untouched, so cells with B = 0 keep its speed). Boundary cells apply the same update
-// inside their own path. The bulk cells' save and update run span by span inside the bulk sweep,
-// right before and after the kernel updates that span, so their populations come from the cache
-// (as separate passes over the covered cells in particle order they made a step with 28% of the
-// cells covered 10 times slower). Every cell owns its slots (AA pattern), so cells are independent; the
-// per-particle sums run in a fixed order: results are the same on any thread count.
+// kernel (untouched, so cells with B = 0 keep its speed): inside the bulk sweep, a span's covered
+// cells save their pre-collision populations right before the kernel runs the span, and the PSM
+// update is applied to the kernel's result right after, g_new = (1 - B) g* + B g + sum_s B_s
+// Omega^s, while the rows are in the cache (as two separate passes in particle order the update
+// made a 128^3 step with 28% of the cells covered twice as slow). Boundary cells apply the same
+// update inside their own path. Every cell owns its slots (AA pattern), so cells are independent;
+// the per-particle sums run in a fixed order: results are the same on any thread count.
 #pragma once
 #include <cstdint>
 #include <vector>
