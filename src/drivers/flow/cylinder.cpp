@@ -346,7 +346,14 @@ class CylinderCase : public FlowCase {
     } else {
       res["recirculation_length_m"] = recirculation_length(last);
     }
-    res["lambda_wall_factor"] = fx.back() / span() / (rho_ * nu_ * u_max());  // [S003] Eq. 16, per unit depth
+    // [S003] Eq. 16 is the wall factor of a cylinder between plates (per unit depth); a duct's
+    // cylinder has walls at its ends too and no such factor.
+    if (duct()) {
+      res["lambda_wall_factor"] = nullptr;
+      res["lambda_wall_factor_reason"] = "defined for a cylinder between two plates ([S003] Eq. 16), not in a duct";
+    } else {
+      res["lambda_wall_factor"] = fx.back() / (rho_ * nu_ * u_max());
+    }
     res["wall_scheme"] = scheme_ == lbm::WallScheme::Bouzidi ? "bouzidi" : scheme_ == lbm::WallScheme::Yu ? "yu" : "halfway";
     if (shedding)
       log::info("cylinder Re = {:.4g}: mean Cd = {:.4f}, Cd max = {:.4f}, Cl max = {:.4f}, St = {:.4f} (over {} shedding "
@@ -357,7 +364,7 @@ class CylinderCase : public FlowCase {
       log::info("cylinder Re = {:.4g}: Cd = {:.4f}, Cl = {:.5f}, Delta p = {:.4g} Pa, L_a = {:.4g} m, lambda = {:.4f} "
                 "(steady, no shedding)",
                 re, cd.back(), cl.back(), dp.back(), double(res["recirculation_length_m"]),
-                double(res["lambda_wall_factor"]));
+                duct() ? NAN : double(res["lambda_wall_factor"]));
     if (!plots) return;
     PlotSpec p;
     p.title = fmt::format("Cylinder in a channel, Re = {:.4g}: force coefficients", re);
