@@ -109,11 +109,18 @@ void Solver<L, T>::bulk_sweep(bool odd, bool sample) {
   const std::int64_t ns = std::int64_t(spans_.size());
   const Span* spans = spans_.data();
   const Grid& g = grid_;
+  // Cells covered by particles (lbm/psm.hpp): the PSM update wraps the kernel of their span.
+  Psm<L, T>* psm = psm_ && psm_->active() ? psm_.get() : nullptr;
+  const bool force_psm = force;
+  const bool incomp = settings_.incompressible;
   // Small lattices run serially: a parallel region costs more than it saves there.
 #pragma omp parallel for schedule(static) if (num_bulk_cells_ > kParallelMinCells)
   for (std::int64_t s = 0; s < ns; ++s) {
     const Span& sp = spans[s];
+    const bool covered = psm && psm->span_covered(s);
+    if (covered) psm->save_span(s, f, odd);
     fn(g, f, N, sp.x0, sp.y, sp.z, sp.n, odd, r, drho, u);
+    if (covered) psm->apply_span(s, f, odd, r, force_psm, incomp);
   }
 }
 

@@ -213,8 +213,12 @@ void Solver<L, T>::step(bool sample) {
   const bool odd = (time_ & 1) != 0;
   save_interpolation_inputs(odd);
   save_outflow_inputs(odd);
-  bulk_sweep(odd, sample);
+  const bool psm = psm_ && psm_->active();
+  if (psm && psm_kinds_stale_)
+    throw Error("internal: LBM geometry finalized after set_particles(): set the particles again before stepping");
+  bulk_sweep(odd, sample);  // covered bulk cells: Psm::save_span / apply_span around their span
   boundary_sweep(odd, sample);
+  if (psm) psm_->reduce();
   reduce_forces();
   ++time_;
 }
@@ -374,7 +378,10 @@ void Solver<L, T>::update_boundary_cell(std::size_t i, bool odd, bool sample) {
   }
   // An outflow donor hands its gathered populations g_q(x, t+1) to the node outside it.
   if (b.capture >= 0) std::copy(g, g + Q, &donor_g_[std::size_t(Q) * b.capture]);
-  // 4. Collide.
+  // 4. Collide (a cell covered by particles keeps its pre-collision populations for the PSM).
+  const std::int32_t psm_slot = psm_ && psm_->active() ? psm_->slot(b.cell) : -1;
+  T gpre[Q];
+  if (psm_slot >= 0) std::copy(g, g + Q, gpre);
   T drho, u[3];
   const bool force = settings_.body_force.squaredNorm() > 0;
   auto run = [&]<CollisionModel M, bool kIncomp>() {
@@ -389,6 +396,7 @@ void Solver<L, T>::update_boundary_cell(std::size_t i, bool odd, bool sample) {
     if (trt) run.template operator()<CollisionModel::Trt, false>();
     else run.template operator()<CollisionModel::Bgk, false>();
   }
+  if (psm_slot >= 0) psm_->apply(psm_slot, gpre, g, relax_, force, settings_.incompressible);
   // 5. Store: even -> own cell, swapped slot; odd -> neighbour x + c_q, regular slot.
   f_[b.cell] = g[0];
   for (int q = 1; q < Q; ++q) {
@@ -405,6 +413,33 @@ void Solver<L, T>::update_boundary_cell(std::size_t i, bool odd, bool sample) {
     drho_[b.cell] = drho;
     for (int a = 0; a < 3; ++a) u_[a][b.cell] = u[a];
   }
+}
+
+template <class L, class T>
+void Solver<L, T>::set_particles(const ParticleSet& p) {
+  if (!psm_) psm_ = std::make_unique<Psm<L, T>>(grid_, settings_.tau);
+  if (psm_kinds_stale_) {
+    std::vector<std::int32_t> span_of(std::size_t(n_()), Psm<L, T>::kNotFluid);
+    for (std::size_t s = 0; s < spans_.size(); ++s)
+      for (int k = 0; k < spans_[s].n; ++k)
+        span_of[std::size_t(grid_.index(spans_[s].x0 + k, spans_[s].y, spans_[s].z))] = std::int32_t(s);
+    for (const BoundaryCell& b : bcells_) span_of[std::size_t(b.cell)] = Psm<L, T>::kBoundaryCell;
+    psm_->set_cell_spans(std::move(span_of), spans_.size());
+    psm_kinds_stale_ = false;
+  }
+  psm_->set_particles(p);
+}
+
+template <class L, class T>
+const std::vector<Vec3>& Solver<L, T>::particle_forces() const {
+  static const std::vector<Vec3> none;
+  return psm_ ? psm_->forces() : none;
+}
+
+template <class L, class T>
+const std::vector<Vec3>& Solver<L, T>::particle_torques() const {
+  static const std::vector<Vec3> none;
+  return psm_ ? psm_->torques() : none;
 }
 
 // Sums the link forces per object in link order: the same result on any thread count.

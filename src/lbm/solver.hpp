@@ -21,6 +21,7 @@
 #pragma once
 #include <array>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -31,6 +32,7 @@
 #include "lbm/collision.hpp"
 #include "lbm/descriptor.hpp"
 #include "lbm/grid.hpp"
+#include "lbm/psm.hpp"
 #include "lbm/shapes.hpp"
 
 namespace ff::lbm {
@@ -134,10 +136,19 @@ class Solver {
   std::size_t num_bulk_cells() const;
   std::size_t num_fluid_cells() const { return num_bulk_cells() + bcells_.size(); }
 
+  // ---- moving particles as partially saturated cells (lbm/psm.hpp), set before each step(); the
+  // covered cells' update then uses this set until the next call. Forces and torques of the
+  // last step on each particle (lattice units, indexed like the set; Units::to_si_force).
+  void set_particles(const ParticleSet& p);
+  const std::vector<Vec3>& particle_forces() const;
+  const std::vector<Vec3>& particle_torques() const;
+  const Psm<L, T>* psm() const { return psm_.get(); }
+
   // Convective outflow: the speed U of the face's last step (set or the mean outflow speed).
   double outflow_velocity(int face) const { return double(convective_u_[face]); }
 
-  // ---- checkpoint: the populations and the step counter are the whole state. The convective
+  // ---- checkpoint: the populations and the step counter are the whole state (the particle set of
+  // the PSM is an input of every step, so a resumed run that sets it again continues bit-for-bit). The convective
   // outflow's state (the previous step's incoming populations and outflow speed of each face
   // node) lives in otherwise unused slots of the open ghost cells, so it is part of populations().
   const AlignedVector<T>& populations() const { return f_; }
@@ -195,6 +206,8 @@ class Solver {
   std::vector<T> donor_g_;
   std::vector<BulkDonor> bulk_donors_;
   std::array<T, kNumFaces> convective_u_{};
+  std::unique_ptr<Psm<L, T>> psm_;     // created by the first set_particles()
+  bool psm_kinds_stale_ = true;        // finalize() changed the cell classification
 };
 
 extern template class Solver<D2Q9, double>;

@@ -33,6 +33,7 @@ void Solver<L, T>::finalize() {
         object_[i] = open ? -1 : std::int16_t(f);
       }
 
+  psm_kinds_stale_ = true;
   spans_.clear();
   bcells_.clear();
   links_.clear();

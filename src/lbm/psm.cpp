@@ -1,0 +1,335 @@
+// Partially saturated cells: covered fractions, the PSM update and the per-particle loads
+// (psm.hpp has the equations and their sources).
+#include "lbm/psm.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/error.hpp"
+
+namespace ff::lbm {
+
+namespace {
+
+
+// Volume of {xi in [0,1]^k : m . xi <= a} for m_i > 0 (inclusion-exclusion over the corners of
+// the cube: each corner v cuts off the simplex (a - m.v)^k / (k! prod m), signed by its parity).
+double box_below_plane(const double* m, int k, double a) {
+  double sum_m = 0;
+  for (int i = 0; i < k; ++i) sum_m += m[i];
+  if (a <= 0) return 0;
+  if (a >= sum_m) return 1;
+  if (k == 1) return a / m[0];
+  double acc = 0, prod = 1, fact = 1;
+  for (int i = 0; i < k; ++i) {
+    prod *= m[i];
+    fact *= i + 1;
+  }
+  for (int v = 0; v < (1 << k); ++v) {
+    double s = a;
+    int bits = 0;
+    for (int i = 0; i < k; ++i)
+      if (v & (1 << i)) {
+        s -= m[i];
+        ++bits;
+      }
+    if (s <= 0) continue;
+    const double p = k == 2 ? s * s : s * s * s;
+    acc += (bits % 2 == 0) ? p : -p;
+  }
+  return std::clamp(acc / (fact * prod), 0.0, 1.0);
+}
+
+}  // namespace
+
+double psm_cell_fraction(int dim, const Vec3& d, double r) {
+  const double dz = dim == 3 ? d[2] : 0.0;
+  const double dist = std::sqrt(d[0] * d[0] + d[1] * d[1] + dz * dz);
+  const double half_diag = dim == 3 ? std::sqrt(0.75) : std::sqrt(0.5);
+  if (dist + half_diag <= r) return 1;  // the farthest corner is inside
+  if (dist - half_diag >= r) return 0;  // the nearest point is outside
+  // Plane tangent on the ray through the cell centre, moved in by the mean gap to the surface
+  // over the cell's cross-section: <rho^2>/(2 r) with <rho^2> = (D - 1)/12.
+  const double rc = r - (dim - 1) / (24.0 * std::max(r, 1.0));
+  double n[3] = {1, 0, 0};
+  if (dist > 1e-12) n[0] = std::abs(d[0]) / dist, n[1] = std::abs(d[1]) / dist, n[2] = std::abs(dz) / dist;
+  // In cell coordinates xi in [0,1]^D with the axes flipped so that n >= 0: n . xi <= rc - dist + sum(n)/2.
+  double m[3];
+  int k = 0;
+  double a = rc - dist;
+  for (int i = 0; i < dim; ++i) {
+    a += 0.5 * n[i];
+    // Components below 1e-4 are dropped (the cube is then a prism along that axis): this keeps
+    // the 1/prod(m) of the corner sum well conditioned at an error below 1e-4.
+    if (n[i] >= 1e-4) m[k++] = n[i];
+    else a -= 0.5 * n[i];
+  }
+  return box_below_plane(m, k, a);
+}
+
+template <class L, class T>
+Psm<L, T>::Psm(const Grid& grid, double tau) : grid_(grid), tau_(tau) {
+  const CellIndex N = grid_.padded_size();
+  for (int q = 0; q < Q; ++q) {
+    const int o = L::opp[q];
+    const std::int64_t cq = L::c[q][0] + grid_.px * (L::c[q][1] + grid_.py * L::c[q][2]);
+    pre_[0][q] = q * N;
+    pre_[1][q] = q == 0 ? 0 : o * N - cq;
+    post_[0][q] = o * N;
+    post_[1][q] = q == 0 ? 0 : q * N + cq;
+  }
+}
+
+// AA pattern: g_q before the step is in f[q][x] (even) or f[opp q][x - c_q] (odd); the kernel
+// writes g*_q to f[opp q][x] (even) or f[q][x + c_q] (odd).
+template <class L, class T>
+void Psm<L, T>::slots(const BulkCell& b, bool odd, CellIndex* pre, CellIndex* post) const {
+  if (!b.edge) {
+    for (int q = 0; q < Q; ++q) {
+      pre[q] = b.cell + pre_[odd][q];
+      post[q] = b.cell + post_[odd][q];
+    }
+    return;
+  }
+  const CellIndex N = grid_.padded_size();
+  const auto x = grid_.coords(b.cell);
+  pre[0] = post[0] = b.cell;
+  for (int q = 1; q < Q; ++q) {
+    const int o = L::opp[q];
+    const auto& c = L::c[q];
+    pre[q] = odd ? o * N + grid_.neighbour(x[0], x[1], x[2], -c[0], -c[1], -c[2]) : q * N + b.cell;
+    post[q] = odd ? q * N + grid_.neighbour(x[0], x[1], x[2], c[0], c[1], c[2]) : o * N + b.cell;
+  }
+}
+
+template <class L, class T>
+void Psm<L, T>::set_particles(const ParticleSet& p) {
+  const std::size_t np = p.size();
+  if (p.position.size() != np || p.velocity.size() != np || p.omega.size() != np || (!p.id.empty() && p.id.size() != np))
+    throw InputError(fmt::format("PSM particle set: the arrays differ in length (radius {}, position {}, velocity {}, "
+                                 "omega {}, id {}): all must have one entry per particle (id may be empty)",
+                                 np, p.position.size(), p.velocity.size(), p.omega.size(), p.id.size()));
+  if (np >= std::size_t(INT32_MAX)) throw InputError("PSM particle set: more than 2^31 - 1 particles");
+  if (slot_.empty()) slot_.assign(std::size_t(grid_.padded_size()), -1);
+  for (const Cell& c : cells_) slot_[std::size_t(c.cell)] = -1;
+  for (const std::int32_t sp : touched_) span_count_[std::size_t(sp)] = 0;
+  touched_.clear();
+  cells_.clear();
+  raw_.clear();
+  const int D = L::D;
+  const int n[3] = {grid_.nx, grid_.ny, grid_.nz};
+  for (std::size_t s = 0; s < np; ++s) {
+    const Vec3& X = p.position[s];
+    const double r = p.radius[s];
+    bool ok = std::isfinite(r) && r > 0;
+    for (int a = 0; a < D; ++a) ok = ok && std::isfinite(X[a]) && (!grid_.periodic[a] || 2 * r < n[a]);
+    if (!ok)
+      throw InputError(fmt::format("PSM particle {} (id {}): radius {} at ({}, {}, {}) must be finite and positive "
+                                   "(and below half the lattice along a periodic axis), position finite",
+                                   s, p.id.empty() ? s : p.id[s], r, X[0], X[1], X[2]));
+    int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    for (int a = 0; a < D; ++a) {
+      // Cell x spans [x - 1/2, x + 1/2]: it meets the particle for x in [X - r - 1/2, X + r + 1/2].
+      lo[a] = int(std::ceil(X[a] - r - 0.5));
+      hi[a] = int(std::floor(X[a] + r + 0.5));
+    }
+    const Vec3& v = p.velocity[s];
+    const Vec3 w = D == 3 ? p.omega[s] : Vec3(0, 0, p.omega[s][2]);
+    for (int z = lo[2]; z <= hi[2]; ++z)
+      for (int y = lo[1]; y <= hi[1]; ++y)
+        for (int x = lo[0]; x <= hi[0]; ++x) {
+          int c[3] = {x, y, z};
+          bool inside = true;
+          for (int a = 0; a < D; ++a) {
+            if (grid_.periodic[a]) c[a] = ((c[a] % n[a]) + n[a]) % n[a];
+            else inside = inside && c[a] >= 0 && c[a] < n[a];
+          }
+          if (!inside) continue;
+          const CellIndex ci = grid_.index(c[0], c[1], c[2]);
+          const std::int32_t span = span_of_[std::size_t(ci)];
+          if (span == kNotFluid) continue;
+          const Vec3 arm = D == 3 ? Vec3(x - X[0], y - X[1], z - X[2]) : Vec3(x - X[0], y - X[1], 0);
+          const double eps = psm_cell_fraction(D, arm, r);
+          if (eps <= 0) continue;
+          std::int32_t& sl = slot_[std::size_t(ci)];
+          if (sl < 0) {
+            sl = std::int32_t(cells_.size());
+            cells_.push_back(Cell{ci, 0, 0, 0.0, T(0), span == kBoundaryCell});
+          }
+          Entry e;
+          e.slot = sl;
+          e.particle = std::int32_t(s);
+          e.eps = eps;
+          e.Bs = 0;
+          const Vec3 us = v + w.cross(arm);
+          for (int a = 0; a < 3; ++a) e.us[a] = T(a < D ? us[a] : 0.0);
+          e.arm = arm;
+          raw_.push_back(e);
+          ++cells_[std::size_t(sl)].count;
+          cells_[std::size_t(sl)].eps += eps;
+        }
+  }
+  // Group the entries by cell (counting sort, stable: particle order within a cell).
+  std::int32_t off = 0;
+  for (Cell& c : cells_) {
+    c.first = off;
+    off += c.count;
+    c.count = 0;
+  }
+  entries_.resize(raw_.size());
+  for (const Entry& e : raw_) {
+    Cell& c = cells_[std::size_t(e.slot)];
+    entries_[std::size_t(c.first + c.count++)] = e;
+  }
+  // Bulk cells grouped by the span that updates them (offsets in order of first touch).
+  for (const Cell& c : cells_) {
+    if (c.boundary) continue;
+    const std::int32_t sp = span_of_[std::size_t(c.cell)];
+    if (span_count_[std::size_t(sp)]++ == 0) touched_.push_back(sp);
+  }
+  std::int32_t nbulk = 0;
+  for (const std::int32_t sp : touched_) {
+    span_first_[std::size_t(sp)] = nbulk;
+    nbulk += span_count_[std::size_t(sp)];
+    span_count_[std::size_t(sp)] = 0;
+  }
+  bulk_.resize(std::size_t(nbulk));
+  for (std::size_t i = 0; i < cells_.size(); ++i) {
+    Cell& c = cells_[i];
+    const double B = psm_weight(std::min(1.0, c.eps), tau_);
+    c.B = T(B);
+    for (std::int32_t k = c.first; k < c.first + c.count; ++k) entries_[std::size_t(k)].Bs = T(B * entries_[std::size_t(k)].eps / c.eps);
+    if (c.boundary) continue;
+    const auto x = grid_.coords(c.cell);
+    bool edge = false;
+    for (int a = 0; a < L::D; ++a) edge = edge || (grid_.periodic[a] && (x[a] == 0 || x[a] == grid_.n(a) - 1));
+    const std::int32_t sp = span_of_[std::size_t(c.cell)];
+    bulk_[std::size_t(span_first_[std::size_t(sp)] + span_count_[std::size_t(sp)]++)] = BulkCell{c.cell, std::int32_t(i), edge};
+  }
+  gpre_.resize(std::size_t(Q) * bulk_.size());
+  entry_force_.assign(3 * entries_.size(), 0.0);
+  force_.assign(np, Vec3::Zero());
+  torque_.assign(np, Vec3::Zero());
+}
+
+template <class L, class T>
+void Psm<L, T>::set_cell_spans(std::vector<std::int32_t> span_of_cell, std::size_t num_spans) {
+  for (const Cell& c : cells_) slot_[std::size_t(c.cell)] = -1;
+  cells_.clear();
+  entries_.clear();
+  bulk_.clear();
+  touched_.clear();
+  span_of_ = std::move(span_of_cell);
+  span_first_.assign(num_spans, 0);
+  span_count_.assign(num_spans, 0);
+}
+
+template <class L, class T>
+void Psm<L, T>::save_span(std::int64_t span, const T* f, bool odd) {
+  const std::int32_t k0 = span_first_[std::size_t(span)], k1 = k0 + span_count_[std::size_t(span)];
+  for (std::int32_t k = k0; k < k1; ++k) {
+    CellIndex pre[Q], post[Q];
+    slots(bulk_[std::size_t(k)], odd, pre, post);
+    T* g = &gpre_[std::size_t(Q) * std::size_t(k)];
+    for (int q = 0; q < Q; ++q) g[q] = f[pre[q]];
+  }
+}
+
+template <class L, class T>
+void Psm<L, T>::apply_span(std::int64_t span, T* f, bool odd, const Relax<T>& r, bool force, bool incomp) {
+  const std::int32_t k0 = span_first_[std::size_t(span)], k1 = k0 + span_count_[std::size_t(span)];
+  for (std::int32_t k = k0; k < k1; ++k) {
+    CellIndex pre[Q], post[Q];
+    slots(bulk_[std::size_t(k)], odd, pre, post);
+    T g[Q];
+    for (int q = 0; q < Q; ++q) g[q] = f[post[q]];
+    apply(bulk_[std::size_t(k)].slot, &gpre_[std::size_t(Q) * std::size_t(k)], g, r, force, incomp);
+    for (int q = 0; q < Q; ++q) f[post[q]] = g[q];
+  }
+}
+
+// Shifted equilibrium (as equilibrium() in collision.hpp) with compile-time directions.
+template <class L, class T>
+FF_LBM_INLINE void psm_equilibrium(T rho, T rho_u, const T* u, T* geq) {
+  const T usq15 = T(1.5) * (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+  static_for<L::Q>([&](auto q) FF_LBM_LAMBDA_INLINE {
+    const T cu = cdot<L::c[q][0], L::c[q][1], L::c[q][2]>(u[0], u[1], u[2]);
+    geq[q] = T(L::w[q]) * ((rho - T(1)) + rho_u * (T(3) * cu + T(4.5) * cu * cu - usq15));
+  });
+}
+
+template <class L, class T>
+void Psm<L, T>::apply(std::int32_t sl, const T* gpre, T* g, const Relax<T>& r, bool force, bool incomp) {
+  const Cell& c = cells_[std::size_t(sl)];
+  // Fluid moments of the pre-collision state (Guo's half force included, as in collide()).
+  T drho = 0, j[3] = {0, 0, 0};
+  static_for<Q>([&](auto q) FF_LBM_LAMBDA_INLINE {
+    drho += gpre[q];
+    static_for<L::D>([&](auto a) FF_LBM_LAMBDA_INLINE {
+      if constexpr (L::c[q][a] > 0) j[a] += gpre[q];
+      if constexpr (L::c[q][a] < 0) j[a] -= gpre[q];
+    });
+  });
+  if (force)
+    for (int a = 0; a < L::D; ++a) j[a] += T(0.5) * r.force[a];
+  const T rho = T(1) + drho;
+  const T rho_u = incomp ? T(1) : rho;
+  const T inv = incomp ? T(1) : T(1) / rho;
+  const T u[3] = {j[0] * inv, j[1] * inv, j[2] * inv};
+  T geq_f[Q], geq_s[Q], sum[Q];
+  psm_equilibrium<L, T>(rho, rho_u, u, geq_f);
+  for (int q = 0; q < Q; ++q) sum[q] = T(0);
+  for (std::int32_t k = c.first; k < c.first + c.count; ++k) {
+    const Entry& e = entries_[std::size_t(k)];
+    psm_equilibrium<L, T>(rho, rho_u, e.us, geq_s);
+    double F[3] = {0, 0, 0};
+    const T Bs = e.Bs;
+    static_for<Q>([&](auto q) FF_LBM_LAMBDA_INLINE {
+      constexpr int o = L::opp[q];
+      const T om = Bs * ((gpre[o] - gpre[q]) + (geq_s[q] - geq_f[o]));
+      sum[q] += om;
+      static_for<L::D>([&](auto a) FF_LBM_LAMBDA_INLINE {
+        if constexpr (L::c[q][a] > 0) F[a] -= double(om);
+        if constexpr (L::c[q][a] < 0) F[a] += double(om);
+      });
+    });
+    for (int a = 0; a < 3; ++a) entry_force_[3 * std::size_t(k) + std::size_t(a)] = F[a];
+  }
+  const T B = c.B, fluid = T(1) - B;
+  for (int q = 0; q < Q; ++q) g[q] = fluid * g[q] + B * gpre[q] + sum[q];
+}
+
+template <class L, class T>
+void Psm<L, T>::reduce() {
+  std::fill(force_.begin(), force_.end(), Vec3::Zero());
+  std::fill(torque_.begin(), torque_.end(), Vec3::Zero());
+  for (std::size_t k = 0; k < entries_.size(); ++k) {
+    const Entry& e = entries_[k];
+    const Vec3 F(entry_force_[3 * k], entry_force_[3 * k + 1], entry_force_[3 * k + 2]);
+    force_[std::size_t(e.particle)] += F;
+    torque_[std::size_t(e.particle)] += e.arm.cross(F);
+  }
+}
+
+template <class L, class T>
+double Psm<L, T>::solid_fraction(CellIndex cell) const {
+  if (slot_.empty()) return 0;
+  const std::int32_t s = slot_[std::size_t(cell)];
+  return s < 0 ? 0.0 : std::min(1.0, cells_[std::size_t(s)].eps);
+}
+
+template <class L, class T>
+double Psm<L, T>::weight(CellIndex cell) const {
+  if (slot_.empty()) return 0;
+  const std::int32_t s = slot_[std::size_t(cell)];
+  return s < 0 ? 0.0 : double(cells_[std::size_t(s)].B);
+}
+
+template class Psm<D2Q9, double>;
+template class Psm<D2Q9, float>;
+template class Psm<D3Q19, double>;
+template class Psm<D3Q19, float>;
+
+}  // namespace ff::lbm

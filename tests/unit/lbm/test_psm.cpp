@@ -1,0 +1,338 @@
+// Partially saturated cells (lbm/psm.hpp; Noble & Torczynski 1998, Int. J. Mod. Phys. C 9:1189):
+// covered fractions against sub-cell sampling, action equals reaction in a closed periodic box,
+// Galilean invariance, thread-count independence, resume and the clearing of uncovered cells.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "core/error.hpp"
+#include "lbm/solver.hpp"
+
+using namespace ff;
+using namespace ff::lbm;
+
+namespace {
+
+// Reference covered fraction: the share of n^D sub-cell centres inside the particle.
+double sampled_fraction(int dim, const Vec3& d, double r, int n) {
+  long in = 0, all = 0;
+  for (int k = 0; k < (dim == 3 ? n : 1); ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const double px = d[0] - 0.5 + (i + 0.5) / n, py = d[1] - 0.5 + (j + 0.5) / n;
+        const double pz = dim == 3 ? d[2] - 0.5 + (k + 0.5) / n : 0.0;
+        in += px * px + py * py + pz * pz <= r * r;
+        ++all;
+      }
+  return double(in) / double(all);
+}
+
+struct FractionError {
+  double max_cell = 0, total_rel = 0;
+};
+
+FractionError fraction_error(int dim, const Vec3& X, double r) {
+  FractionError e;
+  double total = 0;
+  const int lo = int(std::floor(-r - 1)), hi = int(std::ceil(r + 1));
+  for (int z = (dim == 3 ? lo : 0); z <= (dim == 3 ? hi : 0); ++z)
+    for (int y = lo; y <= hi; ++y)
+      for (int x = lo; x <= hi; ++x) {
+        const Vec3 d(x - X[0], y - X[1], dim == 3 ? z - X[2] : 0.0);
+        const double eps = psm_cell_fraction(dim, d, r);
+        total += eps;
+        if (eps > 0 && eps < 1) e.max_cell = std::max(e.max_cell, std::abs(eps - sampled_fraction(dim, d, r, dim == 3 ? 32 : 64)));
+      }
+  const double exact = dim == 3 ? 4.0 / 3.0 * M_PI * r * r * r : M_PI * r * r;
+  e.total_rel = std::abs(total - exact) / exact;
+  return e;
+}
+
+// Total fluid momentum of the state before step t, from the populations alone (periodic box):
+// even t: g_q(x) in f[q][x]; odd t: in f[opp q][x - c_q], so the sum over the box is -sum c_p f[p].
+template <class L, class T>
+Vec3 fluid_momentum(const Solver<L, T>& s) {
+  const Grid& g = s.grid();
+  const auto& f = s.populations();
+  const CellIndex N = g.padded_size();
+  long double P[3] = {0, 0, 0};
+  for (int z = 0; z < g.nz; ++z)
+    for (int y = 0; y < g.ny; ++y)
+      for (int x = 0; x < g.nx; ++x)
+        for (int q = 1; q < L::Q; ++q)
+          for (int a = 0; a < L::D; ++a) P[a] += (long double)(L::c[q][a]) * f[q * N + g.index(x, y, z)];
+  const double sign = s.time_step() % 2 == 0 ? 1.0 : -1.0;
+  return sign * Vec3(double(P[0]), double(P[1]), double(P[2]));
+}
+
+template <class L>
+Solver<L, double> periodic_box(int nx, int ny, int nz, double tau, const Vec3& u0, bool walls_y = false) {
+  Grid g(L::D, nx, ny, nz, {true, !walls_y, true});
+  SolverSettings s;
+  s.tau = tau;
+  Solver<L, double> sol(g, s);
+  sol.finalize();
+  sol.initialize([&](int x, int y, int z, double& rho, Vec3& u) {
+    rho = 1.0;
+    u = u0;
+    if (walls_y) u += Vec3(0.01 * std::sin(0.3 * x + 0.2 * z), 0.005 * std::cos(0.2 * y), 0);
+  });
+  return sol;
+}
+
+// Three particles, two of them overlapping (bonded grains touch), moving and spinning.
+ParticleSet moving_set(int dim, double t) {
+  ParticleSet p;
+  p.resize(3);
+  const double r[3] = {5.3, 4.1, 3.2};
+  const Vec3 v[3] = {Vec3(0.02, 0.01, 0.005), Vec3(-0.01, 0.015, -0.01), Vec3(0.0, -0.02, 0.01)};
+  const Vec3 X0[3] = {Vec3(12.3, 14.7, 10.2), Vec3(20.1, 16.2, 11.6), Vec3(30.4, 8.9, 13.1)};
+  for (int s = 0; s < 3; ++s) {
+    p.id[s] = 1000000000000ull + std::uint64_t(s);
+    p.radius[s] = r[s];
+    p.velocity[s] = v[s];
+    p.position[s] = X0[s] + t * v[s];
+    p.omega[s] = Vec3(0.004 * s, -0.003, 0.005 * (s + 1));
+    if (dim == 2) p.position[s][2] = 0;
+  }
+  return p;
+}
+
+}  // namespace
+
+// Plane approximation against 64^2 (2D) / 32^3 (3D) sub-cell sampling: per cell and in total.
+// Tolerances are the measured errors rounded up (curvature of the surface within one cell).
+TEST(Psm, CoveredFractionAgainstSubCellSampling) {
+  for (double r : {3.0, 5.5, 10.25}) {
+    const FractionError e2 = fraction_error(2, Vec3(0.31, 0.77, 0), r);
+    std::printf("disk r = %.2f: max cell error %.4f, total %.2e\n", r, e2.max_cell, e2.total_rel);
+    EXPECT_LT(e2.max_cell, 0.02) << "disk r = " << r;
+    EXPECT_LT(e2.total_rel, 1e-3) << "disk r = " << r;
+  }
+  for (double r : {3.0, 4.6}) {
+    const FractionError e3 = fraction_error(3, Vec3(0.31, 0.77, 0.12), r);
+    std::printf("sphere r = %.2f: max cell error %.4f, total %.2e\n", r, e3.max_cell, e3.total_rel);
+    EXPECT_LT(e3.max_cell, 0.03) << "sphere r = " << r;
+    EXPECT_LT(e3.total_rel, 1e-3) << "sphere r = " << r;
+  }
+  // Exact cases: a cell cut in half by the plane x = 0 of a huge disk, a cell inside, outside.
+  EXPECT_NEAR(psm_cell_fraction(2, Vec3(1e6, 0, 0), 1e6), 0.5, 1e-6);
+  EXPECT_EQ(psm_cell_fraction(3, Vec3(1, 1, 1), 3.0), 1.0);
+  EXPECT_EQ(psm_cell_fraction(3, Vec3(4, 0, 0), 3.0), 0.0);
+  // Noble & Torczynski's weighting: B(0) = 0, B(1) = 1, B(eps) <= eps.
+  EXPECT_EQ(psm_weight(0, 0.8), 0.0);
+  EXPECT_EQ(psm_weight(1, 0.8), 1.0);
+  EXPECT_NEAR(psm_weight(0.5, 1.0), 0.25, 1e-15);  // 0.5 * 0.5 / (0.5 + 0.5)
+}
+
+// Overlapping particles: the cell's fraction is capped at one and split by eps; moving the set
+// clears the cells it left (no stale coverage).
+TEST(Psm, OverlapAndClearing) {
+  auto sol = periodic_box<D2Q9>(48, 32, 1, 0.8, Vec3::Zero());
+  ParticleSet p;
+  p.resize(2);
+  p.radius = {4.0, 4.0};
+  p.position = {Vec3(10, 10, 0), Vec3(15, 10, 0)};  // overlap by 3 cells
+  sol.set_particles(p);
+  const Grid& g = sol.grid();
+  EXPECT_DOUBLE_EQ(sol.psm()->solid_fraction(g.index(12, 10, 0)), 1.0);  // covered by both
+  EXPECT_DOUBLE_EQ(sol.psm()->weight(g.index(12, 10, 0)), 1.0);
+  const std::size_t before = sol.psm()->num_cells();
+  p.position = {Vec3(30, 20, 0), Vec3(40, 20, 0)};
+  sol.set_particles(p);
+  EXPECT_EQ(sol.psm()->solid_fraction(g.index(10, 10, 0)), 0.0);
+  EXPECT_EQ(sol.psm()->weight(g.index(12, 10, 0)), 0.0);
+  EXPECT_GT(sol.psm()->num_cells(), before);  // two separate disks cover more cells
+  // Bad input names the particle.
+  p.radius[1] = -1;
+  EXPECT_THROW(sol.set_particles(p), InputError);
+}
+
+// Action equals reaction: in a closed periodic box without body force the fluid's momentum
+// changes only through the solid term, so dP_fluid = -sum_s F_s every step. Tolerance: 1e-12
+// relative to the summed force magnitude (round-off of the double-precision update; measured
+// below 1e-13).
+template <class L>
+void check_action_reaction(int nz) {
+  auto sol = periodic_box<L>(40, 28, nz, 0.7, Vec3::Zero());
+  double worst = 0;
+  for (int t = 0; t < 60; ++t) {
+    sol.set_particles(moving_set(L::D, double(t)));
+    const Vec3 P0 = fluid_momentum(sol);
+    sol.step();
+    const Vec3 P1 = fluid_momentum(sol);
+    Vec3 F = Vec3::Zero();
+    double mag = 0;
+    for (const Vec3& f : sol.particle_forces()) {
+      F += f;
+      mag += f.norm();
+    }
+    ASSERT_GT(mag, 0);
+    worst = std::max(worst, (P1 - P0 + F).norm() / mag);
+  }
+  EXPECT_LT(worst, 1e-12) << L::name;
+  std::printf("%s: max |dP + sum F| / sum |F| = %.2e\n", std::string(L::name).c_str(), worst);
+}
+
+TEST(Psm, ActionEqualsReaction2D) { check_action_reaction<D2Q9>(1); }
+TEST(Psm, ActionEqualsReaction3D) { check_action_reaction<D3Q19>(24); }
+
+// Galilean invariance: a particle moving with a uniform flow feels no force (the fluid is at
+// equilibrium with u = u_s in every covered cell). Bound: 1e-12 of the Stokes-like scale
+// 6 pi nu a |U| (round-off).
+template <class L>
+void check_comoving(int nz) {
+  const Vec3 U = L::D == 3 ? Vec3(0.03, -0.02, 0.01) : Vec3(0.03, -0.02, 0);
+  auto sol = periodic_box<L>(32, 30, nz, 0.9, U);
+  ParticleSet p;
+  p.resize(1);
+  p.radius[0] = 5.7;
+  p.velocity[0] = U;
+  const double scale = 6 * M_PI * (0.4 / 3) * 5.7 * U.norm();
+  double worst = 0;
+  for (int t = 0; t < 40; ++t) {
+    p.position[0] = Vec3(10.2, 11.9, L::D == 3 ? 12.4 : 0) + double(t) * U;
+    sol.set_particles(p);
+    sol.step();
+    worst = std::max(worst, sol.particle_forces()[0].norm() / scale);
+    worst = std::max(worst, sol.particle_torques()[0].norm() / (scale * 5.7));
+  }
+  EXPECT_LT(worst, 1e-12) << L::name;
+  std::printf("%s: comoving |F| / (6 pi mu a U) = %.2e\n", std::string(L::name).c_str(), worst);
+}
+
+TEST(Psm, ComovingParticleFeelsNoForce2D) { check_comoving<D2Q9>(1); }
+TEST(Psm, ComovingParticleFeelsNoForce3D) { check_comoving<D3Q19>(20); }
+
+// The boundary-cell path: a disk overlapping a wall (cells next to it are boundary cells), both
+// walls and the fluid moving with the disk's velocity: uniform flow stays exact, no force.
+TEST(Psm, ComovingParticleAtAMovingWall) {
+  const Vec3 U(0.03, 0, 0);
+  Grid g(2, 40, 24, 1, {true, false, true});
+  SolverSettings st;
+  st.tau = 0.8;
+  Solver<D2Q9, double> sol(g, st);
+  FaceCondition wall;
+  wall.kind = FaceCondition::Kind::Wall;
+  wall.velocity = U;
+  sol.set_face(2, wall);
+  sol.set_face(3, wall);
+  sol.finalize();
+  sol.initialize([&](int, int, int, double& rho, Vec3& u) {
+    rho = 1;
+    u = U;
+  });
+  ParticleSet p;
+  p.resize(1);
+  p.radius[0] = 4.3;
+  p.velocity[0] = U;
+  double worst = 0;
+  for (int t = 0; t < 30; ++t) {
+    p.position[0] = Vec3(10.2 + t * U[0], 1.4, 0);
+    sol.set_particles(p);
+    sol.step();
+    worst = std::max(worst, sol.particle_forces()[0].norm() / (6 * M_PI * (0.3 / 3) * 4.3 * U.norm()));
+  }
+  EXPECT_LT(worst, 1e-12);
+  std::printf("comoving at a wall: |F| / (6 pi mu a U) = %.2e\n", worst);
+}
+
+// The boundary-cell path with a disk fixed on a resting wall in a channel driven by a body force:
+// (1) the fluid in fully covered cells next to the wall follows the disk (u = 0 to 1e-3 of the
+// channel's peak speed, as in covered bulk cells), (2) momentum balance of every step,
+// P(t+1) - P(t) = f_body sum(1 - B) - sum F_particle(t) - F_walls(t+1), from the sampled moments
+// (tolerance 1e-10 of the step's momentum flux scale).
+TEST(Psm, BoundaryCellsAtARestingWall) {
+  Grid g(2, 48, 24, 1, {true, false, true});
+  SolverSettings st;
+  st.tau = 0.8;
+  const double fx = 1e-5;
+  st.body_force = Vec3(fx, 0, 0);
+  Solver<D2Q9, double> sol(g, st);
+  sol.finalize();
+  sol.initialize([&](int, int, int, double& rho, Vec3& u) {
+    rho = 1;
+    u = Vec3::Zero();
+  });
+  ParticleSet p;
+  p.resize(1);
+  p.radius[0] = 4.3;
+  p.position[0] = Vec3(20.2, 1.4, 0);
+  sol.set_particles(p);
+  auto momentum = [&]() {
+    long double P[2] = {0, 0};
+    for (int y = 0; y < g.ny; ++y)
+      for (int x = 0; x < g.nx; ++x)
+        for (int a = 0; a < 2; ++a) P[a] += (long double)(sol.density(x, y, 0)) * sol.velocity(x, y, 0)[a];
+    return Vec3(double(P[0]), double(P[1]), 0);
+  };
+  // Guo: the sampled velocity carries half the force; subtract it to get sum c g.
+  double body = 0;  // sum over cells of (1 - B): the fluid fraction the body force acts on
+  for (int y = 0; y < g.ny; ++y)
+    for (int x = 0; x < g.nx; ++x) body += 1 - sol.psm()->weight(g.index(x, y, 0));
+  double worst = 0, umax = 0;
+  sol.step(true);
+  Vec3 P0 = momentum() - Vec3(0.5 * fx * g.nx * g.ny, 0, 0);
+  Vec3 Fp = sol.particle_forces()[0];
+  for (int t = 1; t < 400; ++t) {
+    sol.step(true);
+    const Vec3 P1 = momentum() - Vec3(0.5 * fx * g.nx * g.ny, 0, 0);
+    const Vec3 Fw = sol.objects()[2].force + sol.objects()[3].force;
+    const Vec3 r = P1 - P0 - Vec3(fx * body, 0, 0) + Fp + Fw;
+    worst = std::max(worst, r.norm() / (fx * g.nx * g.ny));
+    P0 = P1;
+    Fp = sol.particle_forces()[0];
+  }
+  for (int y = 0; y < g.ny; ++y) umax = std::max(umax, sol.velocity(40, y, 0)[0]);
+  const double u_covered = sol.velocity(20, 0, 0).norm();  // eps = 1, next to the wall
+  ASSERT_EQ(sol.psm()->solid_fraction(g.index(20, 0, 0)), 1.0);
+  std::printf("disk on a wall: |u| in a covered wall cell / u_max = %.2e, momentum balance %.2e\n", u_covered / umax,
+              worst);
+  EXPECT_LT(u_covered, 1e-3 * umax);
+  EXPECT_LT(worst, 1e-10);
+}
+
+// 1 and 2 threads give identical populations and forces, with particles touching the walls (the
+// boundary-cell path) and enough cells for the parallel sweeps and PSM passes; a run resumed from the
+// populations at step 10 (particles set again) continues bit-for-bit.
+TEST(Psm, ThreadsAndResumeBitIdentical) {
+  auto run = [](int threads, int steps, Solver<D2Q9, double>* from) {
+    omp_set_num_threads(threads);
+    auto sol = periodic_box<D2Q9>(180, 120, 1, 0.7, Vec3::Zero(), true);
+    if (from) sol.restore(std::vector<double>(from->populations().begin(), from->populations().end()), from->time_step());
+    ParticleSet p;
+    p.resize(40);
+    for (int s = 0; s < 40; ++s) {
+      p.radius[s] = 6.5 + 0.1 * (s % 7);  // neighbours overlap; > 4096 covered cells: parallel PSM passes
+      p.velocity[s] = Vec3(0.01 * std::sin(s), 0.01 * std::cos(s), 0);
+      p.omega[s] = Vec3(0, 0, 0.002 * (s % 3 - 1));
+    }
+    for (long t = sol.time_step(); t < steps; ++t) {
+      for (int s = 0; s < 40; ++s)
+        p.position[s] = Vec3(9.0 * (s % 20) + 3.1, s < 20 ? 3.2 : 60.3, 0) + double(t) * p.velocity[s];
+      sol.set_particles(p);
+      sol.step();
+    }
+    return sol;
+  };
+  const int saved = omp_get_max_threads();
+  auto a = run(1, 30, nullptr);
+  auto b = run(2, 30, nullptr);
+  auto half = run(1, 10, nullptr);
+  auto c = run(2, 30, &half);
+  omp_set_num_threads(saved);
+  ASSERT_EQ(a.populations().size(), b.populations().size());
+  for (std::size_t i = 0; i < a.populations().size(); ++i) {
+    ASSERT_EQ(a.populations()[i], b.populations()[i]) << "threads, slot " << i;
+    ASSERT_EQ(a.populations()[i], c.populations()[i]) << "resume, slot " << i;
+  }
+  for (std::size_t s = 0; s < a.particle_forces().size(); ++s) {
+    EXPECT_EQ(a.particle_forces()[s], b.particle_forces()[s]);
+    EXPECT_EQ(a.particle_torques()[s], c.particle_torques()[s]);
+  }
+  EXPECT_GT(a.psm()->num_cells(), 4096u);
+}
