@@ -58,38 +58,42 @@ output.plots = false
 
 using ff::test::run_program;
 
+// Writes `text` to s.path/file and runs it twice through the program: whole, and cut by
+// --max-steps (no summary yet). Returns the cut run's output.
+std::string run_whole_and_cut(const ff::test::TestScratch& s, const std::string& file, const char* text,
+                              long max_steps, const fs::path& whole, const fs::path& cut) {
+  const fs::path scen = s.path / file;
+  std::ofstream(scen) << text;
+  auto r = run_program("run " + scen.string() + " --out " + whole.string() + " --quiet");
+  EXPECT_EQ(r.code, 0) << r.output;
+  r = run_program("run " + scen.string() + " --out " + cut.string() + " --quiet --max-steps " + std::to_string(max_steps));
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_FALSE(fs::exists(cut / "summary.json")) << "stopped before the end";
+  return r.output;
+}
+
 }  // namespace
 
 TEST(FlowCli, ADuctRunResumesFromItsSavedScenario) {
   const ff::test::TestScratch s("flowcli");
-  const fs::path scen = s.path / "duct.toml";
-  std::ofstream(scen) << kDuct;
   const fs::path whole = s.path / "whole", cut = s.path / "cut";
-  auto r = run_program("run " + scen.string() + " --out " + whole.string() + " --quiet");
-  ASSERT_EQ(r.code, 0) << r.output;
-  r = run_program("run " + scen.string() + " --out " + cut.string() + " --quiet --max-steps 250");
-  ASSERT_EQ(r.code, 0) << r.output;
-  EXPECT_FALSE(fs::exists(cut / "summary.json")) << "stopped before the end";
+  run_whole_and_cut(s, "duct.toml", kDuct, 250, whole, cut);
+  ASSERT_FALSE(::testing::Test::HasFailure());
   EXPECT_NE(ff::test::read_bytes(cut / "scenario.toml").find("# (default, not set) lbm.depth_cells"), std::string::npos);
-  r = run_program("resume " + cut.string() + " --quiet");
+  const auto r = run_program("resume " + cut.string() + " --quiet");
   ASSERT_EQ(r.code, 0) << r.output;
   ff::test::expect_same_results(whole, cut, "duct interrupted by --max-steps 250 and resumed through the program");
 }
 
 TEST(FlowCli, MaxStepsStopsAndATimeStepRunResumesBitForBit) {
   const ff::test::TestScratch s("flowcli");
-  const fs::path scen = s.path / "cyl.toml";
-  std::ofstream(scen) << kCylinder;
   const fs::path whole = s.path / "whole", cut = s.path / "cut";
-  auto r = run_program("run " + scen.string() + " --out " + whole.string() + " --quiet");
-  ASSERT_EQ(r.code, 0) << r.output;
-  r = run_program("run " + scen.string() + " --out " + cut.string() + " --quiet --max-steps 2345");
-  ASSERT_EQ(r.code, 0) << r.output;
-  EXPECT_NE(r.output.find("--max-steps 2345"), std::string::npos) << r.output;
-  EXPECT_FALSE(fs::exists(cut / "summary.json")) << "stopped before the end";
+  const std::string out = run_whole_and_cut(s, "cyl.toml", kCylinder, 2345, whole, cut);
+  ASSERT_FALSE(::testing::Test::HasFailure());
+  EXPECT_NE(out.find("--max-steps 2345"), std::string::npos) << out;
   // Resumed with a --max-steps it has already passed: stops at once, nothing advances.
   const std::string before = ff::test::read_bytes(cut / "series.csv");
-  r = run_program("resume " + cut.string() + " --quiet --max-steps 1000");
+  auto r = run_program("resume " + cut.string() + " --quiet --max-steps 1000");
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_EQ(ff::test::read_bytes(cut / "series.csv"), before);
   // The saved scenario holds lbm.time_step and lbm.tau's default as a comment: resume accepts it.

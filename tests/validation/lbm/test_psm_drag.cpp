@@ -19,6 +19,21 @@ using namespace ff::lbm;
 
 namespace {
 
+// A D3Q19 periodic box of n^3 cells, fluid at rest, relaxation time tau, body force gx along x.
+Solver<D3Q19, double> periodic_box_at_rest(int n, double tau, double gx) {
+  Grid g(3, n, n, n, {true, true, true});
+  SolverSettings s;
+  s.tau = tau;
+  s.body_force = Vec3(gx, 0, 0);
+  Solver<D3Q19, double> sol(g, s);
+  sol.finalize();
+  sol.initialize([](int, int, int, double& rho, Vec3& u) {
+    rho = 1;
+    u = Vec3::Zero();
+  });
+  return sol;
+}
+
 struct DragResult {
   double K = 0;     // Zick & Homsy's drag coefficient
   double U = 0;     // superficial velocity
@@ -28,21 +43,11 @@ struct DragResult {
 // One sphere of solid fraction phi in a periodic box of n^3 cells, body force along x; runs until
 // U changes by less than 1e-5 (relative) over 200 steps.
 DragResult zick_homsy_case(int n, double phi, double tau) {
-  Grid g(3, n, n, n, {true, true, true});
-  SolverSettings s;
-  s.tau = tau;
   const double nu = (tau - 0.5) / 3;
   const double a = std::cbrt(3 * phi / (4 * M_PI)) * n;
   // Stokes flow: U grows like n^2 at a fixed force, so the force falls like n^-3 (Reynolds number
   // 2 a U / nu below 0.25 for every case here).
-  const double gx = 1e-6 * std::pow(24.0 / n, 3);
-  s.body_force = Vec3(gx, 0, 0);
-  Solver<D3Q19, double> sol(g, s);
-  sol.finalize();
-  sol.initialize([](int, int, int, double& rho, Vec3& u) {
-    rho = 1;
-    u = Vec3::Zero();
-  });
+  auto sol = periodic_box_at_rest(n, tau, 1e-6 * std::pow(24.0 / n, 3));
   ParticleSet p;
   p.resize(1);
   p.radius[0] = a;
@@ -83,16 +88,8 @@ struct TorqueResult {
 };
 
 TorqueResult rotating_torque(int n, double a, double tau) {
-  Grid g(3, n, n, n, {true, true, true});
-  SolverSettings s;
-  s.tau = tau;
   const double nu = (tau - 0.5) / 3;
-  Solver<D3Q19, double> sol(g, s);
-  sol.finalize();
-  sol.initialize([](int, int, int, double& rho, Vec3& u) {
-    rho = 1;
-    u = Vec3::Zero();
-  });
+  auto sol = periodic_box_at_rest(n, tau, 0.0);
   const double Omega = 1e-3;
   ParticleSet p;
   p.resize(1);
