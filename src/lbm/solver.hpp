@@ -138,7 +138,7 @@ class Solver {
 
   // ---- moving particles as partially saturated cells (lbm/psm.hpp), set before each step(); the
   // covered cells' update then uses this set until the next call. Forces and torques of the
-  // last step on each particle (lattice units, indexed like the set; Units::to_si_force).
+  // last step on each particle (lattice units, indexed like the set; Units::to_si_force and to_si_torque).
   void set_particles(const ParticleSet& p);
   const std::vector<Vec3>& particle_forces() const;
   const std::vector<Vec3>& particle_torques() const;

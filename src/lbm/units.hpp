@@ -73,6 +73,8 @@ class Units {
   double to_si_density_offset(double p) const { return 3.0 * p / pressure_factor(); }  // Pa -> rho_lb - 1
   // Force on a solid: N on a 3D lattice; on a 2D lattice N per metre of depth.
   double to_si_force(double f, int dim) const { return dim == 3 ? f * force_factor() * dx_ : f * force_factor(); }
+  // Torque (force times a lattice lever arm): N m on a 3D lattice; N m per metre of depth (N) in 2D.
+  double to_si_torque(double t, int dim) const { return to_si_force(t, dim) * dx_; }
 
   // Mach number and relaxation-time checks for a characteristic speed u [m/s] (METHODS §4.2:
   // tau > 1/2 needed, tau - 1/2 >= 0.01 advisable; Ma = u_lb / c_s below 0.1 advisable, above

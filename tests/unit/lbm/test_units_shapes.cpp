@@ -27,6 +27,9 @@ TEST(LbmUnits, ConversionFactors) {
   const double G = 3.0, cells = 40;
   EXPECT_NEAR(u.to_si_force(u.to_lattice_force_density(G) * cells, 2), G * cells * 1e-8, 1e-20);
   EXPECT_NEAR(u.to_si_force(u.to_lattice_force_density(G) * cells, 3), G * cells * 1e-12, 1e-24);
+  // That force on a lever arm of 7 cells (7e-4 m) is a torque of F * 7e-4.
+  EXPECT_NEAR(u.to_si_torque(u.to_lattice_force_density(G) * cells * 7, 2), G * cells * 1e-8 * 7e-4, 1e-24);
+  EXPECT_NEAR(u.to_si_torque(u.to_lattice_force_density(G) * cells * 7, 3), G * cells * 1e-12 * 7e-4, 1e-28);
   // The other way round: from the time step.
   const Units v = Units::from_time_step(1e-4, u.dt(), 1e-6, 1000);
   EXPECT_NEAR(v.tau(), 0.8, 1e-12);
