@@ -10,7 +10,6 @@
 // for vortex shedding the extremes of Cd and Cl and Delta p half a period after the maximum lift.
 #include <fmt/format.h>
 
-
 #include <cmath>
 
 #include "core/error.hpp"

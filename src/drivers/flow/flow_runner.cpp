@@ -396,10 +396,7 @@ RunStatus Runner<L, T>::run() {
   const long steady_window =
       std::max(kSteadyMinSamples, std::lround(periods * acoustic_period / double(sample_every)));
 
-  // Names end in their SI unit (time_s, ..._Pa, ..._m_per_s); dimensionless ones have none.
-  std::vector<std::string> columns = {"step", "time_s"};
-  for (auto& c : fc_.columns()) columns.push_back(c);
-  probes_.columns(columns);
+  const std::vector<std::string> columns = series_columns(cfg_, fc_, probes_);
   ncols_ = columns.size();
   history_.reserve(std::size_t(n_samples) * ncols_);
   CsvWriter series;

@@ -22,21 +22,7 @@ void validate_flow(const Config& cfg, const FlowCase& fc) {
   if (!chk.error.empty()) cfg.fail(fu.key(), chk.error);
   const int nz = d3 ? int(cfg.integer("lbm.depth_cells")) : 1;
   const ProbeSet probes = read_probes(cfg, d3, nz * fc.cell_size());
-  // A probe column must not repeat one of the case's (e.g. probes "front" and "back" with
-  // probes.delta_p give dp_front_back_Pa, which flow/cylinder writes itself).
-  {
-    std::vector<std::string> cols = {"step", "time_s"};
-    for (auto& c : fc.columns()) cols.push_back(c);
-    const std::size_t own = cols.size();
-    Probes(probes, fc.cell_size()).columns(cols);
-    for (std::size_t i = own; i < cols.size(); ++i)
-      for (std::size_t j = 0; j < i; ++j)
-        if (cols[i] == cols[j])
-          cfg.fail(j < own ? "probes.names" : "probes.delta_p",
-                   fmt::format("the probe column '{}' repeats a column {} already writes to series.csv: rename the "
-                               "probe(s) in probes.names",
-                               cols[i], j < own ? "the driver" : "another probe"));
-  }
+  series_columns(cfg, fc, Probes(probes, fc.cell_size()));  // refuses probe columns that repeat the case's
   if (!probes.empty()) {
     // The lattice's extent and solids from the case's domain (no solver is built). domain()
     // only caches the units in the case, which run() sets again.

@@ -253,4 +253,18 @@ void Probes::measure(const FlowSample& s, std::vector<double>& row) {
   }
 }
 
+std::vector<std::string> series_columns(const Config& cfg, const FlowCase& fc, const Probes& probes) {
+  // Names end in their SI unit (time_s, ..._Pa, ..._m_per_s); dimensionless ones have none.
+  std::vector<std::string> cols = {"step", "time_s"};
+  for (auto& c : fc.columns()) cols.push_back(c);
+  const std::size_t own = cols.size();
+  probes.columns(cols);
+  for (std::size_t i = own; i < cols.size(); ++i)
+    if (std::find(cols.begin(), cols.begin() + std::ptrdiff_t(own), cols[i]) != cols.begin() + std::ptrdiff_t(own))
+      cfg.fail("probes.names", fmt::format("the probe column '{}' repeats a column the driver already writes to "
+                                           "series.csv: rename the probe(s) in probes.names",
+                                           cols[i]));
+  return cols;
+}
+
 }  // namespace ff::drivers

@@ -78,4 +78,10 @@ class Probes {
   std::vector<ProbeStencil> stencils_;
 };
 
+class FlowCase;
+// The columns of series.csv: "step", "time_s", the case's, then the probes'. Throws InputError
+// naming probes.names when a probe column repeats one of the case's (probes "front" and "back"
+// with probes.delta_p give dp_front_back_Pa, which flow/cylinder writes itself).
+std::vector<std::string> series_columns(const Config& cfg, const FlowCase& fc, const Probes& probes);
+
 }  // namespace ff::drivers
