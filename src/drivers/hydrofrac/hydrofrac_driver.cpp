@@ -1,0 +1,846 @@
+// The hydraulic-fracturing driver: stages, time loop, outputs (docs/hydrofrac.md).
+//   set-up     sample (sample builder) -> borehole and perforations carved -> DFN bonds cut ->
+//              servo walls on every face (x: sigma_H, y: sigma_h, 3D z: sigma_v) -> time step
+//   stage 0    the walls servo to the in-situ stresses until they hold within insitu.tolerance
+//              and the unbalanced-force ratio is below it (checked every series row)
+//   stage 1    injection: the fluid (fluid_load.hpp) pressurises the hole; the walls keep
+//              servoing to the in-situ stresses; stop at injection.stop_extent, max_pressure,
+//              max_time or (rate mode) when the pressure fell below stop_fraction of its peak.
+// The loop mirrors DemRun's (dem_run_loop.cpp): checkpoint/resume bit for bit, --max-steps,
+// --max-wall, signals, cracks.csv and the VTK series; its curve is pressure against time.
+#include "drivers/hydrofrac/hydrofrac_driver.hpp"
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iterator>
+#include <memory>
+
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "core/progress.hpp"
+#include "dem/dem_checkpoint.hpp"
+#include "dem/dem_output.hpp"
+#include "dem/dem_params.hpp"
+#include "dem/diagnostics.hpp"
+#include "dem/membrane/flexible_membrane.hpp"
+#include "dem/sample_builder.hpp"
+#include "drivers/dem_results.hpp"
+#include "drivers/hydrofrac/borehole.hpp"
+#include "drivers/hydrofrac/dfn.hpp"
+#include "drivers/hydrofrac/kirsch.hpp"
+#include "drivers/hydrofrac/sleeve_load.hpp"
+#include "drivers/run_control.hpp"
+#include "drivers/run_estimate.hpp"
+#include "drivers/run_record.hpp"
+#include "fracflow/version.hpp"
+#include "io/csv.hpp"
+#include "io/json_out.hpp"
+#include "io/plot.hpp"
+
+namespace fs = std::filesystem;
+
+namespace ff::drivers {
+namespace {
+
+using hydrofrac::BoreholeGeometry;
+using hydrofrac::CircleStress;
+
+void declare(ParamTable& t) {
+  dem::declare_dem_params(t);
+  dem::declare_sample_params(t);
+  hydrofrac::declare_dfn_params(t);
+  t.real("borehole.radius", 3e-3, "m", "borehole radius: particles whose centres lie closer to the block's centre axis are removed")
+      .positive();
+  t.real("borehole.perforation_length", 0, "m", "length of each perforation slot beyond the wall (0: none)").non_negative();
+  t.real("borehole.perforation_width", 0, "m", "width of the perforation slots (0: 2 sample.radius_max)").non_negative();
+  t.real("borehole.perforation_azimuth", 0, "deg", "direction of the perforation from x (the sigma_H direction)");
+  t.integer("borehole.perforation_sides", 2, "-", "1: one slot; 2: two opposite slots").range(1, 2);
+  t.real("insitu.sigma_H", 5e6, "Pa", "maximum horizontal stress, applied along x by servo walls (compression > 0)").positive();
+  t.real("insitu.sigma_h", 5e6, "Pa", "minimum horizontal stress, along y").positive();
+  t.real("insitu.sigma_v", 5e6, "Pa", "vertical stress along z (3D only)").positive();
+  t.real("insitu.tolerance", 0.02, "-",
+         "equilibrium before injection: every wall stress within this fraction of its target and the unbalanced-force "
+         "ratio below it")
+      .positive();
+  t.integer("insitu.max_steps", 100000, "steps", "cap of the in-situ stage (a warning when equilibrium is not reached)").positive();
+  t.real("insitu.servo_velocity", 0.5, "m/s", "speed cap of the wall servos").positive();
+  t.real("insitu.servo_relaxation", 0.5, "-", "servo relaxation factor alpha (PFC default 0.8)").open_range(0, 1).at_most(1);
+  t.string("injection.fluid", "sleeve",
+           "fluid model: sleeve (pressure on the hole's wall particles, and on connected crack faces with penetration); "
+           "lbm (lattice Boltzmann coupling: not available yet)")
+      .one_of({"sleeve", "lbm"});
+  t.string("injection.mode", "ramp", "ramp: pressure rises at injection.ramp_rate; rate: pumped at injection.rate into a compressible borehole")
+      .one_of({"ramp", "rate"});
+  t.real("injection.ramp_rate", 1e10, "Pa/s", "pressure rise rate (ramp mode)").positive();
+  t.real("injection.initial_pressure", 0, "Pa", "borehole pressure when injection starts").non_negative();
+  t.real("injection.rate", 1e-3, "m^3/s", "pumped volume rate (rate mode; 2D: per metre of thickness)").positive();
+  t.real("injection.fluid_bulk_modulus", 2.2e9, "Pa", "fluid bulk modulus K_f (water 2.2e9): dp/dt = K_f/V (Q - dV/dt)").positive();
+  t.boolean("injection.penetration", false,
+            "fluid enters cracks connected to the hole (pressure on their faces); false: sleeve test, the wall only");
+  t.integer("injection.update_interval", 20, "steps", "steps between searches for cracks newly connected to the hole").positive();
+  t.real("injection.breakdown_length", 0, "m",
+         "ramp mode: breakdown = pressure when the connected fracture first reaches this far beyond the hole's wall (0: one "
+         "borehole radius)")
+      .non_negative();
+  t.real("injection.peak_drop", 0.05, "-", "rate mode: breakdown = the first pressure peak followed by a drop of this fraction")
+      .open_range(0, 1);
+  t.real("injection.stop_fraction", 0.5, "-", "rate mode: stop when the pressure fell below this fraction of its peak").open_range(0, 1);
+  t.real("injection.stop_extent", 0.8, "-",
+         "stop when the connected fracture reaches this fraction of the distance from the hole's wall to the nearest block face")
+      .open_range(0, 1)
+      .at_most(1);
+  t.real("injection.max_pressure", 500e6, "Pa", "stop at this borehole pressure in any case").positive();
+  t.real("injection.max_time", 0.05, "s", "stop after this injection time in any case").positive();
+  t.real_list("measure.radii", {1.8, 2.5, 3.5}, "-",
+              "distances of the measurement circles (spheres) from the hole's axis, in borehole radii (Kirsch comparison)")
+      .positive();
+  t.real_list("measure.angles", {0, 45, 90}, "deg", "azimuths of the measurement circles from x (sigma_H)");
+  t.real("measure.circle_radius", 0.4, "-", "radius of each measurement circle (sphere), in borehole radii").positive();
+  t.real("measure.pressure", 0, "Pa",
+         "a second elastic-state snapshot when the borehole pressure first reaches this (0: only the in-situ snapshot)")
+      .non_negative();
+  t.integer("hydrofrac.series_interval", 100, "steps", "steps between rows of series.csv (and stage checks)").positive();
+  t.integer("hydrofrac.vtk_interval", 0, "steps",
+            "steps between VTK snapshots during injection (0: at the start of injection, at breakdown and at the end)")
+      .non_negative();
+  t.integer("hydrofrac.checkpoint_interval", 0, "steps",
+            "steps between extra checkpoints (0: by wall clock only, output.checkpoint_wall_interval, and at the end)")
+      .non_negative();
+}
+
+// Geometry of the block from the sample keys: 2D box (x: width, y: height), 3D box (x: width,
+// y: depth, z: height); the borehole on the axis through the middle (3D: along z).
+struct Block {
+  Real lx = 0, ly = 0, lz = 0;
+  Vec3 centre = Vec3::Zero();
+};
+Block block_of(const Config& cfg) {
+  Block b;
+  const int dim = static_cast<int>(cfg.integer("dem.dim"));
+  b.lx = cfg.real("sample.width");
+  b.ly = dim == 3 ? cfg.real("sample.depth") : cfg.real("sample.height");
+  b.lz = dim == 3 ? cfg.real("sample.height") : 0;
+  b.centre = Vec3(0.5 * b.lx, 0.5 * b.ly, 0);
+  return b;
+}
+
+void validate(const Config& cfg) {
+  dem::validate_dem_sample(cfg);
+  if (cfg.string("sample.shape") != "box")
+    cfg.fail("sample.shape", "the hydrofrac block is a box: shape = \"box\" (2D rectangle in x-y; 3D box with the borehole along z)");
+  if (cfg.string("injection.fluid") == "lbm")
+    cfg.fail("injection.fluid", "the lattice Boltzmann fluid (\"lbm\") is not available in this build yet; use \"sleeve\"");
+  const Block b = block_of(cfg);
+  const Real R = cfg.real("borehole.radius"), rmax = cfg.real("sample.radius_max");
+  const Real lmin = std::min(b.lx, b.ly);
+  if (R < 2 * rmax)
+    cfg.fail("borehole.radius", fmt::format("{} m is below 2 sample.radius_max ({} m): the hole must be several grains wide", R, 2 * rmax));
+  const Real reach = R + cfg.real("borehole.perforation_length");
+  if (reach > 0.35 * lmin)
+    cfg.fail(cfg.real("borehole.perforation_length") > 0 ? "borehole.perforation_length" : "borehole.radius",
+             fmt::format("the hole and its perforations reach {} m from the axis; keep that below 0.35 x the block's smaller "
+                         "side ({} m) so that the block is much larger than the hole",
+                         reach, lmin));
+  const Real rho = cfg.real("measure.circle_radius");
+  for (double r : cfg.real_list("measure.radii")) {
+    if ((r - rho) * R < R + rmax)
+      cfg.fail("measure.radii", fmt::format("a circle at {} borehole radii with measure.circle_radius = {} reaches within "
+                                            "sample.radius_max of the wall; use radii >= {:.3g}",
+                                            r, rho, 1 + rho + rmax / R));
+    if ((r + rho) * R > 0.5 * lmin)
+      cfg.fail("measure.radii", fmt::format("a circle at {} borehole radii (circle radius {} radii) leaves the block's inner "
+                                            "half-width {} m; use smaller radii",
+                                            r, rho, 0.5 * lmin));
+  }
+  if (cfg.integer("dem.dim") == 3 && cfg.real("sample.height") < 4 * rmax)
+    cfg.fail("sample.height", "the 3D block must be at least 4 sample.radius_max high");
+  if (!cfg.string("dfn.file").empty() || cfg.integer("dfn.count") > 0) {
+    const int dim = static_cast<int>(cfg.integer("dem.dim"));
+    hydrofrac::make_joints(cfg, Vec3::Zero(), Vec3(b.lx, b.ly, b.lz), b.centre, R, dim);
+  }
+}
+
+const std::vector<std::string> kColumns = {
+    "step", "time_s", "stage", "pressure_Pa", "injected_volume_m3", "borehole_volume_m3", "sigma_xx_wall_Pa",
+    "sigma_yy_wall_Pa", "sigma_zz_wall_Pa", "cracks_tensile", "cracks_shear", "cracks_total", "cracks_connected",
+    "wetted_cracks", "fracture_length_m", "fracture_extent_m", "fracture_azimuth_deg", "kinetic_energy_J",
+    "unbalanced_force_ratio"};
+
+// The loop's state (raw bytes in the checkpoint: its layout is the format).
+struct HfState {
+  long rows = 0, cracks_written = 0, vtk_index = 0, stage = 0, finished = 0;
+  long insitu_steps = 0, injection_step = 0, equilibrium = 0;
+  long breakdown_found = 0, breakdown_row = 0, probe_taken = 0, initiation_found = 0;
+  Real breakdown_pressure = 0, breakdown_time = 0, peak_pressure = 0, peak_time = 0;
+  Real initiation_pressure = 0, effective_radius = 0, probe_pressure_actual = 0;
+  long breakdown_cracks = 0, peak_cracks = 0;
+  Real last_vtk_time = 0;
+};
+
+// One measurement circle with Kirsch's prediction (compression positive), a checkpoint record.
+struct CircleRecord {
+  Real r_over_a = 0, angle_deg = 0, x = 0, y = 0, radius = 0, porosity = 0;
+  long particles = 0, far = 0;  // far: one of the four interior-stress circles
+  Real xx = 0, yy = 0, xy = 0, zz = 0, k_xx = 0, k_yy = 0, k_xy = 0, pressure = 0;
+};
+
+struct HoleRecord {  // BoreholeGeometry
+  Real cx = 0, cy = 0, radius = 0, plen = 0, pwid = 0, paz = 0, z_lo = 0, z_hi = 0;
+  long sides = 2, dim = 2;
+};
+
+}  // namespace
+}  // namespace ff::drivers
+
+namespace ff::drivers {
+namespace {
+
+class HydrofracRun {
+ public:
+  HydrofracRun(const Config& c, const RunOptions& o) : cfg(c), opt(o), control_(c, o) {
+    sys.settings = dem::build_settings(cfg);
+    sys.materials = dem::build_materials(cfg);
+    cp_dir_ = opt.out_dir / "checkpoint";
+    const int dim = sys.settings.dim;
+    targets_ = Vec3(cfg.real("insitu.sigma_H"), cfg.real("insitu.sigma_h"), dim == 3 ? cfg.real("insitu.sigma_v") : 0.0);
+    servo_v_ = cfg.real("insitu.servo_velocity");
+    servo_alpha_ = cfg.real("insitu.servo_relaxation");
+  }
+  RunStatus run();
+
+ private:
+  void set_up();
+  void make_fluid();
+  void servo();
+  void advance(long steps);
+  Vec3 wall_stress() const;
+  Real face_gap() const;  // distance from the hole's wall to the nearest wall [m]
+  void measure_row();
+  std::vector<CircleRecord> snapshot(Real pressure) const;
+  void save(const fs::path& dir);
+  void load();
+  void checkpoint() {
+    save(cp_dir_);
+    control_.checkpoint_written();
+  }
+  void begin_injection();
+  void vtk();
+  void finish(const std::string& stop);
+  void plots();
+  nlohmann::json circles_json(const std::vector<CircleRecord>& c) const;
+
+  const Config& cfg;
+  const RunOptions& opt;
+  RunControl control_;
+  dem::DemSystem sys;
+  dem::SampleInfo info;
+  BoreholeGeometry hole_;
+  std::vector<hydrofrac::JointPair> joints_;
+  std::unique_ptr<hydrofrac::FluidLoad> fluid_;
+  HfState st_;
+  Vec3 targets_;
+  Real servo_v_ = 0, servo_alpha_ = 0;
+  std::vector<CircleRecord> insitu_, probe_;
+  fs::path cp_dir_;
+  CsvWriter series_;
+  dem::DemVtkWriter vtk_writer_;
+  bool vtk_on_ = false;
+  std::vector<double> row_;
+  std::string status_;
+  // fracture measurement scratch (refreshed each row)
+  std::vector<Index> id_index_;
+  std::vector<std::size_t> ev_, jt_;
+  std::vector<char> visited_;
+  hydrofrac::FractureShape shape_;
+  Real extent_ = 0;  // connected fracture beyond the wall [m]
+};
+
+}  // namespace
+}  // namespace ff::drivers
+
+namespace ff::drivers {
+namespace {
+
+void HydrofracRun::make_fluid() {
+  hydrofrac::SleeveSettings s;
+  s.rate_mode = cfg.string("injection.mode") == "rate";
+  s.ramp_rate = cfg.real("injection.ramp_rate");
+  s.initial_pressure = cfg.real("injection.initial_pressure");
+  s.flow_rate = cfg.real("injection.rate");
+  s.bulk_modulus = cfg.real("injection.fluid_bulk_modulus");
+  s.penetration = cfg.boolean("injection.penetration");
+  s.update_interval = cfg.integer("injection.update_interval");
+  // Flood-fill cells of a quarter of the smallest radius (at most ~4e6 cells); particles are
+  // inflated by half the bond gap so that bonded neighbours close the wall; the flood stays
+  // within 1.5 radius_max of the carved region.
+  const Real rmin = cfg.real("sample.radius_min"), rmax = cfg.real("sample.radius_max");
+  const Real span = 2 * (hole_.radius + hole_.perforation_length + 3 * rmax);
+  Real cell = 0.25 * rmin;
+  const Real zspan = sys.settings.dim == 3 ? std::max<Real>(hole_.z_hi - hole_.z_lo, cell) : cell;
+  const Real cells = (span / cell) * (span / cell) * (sys.settings.dim == 3 ? zspan / cell : 1.0);
+  if (cells > 4e6) cell *= std::pow(cells / 4e6, sys.settings.dim == 3 ? 1.0 / 3.0 : 0.5);
+  s.cell = cell;
+  s.inflate = std::min(0.5 * cfg.real("sample.bond_gap"), 0.5 * rmin);
+  s.reach = 1.5 * rmax;
+  fluid_ = std::make_unique<hydrofrac::SleeveLoad>(s);
+}
+
+void HydrofracRun::set_up() {
+  info = dem::build_sample(cfg, sys);
+  const int dim = sys.settings.dim;
+  auto& P = sys.particles;
+  const Block b = block_of(cfg);
+  hole_.dim = dim;
+  hole_.centre = b.centre;
+  hole_.radius = cfg.real("borehole.radius");
+  hole_.perforation_length = cfg.real("borehole.perforation_length");
+  hole_.perforation_width =
+      cfg.real("borehole.perforation_width") > 0 ? cfg.real("borehole.perforation_width") : 2 * cfg.real("sample.radius_max");
+  hole_.perforation_azimuth = cfg.real("borehole.perforation_azimuth") * kPi / 180;
+  hole_.perforation_sides = static_cast<int>(cfg.integer("borehole.perforation_sides"));
+  std::vector<char> remove(P.size(), 0);
+  for (std::size_t i = 0; i < P.size(); ++i) remove[i] = hydrofrac::in_hole(hole_, P.pos[i], 0) ? 1 : 0;
+  const std::size_t removed = hydrofrac::remove_particles(sys, remove);
+  // The block's faces touch the outermost particles (the genesis shrinks the radii a little).
+  Vec3 lo = Vec3::Constant(std::numeric_limits<Real>::infinity()), hi = -lo;
+  for (std::size_t i = 0; i < P.size(); ++i) {
+    lo = lo.cwiseMin(P.pos[i] - Vec3::Constant(P.radius[i]));
+    hi = hi.cwiseMax(P.pos[i] + Vec3::Constant(P.radius[i]));
+  }
+  hole_.z_lo = dim == 3 ? lo.z() : 0;
+  hole_.z_hi = dim == 3 ? hi.z() : 0;
+  const auto joints = hydrofrac::make_joints(cfg, lo, hi, hole_.centre, hole_.radius, dim);
+  joints_ = hydrofrac::cut_bonds(sys, joints);
+  sys.walls.clear();
+  const char* names[6] = {"x-", "x+", "y-", "y+", "z-", "z+"};
+  for (int a = 0; a < dim; ++a)
+    for (int side = 0; side < 2; ++side) {
+      dem::Wall w;
+      w.name = names[2 * a + side];
+      w.point = Vec3::Zero();
+      w.point[a] = side == 0 ? lo[a] : hi[a];
+      w.normal = Vec3::Zero();
+      w.normal[a] = side == 0 ? 1 : -1;
+      w.friction = 0;
+      sys.walls.push_back(w);
+    }
+  sys.initialise();
+  dem::choose_time_step(cfg, sys);
+  log::info("hydrofrac: {} particles, {} bonds; borehole radius {:.4g} m ({} particles removed){}; {} natural fractures "
+            "cutting {} bonds; time step {:.3g} s",
+            P.size(), intact_bonds(sys), hole_.radius, removed,
+            hole_.perforation_length > 0 ? fmt::format(", perforation {:.4g} m at {:.1f} deg", hole_.perforation_length,
+                                                       cfg.real("borehole.perforation_azimuth"))
+                                         : std::string(),
+            joints.size(), joints_.size(), sys.settings.dt);
+}
+
+// Compressive stress on each pair of opposite walls (mean of the two) [Pa].
+Vec3 HydrofracRun::wall_stress() const {
+  const int dim = sys.settings.dim;
+  const auto& W = sys.walls;
+  Vec3 s = Vec3::Zero();
+  const Real len[3] = {W[1].point.x() - W[0].point.x(), W[3].point.y() - W[2].point.y(),
+                       dim == 3 ? W[5].point.z() - W[4].point.z() : 1.0};
+  for (int a = 0; a < dim; ++a) {
+    const Real area = dim == 3 ? len[(a + 1) % 3] * len[(a + 2) % 3] : len[1 - a];
+    // Particles push the low wall towards -a and the high one towards +a.
+    s[a] = 0.5 * (-W[2 * a].force[a] + W[2 * a + 1].force[a]) / area;
+  }
+  return s;
+}
+
+void HydrofracRun::servo() {
+  const int dim = sys.settings.dim;
+  const auto& W0 = sys.walls;
+  const Real len[3] = {W0[1].point.x() - W0[0].point.x(), W0[3].point.y() - W0[2].point.y(),
+                       dim == 3 ? W0[5].point.z() - W0[4].point.z() : 1.0};
+  for (int a = 0; a < dim; ++a) {
+    const Real area = dim == 3 ? len[(a + 1) % 3] * len[(a + 2) % 3] : len[1 - a];
+    for (int side = 0; side < 2; ++side) {
+      auto& w = sys.walls[2 * a + side];
+      const Real pushed = side == 0 ? -w.force[a] : w.force[a];
+      const Real v = dem::FlexibleMembrane::servo_law(targets_[a] * area, -pushed, w.contact_stiffness, sys.settings.dt,
+                                                      servo_alpha_, servo_v_);
+      w.velocity = Vec3::Zero();
+      w.velocity[a] = side == 0 ? v : -v;
+    }
+  }
+}
+
+// The stages of DemSystem::step() with the fluid's loads between the forces and the motion.
+void HydrofracRun::advance(long steps) {
+  const bool inject = st_.stage == 1;
+  for (long k = 0; k < steps; ++k) {
+    servo();
+    sys.update_neighbors();
+    sys.compute_forces();
+    if (inject) fluid_->add_forces(sys);
+    sys.add_external_loads();
+    sys.integrate();
+    if (inject) fluid_->advance(sys);
+  }
+}
+
+Real HydrofracRun::face_gap() const {
+  const auto& W = sys.walls;
+  const Real a = st_.effective_radius > 0 ? st_.effective_radius : hole_.radius;
+  return std::min({hole_.centre.x() - W[0].point.x(), W[1].point.x() - hole_.centre.x(), hole_.centre.y() - W[2].point.y(),
+                   W[3].point.y() - hole_.centre.y()}) -
+         a;
+}
+
+std::vector<CircleRecord> HydrofracRun::snapshot(Real pressure) const {
+  std::vector<CircleRecord> out;
+  const int dim = sys.settings.dim;
+  const Real R = hole_.radius, a = st_.effective_radius;
+  const Real rho = cfg.real("measure.circle_radius") * R;
+  const Real zc = dim == 3 ? 0.5 * (hole_.z_lo + hole_.z_hi) : 0.0;
+  auto one = [&](Real dx, Real dy, Real rad, Real r_over_a, Real ang, bool far) {
+    const CircleStress m = hydrofrac::measure_circle(sys, Vec3(hole_.centre.x() + dx, hole_.centre.y() + dy, zc), rad);
+    const Vec3 k = hydrofrac::kirsch_average(targets_.x(), targets_.y(), pressure, a, dx, dy, rad, dim);
+    CircleRecord c;
+    c.r_over_a = r_over_a;
+    c.angle_deg = ang;
+    c.x = dx;
+    c.y = dy;
+    c.radius = rad;
+    c.porosity = m.porosity;
+    c.particles = m.particles;
+    c.far = far;
+    c.xx = m.xx;
+    c.yy = m.yy;
+    c.xy = m.xy;
+    c.zz = m.zz;
+    c.k_xx = k.x();
+    c.k_yy = k.y();
+    c.k_xy = k.z();
+    c.pressure = pressure;
+    out.push_back(c);
+  };
+  for (double r : cfg.real_list("measure.radii"))
+    for (double ang : cfg.real_list("measure.angles")) {
+      const Real t = ang * kPi / 180;
+      one(r * R * std::cos(t), r * R * std::sin(t), rho, r * R / a, ang, false);
+    }
+  // Interior stress: four circles half-way between the axis and the block's corners.
+  const auto& W = sys.walls;
+  const Real hx = 0.5 * (W[1].point.x() - W[0].point.x()), hy = 0.5 * (W[3].point.y() - W[2].point.y());
+  const Real q = std::min(hx, hy);
+  for (int s = 0; s < 4; ++s) {
+    const Real dx = (s % 2 ? 0.5 : -0.5) * hx, dy = (s / 2 ? 0.5 : -0.5) * hy;
+    one(dx, dy, 0.3 * q, std::hypot(dx, dy) / a, std::atan2(dy, dx) * 180 / kPi, true);
+  }
+  return out;
+}
+
+void HydrofracRun::begin_injection() {
+  st_.stage = 1;
+  st_.injection_step = sys.step_count;
+  fluid_->begin(sys, hole_, joints_);
+  st_.effective_radius = static_cast<hydrofrac::SleeveLoad&>(*fluid_).effective_radius();
+  insitu_ = snapshot(0);
+  const Vec3 ws = wall_stress();
+  Real far_xx = 0, far_yy = 0;
+  int nf = 0;
+  for (const auto& c : insitu_)
+    if (c.far) far_xx += c.xx, far_yy += c.yy, ++nf;
+  log::info("hydrofrac: in-situ stage {} after {} steps: walls {:.3f} / {:.3f}{} MPa (targets {:.3f} / {:.3f}{}), interior "
+            "circles {:.3f} / {:.3f} MPa; hole: {} wall particles, effective radius {:.4g} m",
+            st_.equilibrium ? "in equilibrium" : "NOT in equilibrium", st_.insitu_steps, 1e-6 * ws.x(), 1e-6 * ws.y(),
+            sys.settings.dim == 3 ? fmt::format(" / {:.3f}", 1e-6 * ws.z()) : std::string(), 1e-6 * targets_.x(),
+            1e-6 * targets_.y(), sys.settings.dim == 3 ? fmt::format(" / {:.3f}", 1e-6 * targets_.z()) : std::string(),
+            1e-6 * far_xx / nf, 1e-6 * far_yy / nf, fluid_->wall_particles().size(), st_.effective_radius);
+  vtk();
+  checkpoint();
+}
+
+void HydrofracRun::vtk() {
+  if (!vtk_on_) return;
+  const Real extent = 1.6 * std::max(sys.walls[1].point.x() - sys.walls[0].point.x(), sys.walls[3].point.y() - sys.walls[2].point.y());
+  vtk_writer_.write(sys, st_.vtk_index++, extent);
+  st_.last_vtk_time = sys.time;
+}
+
+void HydrofracRun::measure_row() {
+  const Vec3 ws = wall_stress();
+  const hydrofrac::FluidState f = st_.stage == 1 ? fluid_->state() : hydrofrac::FluidState{};
+  long connected = 0;
+  shape_ = {};
+  extent_ = 0;
+  if (st_.stage == 1) {
+    if (id_index_.size() != static_cast<std::size_t>(sys.particles.next_id)) id_index_ = hydrofrac::index_of_ids(sys.particles);
+    hydrofrac::connected_cracks(sys, id_index_, fluid_->wall_particles(), joints_, ev_, jt_, visited_);
+    connected = static_cast<long>(ev_.size());
+    shape_ = hydrofrac::fracture_shape(sys, ev_, hole_.centre);
+    extent_ = std::max<Real>(0, shape_.max_distance - st_.effective_radius);
+  }
+  row_ = {static_cast<double>(sys.step_count), sys.time, static_cast<double>(st_.stage), f.pressure, f.injected_volume,
+          f.borehole_volume, ws.x(), ws.y(), ws.z(), static_cast<double>(sys.cracks.tensile),
+          static_cast<double>(sys.cracks.shear), static_cast<double>(sys.cracks.total()), static_cast<double>(connected),
+          static_cast<double>(f.wetted_cracks), shape_.length, extent_, shape_.azimuth_deg, kinetic_energy(sys),
+          max_unbalanced_force_ratio(sys)};
+  for (double v : row_)
+    if (!std::isfinite(v))
+      throw NumericalError(fmt::format(
+          "the hydrofrac run became unstable by step {} (t = {:.6g} s): a series.csv value is {}. The last good checkpoint "
+          "stays in {}/checkpoint. Lower dem.time_step_safety, injection.ramp_rate or injection.rate, or insitu.servo_velocity",
+          sys.step_count, sys.time, v, opt.out_dir.string()));
+  series_.row(row_);
+  ++st_.rows;
+  status_.clear();
+  if (st_.stage == 0)
+    fmt::format_to(std::back_inserter(status_), "in-situ: walls {:.3f}/{:.3f} MPa, unbalanced {:.3g}", 1e-6 * ws.x(),
+                   1e-6 * ws.y(), row_.back());
+  else
+    fmt::format_to(std::back_inserter(status_), "p {:.3f} MPa  cracks {} ({} connected)  fracture {:.3g} m", 1e-6 * f.pressure,
+                   sys.cracks.total(), connected, extent_);
+}
+
+void HydrofracRun::save(const fs::path& dir) {
+  fs::create_directories(dir);
+  CheckpointWriter w(dir / "state.ffcp", /*keep_previous=*/true);
+  dem::save_dem(w, sys);
+  w.put_value("hydrofrac.state", st_);
+  w.put_value("hydrofrac.sample", sample_record(info));
+  const HoleRecord h{hole_.centre.x(), hole_.centre.y(), hole_.radius, hole_.perforation_length, hole_.perforation_width,
+                     hole_.perforation_azimuth, hole_.z_lo, hole_.z_hi, hole_.perforation_sides, hole_.dim};
+  w.put_value("hydrofrac.hole", h);
+  w.put("hydrofrac.joints", joints_);
+  w.put("hydrofrac.insitu", insitu_);
+  w.put("hydrofrac.probe", probe_);
+  if (st_.stage == 1) fluid_->save(w);
+  w.commit();
+}
+
+void HydrofracRun::load() {
+  CheckpointReader r = open_checkpoint(cp_dir_ / "state.ffcp");
+  dem::load_dem(r, sys);
+  st_ = r.get_value<HfState>("hydrofrac.state");
+  info = sample_info(r.get_value<SampleRecord>("hydrofrac.sample"));
+  const auto h = r.get_value<HoleRecord>("hydrofrac.hole");
+  hole_.centre = Vec3(h.cx, h.cy, 0);
+  hole_.radius = h.radius;
+  hole_.perforation_length = h.plen;
+  hole_.perforation_width = h.pwid;
+  hole_.perforation_azimuth = h.paz;
+  hole_.z_lo = h.z_lo;
+  hole_.z_hi = h.z_hi;
+  hole_.perforation_sides = static_cast<int>(h.sides);
+  hole_.dim = static_cast<int>(h.dim);
+  r.get("hydrofrac.joints", joints_);
+  r.get("hydrofrac.insitu", insitu_);
+  r.get("hydrofrac.probe", probe_);
+  if (st_.stage == 1) fluid_->load(r, sys);
+}
+
+RunStatus HydrofracRun::run() {
+  make_fluid();
+  if (opt.resume) {
+    load();
+    if (st_.finished) {
+      log::info("this run had already finished; nothing to resume");
+      return RunStatus::Finished;
+    }
+    log::info("resuming at step {} (t = {:.6g} s), {}", sys.step_count, sys.time, st_.stage == 0 ? "in-situ stage" : "injecting");
+  } else {
+    set_up();
+    begin_output(opt);
+  }
+  // Outputs; on resume, rows, crack lines and snapshots after the checkpoint are dropped (the
+  // run recomputes them identically).
+  const fs::path cracks_csv = opt.out_dir / "cracks.csv";
+  if (opt.resume) series_.reopen(opt.out_dir / "series.csv", kColumns, static_cast<std::size_t>(st_.rows));
+  else series_.open(opt.out_dir / "series.csv", kColumns);
+  {
+    dem::CrackLog head;
+    head.events.assign(sys.cracks.events.begin(), sys.cracks.events.begin() + st_.cracks_written);
+    dem::append_cracks_csv(cracks_csv, head, sys.materials, 0);
+  }
+  vtk_on_ = cfg.boolean("output.vtk");
+  if (vtk_on_) vtk_writer_.open(opt.out_dir / "vtk", opt.resume, sys.time);
+  if (!opt.resume) {
+    vtk();
+    checkpoint();
+  }
+  row_.reserve(kColumns.size());
+  const long every = cfg.integer("hydrofrac.series_interval");
+  const long cp_every = cfg.integer("hydrofrac.checkpoint_interval");
+  const long vtk_every = cfg.integer("hydrofrac.vtk_interval");
+  const Real tol = cfg.real("insitu.tolerance");
+  const long insitu_max = cfg.integer("insitu.max_steps");
+  const bool rate_mode = cfg.string("injection.mode") == "rate";
+  const Real bd_len = cfg.real("injection.breakdown_length") > 0 ? cfg.real("injection.breakdown_length") : hole_.radius;
+  const Real probe_p = cfg.real("measure.pressure");
+  const Real max_p = cfg.real("injection.max_pressure"), max_t = cfg.real("injection.max_time");
+  const Real stop_extent = cfg.real("injection.stop_extent"), stop_fraction = cfg.real("injection.stop_fraction");
+  const Real peak_drop = cfg.real("injection.peak_drop");
+  const Real ramp = cfg.real("injection.ramp_rate");
+  Progress progress("hydrofrac", opt.progress_interval_s);
+  const double planned = static_cast<double>(insitu_max) +
+                         (rate_mode ? max_t : std::min(max_t, max_p / ramp)) / sys.settings.dt;
+  LongRunNotice long_run(planned - static_cast<double>(sys.step_count), "injection.ramp_rate, injection.max_time or insitu.max_steps",
+                         sys.step_count);
+  std::string stop;
+  try {
+    for (;;) {
+      advance(every);
+      measure_row();
+      double fraction = -1;
+      if (st_.stage == 0) {
+        st_.insitu_steps = sys.step_count;
+        const Vec3 ws = wall_stress();
+        Real err = 0;
+        for (int a = 0; a < sys.settings.dim; ++a) err = std::max(err, std::abs(ws[a] - targets_[a]) / targets_[a]);
+        const bool eq = err <= tol && row_.back() <= tol && st_.rows >= 3;
+        fraction = 0.5 * static_cast<double>(sys.step_count) / static_cast<double>(insitu_max);
+        if (eq || sys.step_count >= insitu_max) {
+          st_.equilibrium = eq;
+          if (!eq)
+            log::warn("hydrofrac: the in-situ stage reached insitu.max_steps = {} without equilibrium (largest wall-stress "
+                      "error {:.3g}, unbalanced-force ratio {:.3g}, tolerance {}); injecting anyway",
+                      insitu_max, err, row_.back(), tol);
+          begin_injection();
+        }
+      } else {
+        const Real p = row_[3];
+        const Real injected_time = static_cast<Real>(sys.step_count - st_.injection_step) * sys.settings.dt;
+        if (!st_.initiation_found && row_[12] > 0) {
+          st_.initiation_found = 1;
+          st_.initiation_pressure = p;
+        }
+        if (!st_.probe_taken && probe_p > 0 && p >= probe_p) {
+          st_.probe_taken = 1;
+          st_.probe_pressure_actual = p;
+          probe_ = snapshot(p);
+        }
+        if (p > st_.peak_pressure) {
+          st_.peak_pressure = p;
+          st_.peak_time = sys.time;
+          st_.peak_cracks = sys.cracks.total();
+        }
+        if (!st_.breakdown_found) {
+          const bool bd = rate_mode ? (st_.peak_pressure > 0 && p < (1 - peak_drop) * st_.peak_pressure) : extent_ >= bd_len;
+          if (bd) {
+            st_.breakdown_found = 1;
+            st_.breakdown_row = st_.rows - 1;
+            st_.breakdown_pressure = rate_mode ? st_.peak_pressure : p;
+            st_.breakdown_time = rate_mode ? st_.peak_time : sys.time;
+            st_.breakdown_cracks = rate_mode ? st_.peak_cracks : sys.cracks.total();
+            vtk();
+          }
+        }
+        if (vtk_every > 0 && sys.time - st_.last_vtk_time >= static_cast<Real>(vtk_every) * sys.settings.dt - 1e-15) vtk();
+        const Real gap = face_gap();
+        if (extent_ >= stop_extent * gap)
+          stop = fmt::format("the fracture reached {:.3g} of the distance from the hole to the block's faces (injection.stop_extent)",
+                             extent_ / gap);
+        else if (p >= max_p)
+          stop = fmt::format("the borehole pressure reached injection.max_pressure = {} Pa", max_p);
+        else if (injected_time >= max_t)
+          stop = fmt::format("the injection time reached injection.max_time = {} s", max_t);
+        else if (rate_mode && st_.breakdown_found && p < stop_fraction * st_.peak_pressure)
+          stop = fmt::format("the pressure fell below injection.stop_fraction = {} of its peak", stop_fraction);
+        fraction = 0.5 + 0.5 * std::min(1.0, rate_mode ? injected_time / max_t : std::max(extent_ / (stop_extent * gap), p / max_p));
+      }
+      progress.update(sys.step_count, sys.time, fraction, status_);
+      long_run.update(sys.step_count);
+      dem::append_cracks_csv(cracks_csv, sys.cracks, sys.materials, static_cast<std::size_t>(st_.cracks_written));
+      st_.cracks_written = static_cast<long>(sys.cracks.events.size());
+      if (!stop.empty()) break;
+      if (const std::string why = control_.stop_reason(sys.step_count); !why.empty()) {
+        checkpoint();
+        log_interruption(why, sys.step_count);
+        series_.close();
+        return RunStatus::Interrupted;
+      }
+      if (control_.checkpoint_due() || (cp_every > 0 && (sys.step_count / every) % std::max(1L, cp_every / every) == 0))
+        checkpoint();
+    }
+  } catch (const NumericalError&) {
+    save(opt.out_dir / "checkpoint_failed");
+    series_.close();
+    throw;
+  }
+  series_.close();
+  finish(stop);
+  return RunStatus::Finished;
+}
+
+nlohmann::json HydrofracRun::circles_json(const std::vector<CircleRecord>& cs) const {
+  nlohmann::json a = nlohmann::json::array();
+  for (const auto& c : cs) {
+    const Real t = std::atan2(c.y, c.x), co = std::cos(t), si = std::sin(t);
+    auto polar = [&](Real xx, Real yy, Real xy) {
+      return std::array<Real, 3>{xx * co * co + yy * si * si + 2 * xy * si * co, xx * si * si + yy * co * co - 2 * xy * si * co,
+                                 (yy - xx) * si * co + xy * (co * co - si * si)};
+    };
+    const auto m = polar(c.xx, c.yy, c.xy), k = polar(c.k_xx, c.k_yy, c.k_xy);
+    nlohmann::json j = {{"kind", c.far ? "interior" : "near_hole"},
+                        {"r_over_a", c.r_over_a},
+                        {"azimuth_deg", c.angle_deg},
+                        {"x_m", c.x},
+                        {"y_m", c.y},
+                        {"radius_m", c.radius},
+                        {"particles", c.particles},
+                        {"porosity", c.porosity},
+                        {"pressure_Pa", c.pressure},
+                        {"measured_Pa", {{"xx", c.xx}, {"yy", c.yy}, {"xy", c.xy}, {"rr", m[0]}, {"tt", m[1]}, {"rt", m[2]}}},
+                        {"kirsch_Pa", {{"xx", c.k_xx}, {"yy", c.k_yy}, {"xy", c.k_xy}, {"rr", k[0]}, {"tt", k[1]}, {"rt", k[2]}}}};
+    if (sys.settings.dim == 3) j["measured_Pa"]["zz"] = c.zz;
+    a.push_back(j);
+  }
+  return a;
+}
+
+void HydrofracRun::finish(const std::string& stop) {
+  vtk();
+  const hydrofrac::FluidState f = fluid_->state();
+  nlohmann::json j;
+  j["fracflow_version"] = kVersion;
+  j["driver"] = "hydrofrac";
+  j["title"] = cfg.string("title");
+  j["stop_reason"] = stop;
+  const bool rate_mode = cfg.string("injection.mode") == "rate";
+  j["injection"] = {{"fluid", cfg.string("injection.fluid")},
+                    {"mode", cfg.string("injection.mode")},
+                    {"penetration", cfg.boolean("injection.penetration")},
+                    {"final_pressure_Pa", f.pressure},
+                    {"injected_volume_m3", f.injected_volume},
+                    {"borehole_volume_m3", f.borehole_volume},
+                    {"wall_particles", f.wetted_particles},
+                    {"wetted_cracks", f.wetted_cracks},
+                    {"peak_pressure_Pa", st_.peak_pressure},
+                    {"start_time_s", static_cast<Real>(st_.injection_step) * sys.settings.dt}};
+  if (sys.settings.dim == 2) j["injection"]["note"] = "2D: volumes and rates per metre of thickness";
+  nlohmann::json bd;
+  bd["definition"] = rate_mode ? "first pressure peak followed by a drop of injection.peak_drop"
+                               : fmt::format("pressure when the fracture connected to the hole first reached {} m beyond its wall "
+                                             "(injection.breakdown_length)",
+                                             cfg.real("injection.breakdown_length") > 0 ? cfg.real("injection.breakdown_length")
+                                                                                        : hole_.radius);
+  if (st_.breakdown_found) {
+    bd["pressure_Pa"] = st_.breakdown_pressure;
+    bd["time_s"] = st_.breakdown_time;
+    bd["cracks"] = st_.breakdown_cracks;
+  } else {
+    bd["pressure_Pa"] = nullptr;
+    bd["reason"] = fmt::format("no breakdown before the run stopped: {}", stop);
+  }
+  bd["initiation_pressure_Pa"] = st_.initiation_found ? nlohmann::json(st_.initiation_pressure) : nlohmann::json(nullptr);
+  bd["initiation_definition"] = "pressure at the first series row with a crack connected to the hole";
+  j["breakdown"] = bd;
+  j["fracture"] = {{"connected_cracks", shape_.cracks},
+                   {"length_m", shape_.length},
+                   {"extent_beyond_wall_m", extent_},
+                   {"azimuth_deg", shape_.azimuth_deg},
+                   {"anisotropy", shape_.anisotropy},
+                   {"definition", "cracks connected to the hole through broken bonds: principal axis of sum d d^T about the "
+                                  "axis (azimuth from x = sigma_H), tip-to-tip length along it, largest distance minus the "
+                                  "effective hole radius"}};
+  j["borehole"] = {{"radius_m", hole_.radius},
+                   {"effective_radius_m", st_.effective_radius},
+                   {"centre_m", {hole_.centre.x(), hole_.centre.y()}},
+                   {"perforation_length_m", hole_.perforation_length},
+                   {"perforation_azimuth_deg", cfg.real("borehole.perforation_azimuth")},
+                   {"natural_fracture_bonds", joints_.size()}};
+  j["insitu"] = {{"targets_Pa", {{"sigma_H", targets_.x()}, {"sigma_h", targets_.y()}}},
+                 {"equilibrium_reached", st_.equilibrium != 0},
+                 {"steps", st_.insitu_steps},
+                 {"tolerance", cfg.real("insitu.tolerance")}};
+  if (sys.settings.dim == 3) j["insitu"]["targets_Pa"]["sigma_v"] = targets_.z();
+  j["elastic_state"] = {
+      {"method", "measurement circles (2D) / spheres (3D) with PFC's porosity correction against Kirsch's solution averaged over "
+                 "the same region (a = effective hole radius, far field = the in-situ targets, compression positive)"},
+      {"insitu", circles_json(insitu_)}};
+  if (!probe_.empty()) j["elastic_state"]["pressurised"] = circles_json(probe_);
+  j["cracks"] = cracks_json(sys);
+  j["sample"] = sample_json(sys, info);
+  j["time_step_s"] = sys.settings.dt;
+  j["steps"] = sys.step_count;
+  j["wall_time_s"] = control_.elapsed_s();
+  j["threads"] = opt.threads;
+  j["parameters"] = params_json(cfg);
+  add_run_record(j, opt);
+  write_json_atomic(opt.out_dir / "summary.json", j);
+  plots();
+  st_.finished = 1;
+  checkpoint();
+  log::info("hydrofrac: {}; breakdown {}, cracks {} ({} tensile, {} shear), {} connected: fracture {:.3g} m long at {:.1f} deg "
+            "from sigma_H",
+            stop,
+            st_.breakdown_found ? fmt::format("{:.3f} MPa", 1e-6 * st_.breakdown_pressure) : std::string("not reached"),
+            sys.cracks.total(), sys.cracks.tensile, sys.cracks.shear, shape_.cracks, shape_.length, shape_.azimuth_deg);
+}
+
+void HydrofracRun::plots() {
+  if (!cfg.boolean("output.plots")) return;
+  const fs::path out = opt.out_dir;
+  fs::create_directories(out / "plots");
+  // Outline of the hole (and the block) for the fracture picture; the cracks are the markers.
+  const fs::path outline = out / "plots" / "outline.csv";
+  {
+    std::ofstream o(outline);
+    o << "x_m,y_m\n";
+    const Real a = st_.effective_radius;
+    for (int k = 0; k <= 72; ++k)
+      o << hole_.centre.x() + a * std::cos(2 * kPi * k / 72) << "," << hole_.centre.y() + a * std::sin(2 * kPi * k / 72) << "\n";
+    const auto& W = sys.walls;
+    o << "nan,nan\n";
+    for (int k : {0, 1, 3, 2, 0}) {
+      const Real x = W[k % 2 ? 1 : 0].point.x(), y = W[k / 2 ? 3 : 2].point.y();
+      o << x << "," << y << "\n";
+    }
+  }
+  PlotJob p{out / "series.csv", out / "plots" / "pressure_cracks.png", {}};
+  p.spec.title = "Hydraulic fracturing: borehole pressure and cracks";
+  p.spec.x = "time_s";
+  p.spec.x_scale = 1e3;
+  p.spec.xlabel = "time [ms]";
+  p.spec.y = {"pressure_Pa"};
+  p.spec.y_scale = 1e-6;
+  p.spec.ylabel = "borehole pressure [MPa]";
+  p.spec.y2 = {"cracks_total", "cracks_tensile", "cracks_shear", "cracks_connected"};
+  p.spec.y2label = "number of cracks";
+  PlotJob v{out / "series.csv", out / "plots" / "injected_volume.png", {}};
+  v.spec.title = "Injected volume";
+  v.spec.x = "time_s";
+  v.spec.x_scale = 1e3;
+  v.spec.xlabel = "time [ms]";
+  v.spec.y = {"injected_volume_m3"};
+  v.spec.y_scale = 1e6;
+  v.spec.ylabel = sys.settings.dim == 2 ? "injected volume [cm^3 per m]" : "injected volume [cm^3]";
+  PlotJob c{outline, out / "plots" / "fracture_pattern.png", {}};
+  c.spec.title = "Cracks (circles) around the borehole";
+  c.spec.x = "x_m";
+  c.spec.x_scale = 1e3;
+  c.spec.xlabel = "x (sigma_H) [mm]";
+  c.spec.y = {"y_m"};
+  c.spec.y_scale = 1e3;
+  c.spec.ylabel = "y (sigma_h) [mm]";
+  c.spec.reference_csv = out / "cracks.csv";
+  c.spec.ref_x = "x_m";
+  c.spec.ref_y = "y_m";
+  c.spec.ref_label = "cracks";
+  const std::vector<PlotJob> jobs = {p, v, c};
+  plot_series(jobs);
+}
+
+RunStatus run(const Config& cfg, const RunOptions& opt) {
+  validate(cfg);
+  return HydrofracRun(cfg, opt).run();
+}
+
+}  // namespace
+
+Driver hydrofrac_driver() {
+  return Driver{"hydrofrac",
+                "hydraulic fracturing from a borehole in a bonded block under servo-controlled in-situ stresses (sleeve pressure)",
+                declare, run, validate};
+}
+
+}  // namespace ff::drivers
