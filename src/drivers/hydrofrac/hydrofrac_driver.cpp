@@ -179,6 +179,8 @@ struct HfState {
   Real initiation_pressure = 0, effective_radius = 0, probe_pressure_actual = 0;
   long breakdown_cracks = 0, peak_cracks = 0;
   Real last_vtk_time = 0;
+  Real bd_azimuth = 0, bd_length = 0, bd_extent = 0, bd_anisotropy = 0;  // the fracture at breakdown
+  long bd_connected = 0, unused = 0;
 };
 
 // One measurement circle with Kirsch's prediction (compression positive), a checkpoint record.
@@ -631,6 +633,11 @@ RunStatus HydrofracRun::run() {
             st_.breakdown_pressure = rate_mode ? st_.peak_pressure : p;
             st_.breakdown_time = rate_mode ? st_.peak_time : sys.time;
             st_.breakdown_cracks = rate_mode ? st_.peak_cracks : sys.cracks.total();
+            st_.bd_azimuth = shape_.azimuth_deg;
+            st_.bd_length = shape_.length;
+            st_.bd_extent = extent_;
+            st_.bd_anisotropy = shape_.anisotropy;
+            st_.bd_connected = shape_.cracks;
             vtk();
           }
         }
@@ -727,6 +734,11 @@ void HydrofracRun::finish(const std::string& stop) {
     bd["pressure_Pa"] = st_.breakdown_pressure;
     bd["time_s"] = st_.breakdown_time;
     bd["cracks"] = st_.breakdown_cracks;
+    bd["fracture"] = {{"connected_cracks", st_.bd_connected},
+                      {"length_m", st_.bd_length},
+                      {"extent_beyond_wall_m", st_.bd_extent},
+                      {"azimuth_deg", st_.bd_azimuth},
+                      {"anisotropy", st_.bd_anisotropy}};
   } else {
     bd["pressure_Pa"] = nullptr;
     bd["reason"] = fmt::format("no breakdown before the run stopped: {}", stop);
