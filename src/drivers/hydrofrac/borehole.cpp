@@ -248,10 +248,21 @@ FractureShape fracture_shape(const dem::DemSystem& sys, const std::vector<std::s
     hi = std::max(hi, s);
   }
   f.length = hi - lo;
-  Real deg = theta * 180 / kPi;
-  if (deg <= -90) deg += 180;
-  if (deg > 90) deg -= 180;
-  f.azimuth_deg = deg;
+  auto fold = [](Real rad) {
+    Real deg = rad * 180 / kPi;
+    while (deg <= -90) deg += 180;
+    while (deg > 90) deg -= 180;
+    return deg;
+  };
+  f.azimuth_deg = fold(theta);
+  Real nxx = 0, nyy = 0, nxy = 0;
+  for (std::size_t k : events) {
+    const Vec3& n = sys.cracks.events[k].normal;
+    nxx += n.x() * n.x();
+    nyy += n.y() * n.y();
+    nxy += n.x() * n.y();
+  }
+  f.normal_azimuth_deg = fold(0.5 * std::atan2(2 * nxy, nxx - nyy) + 0.5 * kPi);
   return f;
 }
 

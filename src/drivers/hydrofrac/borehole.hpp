@@ -49,6 +49,9 @@ struct FractureShape {
   long cracks = 0;
   Real azimuth_deg = 0, length = 0, max_distance = 0;
   Real anisotropy = 0;  // 1 - lambda2/lambda1: 0 for a round cloud, 1 for a line
+  // From the cracks' normals (bond axes): the plane normal to the principal axis of sum n n^T,
+  // i.e. the opening direction's normal (less sensitive to side branches than the positions).
+  Real normal_azimuth_deg = 0;
 };
 FractureShape fracture_shape(const dem::DemSystem& sys, const std::vector<std::size_t>& events, const Vec3& centre);
 

@@ -179,8 +179,9 @@ struct HfState {
   Real initiation_pressure = 0, effective_radius = 0, probe_pressure_actual = 0;
   long breakdown_cracks = 0, peak_cracks = 0;
   Real last_vtk_time = 0;
-  Real bd_azimuth = 0, bd_length = 0, bd_extent = 0, bd_anisotropy = 0;  // the fracture at breakdown
-  long bd_connected = 0, unused = 0;
+  Real bd_azimuth = 0, bd_length = 0, bd_extent = 0, bd_anisotropy = 0, bd_normal_azimuth = 0;  // the fracture at breakdown
+  long bd_connected = 0;
+  Real injection_time = 0;  // sys.time when injection began
 };
 
 // One measurement circle with Kirsch's prediction (compression positive), a checkpoint record.
@@ -443,6 +444,7 @@ std::vector<CircleRecord> HydrofracRun::snapshot(Real pressure) const {
 void HydrofracRun::begin_injection() {
   st_.stage = 1;
   st_.injection_step = sys.step_count;
+  st_.injection_time = sys.time;
   fluid_->begin(sys, hole_, joints_);
   st_.effective_radius = static_cast<hydrofrac::SleeveLoad&>(*fluid_).effective_radius();
   insitu_ = snapshot(0);
@@ -637,6 +639,7 @@ RunStatus HydrofracRun::run() {
             st_.bd_length = shape_.length;
             st_.bd_extent = extent_;
             st_.bd_anisotropy = shape_.anisotropy;
+            st_.bd_normal_azimuth = shape_.normal_azimuth_deg;
             st_.bd_connected = shape_.cracks;
             vtk();
           }
@@ -722,7 +725,7 @@ void HydrofracRun::finish(const std::string& stop) {
                     {"wall_particles", f.wetted_particles},
                     {"wetted_cracks", f.wetted_cracks},
                     {"peak_pressure_Pa", st_.peak_pressure},
-                    {"start_time_s", static_cast<Real>(st_.injection_step) * sys.settings.dt}};
+                    {"start_time_s", st_.injection_time}};
   if (sys.settings.dim == 2) j["injection"]["note"] = "2D: volumes and rates per metre of thickness";
   nlohmann::json bd;
   bd["definition"] = rate_mode ? "first pressure peak followed by a drop of injection.peak_drop"
@@ -738,7 +741,8 @@ void HydrofracRun::finish(const std::string& stop) {
                       {"length_m", st_.bd_length},
                       {"extent_beyond_wall_m", st_.bd_extent},
                       {"azimuth_deg", st_.bd_azimuth},
-                      {"anisotropy", st_.bd_anisotropy}};
+                      {"anisotropy", st_.bd_anisotropy},
+                      {"normal_azimuth_deg", st_.bd_normal_azimuth}};
   } else {
     bd["pressure_Pa"] = nullptr;
     bd["reason"] = fmt::format("no breakdown before the run stopped: {}", stop);
@@ -751,9 +755,11 @@ void HydrofracRun::finish(const std::string& stop) {
                    {"extent_beyond_wall_m", extent_},
                    {"azimuth_deg", shape_.azimuth_deg},
                    {"anisotropy", shape_.anisotropy},
+                   {"normal_azimuth_deg", shape_.normal_azimuth_deg},
                    {"definition", "cracks connected to the hole through broken bonds: principal axis of sum d d^T about the "
                                   "axis (azimuth from x = sigma_H), tip-to-tip length along it, largest distance minus the "
-                                  "effective hole radius"}};
+                                  "effective hole radius; normal_azimuth_deg: normal to the principal axis of the cracks' "
+                                  "normals sum n n^T"}};
   j["borehole"] = {{"radius_m", hole_.radius},
                    {"effective_radius_m", st_.effective_radius},
                    {"centre_m", {hole_.centre.x(), hole_.centre.y()}},
