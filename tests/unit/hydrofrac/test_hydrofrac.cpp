@@ -3,7 +3,8 @@
 // minimum in-situ stress (with the rock's tensile strength measured by the direct-tension
 // driver on the same material), the fracture's orientation against sigma_H, penetration,
 // the constant-rate mode, natural fractures, input errors and resume bit for bit.
-// Small 2D blocks (560-2900 disks) keep the binary at about a minute on one core.
+// Small 2D blocks (560-2900 disks) keep the binary under a minute on one core. The fracture's
+// orientation needs a finer block: tests/validation/hydrofrac (label long).
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
@@ -224,22 +225,6 @@ grip_velocity = 0.1
   EXPECT_LT(slope, 4.5);
 }
 
-// The fracture runs along sigma_H once sigma_H/sigma_h >= 1.5 (the hoop stress is least where
-// sigma_H is tangent to the wall, Kirsch): within 15 degrees of x for sH/sh = 2, and of y when
-// the two stresses are swapped (a check that the measured azimuth is not x whatever happens).
-// Measured at breakdown: 1.3 and 88-90 degrees.
-TEST(Hydrofrac, FractureFollowsTheMaximumStress) {
-  Scratch s;
-  const fs::path file = s.write("block.toml", kBlock);
-  const auto a = run_scenario(file, s / "x");
-  const double ax = a["breakdown"]["fracture"]["azimuth_deg"];
-  EXPECT_LT(std::abs(ax), 15.0) << a["breakdown"].dump(1);
-  const auto b = run_scenario(file, s / "y", " --set insitu.sigma_H=2e6 --set insitu.sigma_h=4e6");
-  const double ay = b["breakdown"]["fracture"]["azimuth_deg"];
-  EXPECT_GT(std::abs(ay), 75.0) << b["breakdown"].dump(1);
-  std::printf("fracture azimuth at breakdown: %.1f deg (sigma_H along x), %.1f deg (along y)\n", ax, ay);
-}
-
 // With penetration the fluid also pushes the faces of the cracks connected to the hole, so the
 // fracture grows at a lower pressure than under a sleeve (Haimson & Fairhurst 1967 against
 // Hubbert & Willis' non-penetrating case). Measured: breakdown 22.9 against 33.4 MPa, the same
@@ -254,13 +239,18 @@ TEST(Hydrofrac, PenetrationLowersTheBreakdownPressure) {
   EXPECT_LT(wet["breakdown"]["pressure_Pa"].get<double>(), 0.9 * dry["breakdown"]["pressure_Pa"].get<double>());
 }
 
-// Constant-rate injection through the fluid's compressibility: before any crack the pressure
-// rises as K_f Q t / V (the hole's compliance is small); the breakdown is a real peak after
-// which the pressure falls as the fracture takes volume.
+// Constant-rate injection through the fluid's compressibility, dp/dt = K_f/V (Q - dV/dt): up
+// to the first crack the pumped volume is stored as compressed fluid and hole growth,
+// Q (t - t0) = V p / K_f + (V - V0), to the accuracy of the explicit update (V changes by a few
+// per cent; tolerance 3%). The rock is about as compliant as the water here (E ~ 2 GPa against
+// K_f = 2.2 GPa): the pressure rises at about a quarter of the rigid-hole rate K_f Q / V, and
+// the hole grows. The breakdown is a real peak after which the pressure falls as the fracture
+// takes volume (measured: peak 32.0 MPa, stop at 15.9 MPa).
 TEST(Hydrofrac, ConstantRateGivesAPressurePeak) {
   Scratch s;
   const fs::path file = s.write("block.toml", kBlock);
   const fs::path out = s / "rate";
+  const double Q = 2e-3, K = 2.2e9;
   const auto j = run_scenario(file, out, " --set injection.mode=\"rate\" --set injection.rate=2e-3");
   ASSERT_TRUE(j["breakdown"]["pressure_Pa"].is_number()) << j.dump(1);
   EXPECT_LT(j["injection"]["final_pressure_Pa"].get<double>(), 0.6 * j["breakdown"]["pressure_Pa"].get<double>());
@@ -268,17 +258,21 @@ TEST(Hydrofrac, ConstantRateGivesAPressurePeak) {
   const auto& p = t.column("pressure_Pa");
   const auto& v = t.column("borehole_volume_m3");
   const auto& time = t.column("time_s");
-  const auto& stage = t.column("stage");
   const auto& cracks = t.column("cracks_total");
+  const auto& stage = t.column("stage");
   std::size_t first = 0;
   while (stage[first] < 1) ++first;
-  // The row before the first crack: K_f Q (t - t0) / V within 10% (the wall's yield takes a little).
   std::size_t k = first + 1;
   while (k + 1 < p.size() && cracks[k + 1] == 0) ++k;
+  ASSERT_GT(k, first + 3);
   const double t0 = j["injection"]["start_time_s"];
-  const double expect = 2.2e9 * 2e-3 * (time[k] - t0) / v[k];
-  EXPECT_NEAR(p[k], expect, 0.1 * expect);
-  EXPECT_LT(p[k], expect);  // the hole grows as it is pressurised: never above the rigid-hole value
+  // V0: the hole before any pressure (the first injection row is one interval in; extrapolate
+  // from the first two rows, where V grows linearly with p).
+  const double v0 = v[first] - (v[first + 1] - v[first]) / (p[first + 1] - p[first]) * p[first];
+  const double pumped = Q * (time[k] - t0), stored = v[k] * p[k] / K + (v[k] - v0);
+  EXPECT_NEAR(stored, pumped, 0.03 * pumped);
+  EXPECT_GT(v[k], v0);                          // the hole grows under pressure
+  EXPECT_LT(p[k], K * Q * (time[k] - t0) / v0);  // so the pressure stays below the rigid-hole value
 }
 
 // Natural fractures from the generator and from a file cut bonds; a joint through the hole's
@@ -315,11 +309,12 @@ TEST(Hydrofrac, CheckRefusesBadInputNamingTheKey) {
 }
 
 // A run stopped by --max-steps during the injection and resumed gives the same files, bit for
-// bit, as one run through (sleeve, wetted cracks and breakdown bookkeeping survive).
+// bit, as one run through (sleeve, wetted cracks and breakdown bookkeeping survive; penetration
+// on, so the wetted-crack list is in the checkpoint too).
 TEST(Hydrofrac, ResumeAfterMaxStepsIsBitIdentical) {
   Scratch s;
   const fs::path file = s.write("block.toml", kBlock);
-  for (const std::string sets : {std::string(), std::string(" --set injection.penetration=true")}) {
+  for (const std::string sets : {std::string(" --set injection.penetration=true")}) {
     const fs::path whole = s / "whole", parts = s / "parts";
     fs::remove_all(whole);
     fs::remove_all(parts);
