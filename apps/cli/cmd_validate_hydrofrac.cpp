@@ -1,0 +1,230 @@
+// `fracflow validate-hydrofrac`: the breakdown pressure of the hydrofrac driver over a sweep of
+// sigma_h against Hubbert & Willis (1957) and Haimson & Fairhurst (1967), as one command. It
+// measures the rock's tensile strength with the direct-tension driver on the same material,
+// runs the borehole block at each sigma_h with the sleeve (non-penetrating) and with
+// penetration, and writes docs/validation/hydrofrac.md (src/drivers/hydrofrac/breakdown_theory.hpp)
+// with a figure. Every run is an ordinary results folder under --out.
+#include <fmt/chrono.h>
+#include <fmt/format.h>
+#include <sys/utsname.h>
+
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <memory>
+
+#include "batch/run_case.hpp"
+#include "commands.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "drivers/hydrofrac/breakdown_theory.hpp"
+#include "io/plot.hpp"
+
+namespace fs = std::filesystem;
+using namespace ff;
+
+namespace {
+
+struct Args {
+  std::string out = "runs/validate_hydrofrac", doc = "docs/validation/hydrofrac.md";
+  std::vector<double> sigma_h = {1e6, 2e6, 3e6, 4e6};
+  double sigma_H = 4e6;
+  double width = 30e-3, radius_min = 0.3e-3, radius_max = 0.45e-3, hole = 3.5e-3, ramp = 2e10;
+  int seed = 1, threads = 1;
+  bool overwrite = false;
+};
+
+// The coal-matrix material of the UCS/Brazilian examples (examples/ucs_2d.toml), 2D.
+const char* kMaterial = R"(
+[dem]
+dim = 2
+bond_law = "parallel"
+[dem.group.matrix]
+density = 1390
+[dem.contact.matrix-matrix]
+emod = 2.09e9
+kratio = 14.65
+friction = 0.4
+[dem.bond.matrix-matrix]
+emod = 2.09e9
+kratio = 14.65
+tensile_strength = 17.4e6
+cohesion = 17.4e6
+friction_angle = 4.0
+[output]
+vtk = false
+progress_interval = 0
+)";
+
+std::string block_scenario(const Args& a) {
+  return fmt::format(R"(driver = "hydrofrac"
+title = "validate-hydrofrac block"
+{}
+[sample]
+shape = "box"
+width = {}
+height = {}
+radius_min = {}
+radius_max = {}
+porosity = 0.2
+bond_gap = {}
+seed = {}
+[borehole]
+radius = {}
+[insitu]
+sigma_H = {}
+sigma_h = {}
+[injection]
+ramp_rate = {}
+)",
+                     kMaterial, a.width, a.width, a.radius_min, a.radius_max, a.radius_min / 2, a.seed, a.hole, a.sigma_H,
+                     0.5 * a.sigma_H, a.ramp);
+}
+
+// A bar 14 x 28 grains-scaled like the block's grains (the Brazilian tests' bar at 0.4-0.6 mm).
+std::string tension_scenario(const Args& a) {
+  const double r = 0.5 * (a.radius_min + a.radius_max);
+  return fmt::format(R"(driver = "direct_tension"
+title = "validate-hydrofrac: tensile strength of the block's material"
+{}
+[sample]
+shape = "box"
+width = {}
+height = {}
+radius_min = {}
+radius_max = {}
+porosity = 0.2
+bond_gap = {}
+seed = {}
+[direct_tension]
+grip_velocity = 0.1
+)",
+                     kMaterial, 28 * r, 56 * r, a.radius_min, a.radius_max, a.radius_min / 2, a.seed);
+}
+
+void write_text(const fs::path& f, const std::string& t) {
+  std::ofstream o(f);
+  o << t;
+  if (!o) throw Error(fmt::format("cannot write '{}'", f.string()));
+}
+
+nlohmann::json run_one(const fs::path& scenario, const std::vector<std::string>& sets, const fs::path& dir, int threads) {
+  batch::InProcessRun r;
+  r.out_dir = dir;
+  r.threads = threads;
+  log::info("validate-hydrofrac: running {}", dir.string());
+  batch::run_in_process(scenario.string(), sets, r);
+  std::ifstream f(dir / "summary.json");
+  return nlohmann::json::parse(f);
+}
+
+double number_or_nan(const nlohmann::json& j) { return j.is_number() ? j.get<double>() : std::numeric_limits<double>::quiet_NaN(); }
+
+int run_validate(const Args& a) {
+  const fs::path out = a.out;
+  if (fs::exists(out)) {
+    if (!a.overwrite) throw InputError(fmt::format("'{}' exists; pass --overwrite to replace it", out.string()));
+    fs::remove_all(out);
+  }
+  fs::create_directories(out);
+  const fs::path block = out / "block.toml", tension = out / "tension.toml";
+  write_text(block, block_scenario(a));
+  write_text(tension, tension_scenario(a));
+  const auto jt = run_one(tension, {}, out / "tension", a.threads);
+  if (!jt["tensile_strength_Pa"].is_number())
+    throw Error(fmt::format("the direct-tension run in {} found no tensile strength", (out / "tension").string()));
+  drivers::hydrofrac::SweepContext ctx;
+  ctx.tensile_strength = jt["tensile_strength_Pa"];
+  ctx.tension_run = fmt::format("`{}`, {} disks", (out / "tension").generic_string(), jt["sample"]["particles"].dump());
+  std::vector<drivers::hydrofrac::BreakdownPoint> pts;
+  for (double sh : a.sigma_h) {
+    drivers::hydrofrac::BreakdownPoint p;
+    p.sigma_H = a.sigma_H;
+    p.sigma_h = sh;
+    const std::vector<std::string> sets = {fmt::format("insitu.sigma_h={}", sh)};
+    const auto js = run_one(block, sets, out / fmt::format("sleeve_sh{:g}MPa", 1e-6 * sh), a.threads);
+    p.sleeve_breakdown = number_or_nan(js["breakdown"]["pressure_Pa"]);
+    p.sleeve_initiation = number_or_nan(js["breakdown"]["initiation_pressure_Pa"]);
+    p.sleeve_azimuth_deg = js["breakdown"].contains("fracture") ? number_or_nan(js["breakdown"]["fracture"]["azimuth_deg"])
+                                                               : std::numeric_limits<double>::quiet_NaN();
+    p.particles = js["sample"]["particles"];
+    p.wall_time_s = js["wall_time_s"];
+    auto sets_p = sets;
+    sets_p.push_back("injection.penetration=true");
+    const auto jp = run_one(block, sets_p, out / fmt::format("penetration_sh{:g}MPa", 1e-6 * sh), a.threads);
+    p.penetrating_breakdown = number_or_nan(jp["breakdown"]["pressure_Pa"]);
+    p.wall_time_s += number_or_nan(jp["wall_time_s"]);
+    pts.push_back(p);
+  }
+  // The figure: DEM points and both theories against sigma_h.
+  const fs::path doc = a.doc;
+  const fs::path images = doc.parent_path() / "images";
+  fs::create_directories(images);
+  {
+    std::ofstream c(out / "breakdown.csv");
+    c << "sigma_h_Pa,initiation_sleeve_Pa,breakdown_sleeve_Pa,breakdown_penetration_Pa,hubbert_willis_Pa,"
+         "haimson_fairhurst_eta0_Pa\n";
+    for (const auto& p : pts)
+      c << p.sigma_h << "," << p.sleeve_initiation << "," << p.sleeve_breakdown << "," << p.penetrating_breakdown << ","
+        << drivers::hydrofrac::hubbert_willis(p.sigma_H, p.sigma_h, ctx.tensile_strength) << ","
+        << drivers::hydrofrac::haimson_fairhurst(p.sigma_H, p.sigma_h, ctx.tensile_strength, 0) << "\n";
+  }
+  PlotSpec spec;
+  spec.title = fmt::format("Breakdown pressure, sigma_H = {:g} MPa, T = {:.2f} MPa (measured)", 1e-6 * a.sigma_H,
+                           1e-6 * ctx.tensile_strength);
+  spec.x = "sigma_h_Pa";
+  spec.x_scale = 1e-6;
+  spec.xlabel = "sigma_h [MPa]";
+  spec.y = {"initiation_sleeve_Pa", "breakdown_sleeve_Pa", "breakdown_penetration_Pa", "hubbert_willis_Pa",
+            "haimson_fairhurst_eta0_Pa"};
+  spec.y_scale = 1e-6;
+  spec.ylabel = "borehole pressure [MPa]";
+  const bool figure = plot_series(out / "breakdown.csv", images / "hydrofrac_breakdown.png", spec);
+  const auto t = std::time(nullptr);
+  ctx.date = fmt::format("{:%Y-%m-%d %H:%M} UTC", fmt::gmtime(t));
+  utsname u{};
+  uname(&u);
+  ctx.machine = fmt::format("{} {}, {} thread(s)", u.sysname, u.machine, a.threads);
+  ctx.command = fmt::format("fracflow validate-hydrofrac --sigma-H {:g} --sigma-h {}", a.sigma_H, [&] {
+    std::string s;
+    for (double v : a.sigma_h) s += (s.empty() ? "" : ",") + fmt::format("{:g}", v);
+    return s;
+  }());
+  ctx.block = fmt::format("A {:.0f} mm square 2D block of about {} bonded disks (radii {:.2f}-{:.2f} mm), the coal-matrix "
+                          "micro-parameters of examples/ucs_2d.toml.",
+                          1e3 * a.width, pts.empty() ? 0L : pts.front().particles, 1e3 * a.radius_min, 1e3 * a.radius_max);
+  ctx.ramp_rate = a.ramp;
+  ctx.hole_radius = a.hole;
+  ctx.grain_radius = 0.5 * (a.radius_min + a.radius_max);
+  std::string text = drivers::hydrofrac::breakdown_report(pts, ctx);
+  if (figure) text += "\n![breakdown pressure against sigma_h](images/hydrofrac_breakdown.png)\n";
+  fs::create_directories(doc.parent_path().empty() ? fs::path(".") : doc.parent_path());
+  write_text(doc, text);
+  fmt::print("report in {}, runs in {}\n", doc.string(), out.string());
+  return 0;
+}
+
+const bool registered = ff::cli::register_command({"validate-hydrofrac", [](CLI::App& app) {
+  auto a = std::make_shared<Args>();
+  auto* sub = app.add_subcommand("validate-hydrofrac",
+                                 "breakdown pressures of a sweep over sigma_h against Hubbert-Willis and Haimson-Fairhurst "
+                                 "(tensile strength measured by direct tension); writes docs/validation/hydrofrac.md");
+  sub->add_option("--out,-o", a->out, "folder of all the runs")->capture_default_str();
+  sub->add_option("--doc", a->doc, "the markdown report to write (figure in its folder/images)")->capture_default_str();
+  sub->add_option("--sigma-h", a->sigma_h, "minimum horizontal stresses of the sweep [Pa]")->delimiter(',')->capture_default_str();
+  sub->add_option("--sigma-H", a->sigma_H, "maximum horizontal stress, fixed [Pa]")->check(CLI::PositiveNumber)->capture_default_str();
+  sub->add_option("--width", a->width, "block side [m]")->check(CLI::PositiveNumber)->capture_default_str();
+  sub->add_option("--radius-min", a->radius_min, "smallest grain radius [m]")->check(CLI::PositiveNumber)->capture_default_str();
+  sub->add_option("--radius-max", a->radius_max, "largest grain radius [m]")->check(CLI::PositiveNumber)->capture_default_str();
+  sub->add_option("--hole", a->hole, "borehole radius [m]")->check(CLI::PositiveNumber)->capture_default_str();
+  sub->add_option("--ramp", a->ramp, "pressure ramp rate [Pa/s]")->check(CLI::PositiveNumber)->capture_default_str();
+  sub->add_option("--seed", a->seed, "packing seed")->capture_default_str();
+  sub->add_option("--threads,-t", a->threads, "OpenMP threads per run")->check(CLI::PositiveNumber)->capture_default_str();
+  sub->add_flag("--overwrite", a->overwrite, "replace an existing --out folder");
+  return ff::cli::Command::Run([a] { return run_validate(*a); });
+}});
+
+}  // namespace
