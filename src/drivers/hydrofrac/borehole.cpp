@@ -189,9 +189,13 @@ std::vector<Index> index_of_ids(const dem::ParticleStore& p) {
 void connected_cracks(const dem::DemSystem& sys, const std::vector<Index>& id_index, const std::vector<Index>& wall,
                       const std::vector<JointPair>& joints, std::vector<std::size_t>& event, std::vector<std::size_t>& joint,
                       std::vector<char>& visited) {
-  visited.assign(sys.particles.size(), 0);
-  for (Index i : wall) visited[static_cast<std::size_t>(i)] = 1;
+  // One scratch array: the particles reached, then the edges walked (no allocation once it has
+  // grown to its size: the crack log is reserved for every bond).
   const auto& ev = sys.cracks.events;
+  const std::size_t np = sys.particles.size();
+  visited.assign(np + ev.size() + joints.size(), 0);
+  char* edge_done = visited.data() + np;
+  for (Index i : wall) visited[static_cast<std::size_t>(i)] = 1;
   auto idx = [&](std::int64_t id) -> Index {
     return id >= 0 && static_cast<std::size_t>(id) < id_index.size() ? id_index[static_cast<std::size_t>(id)] : -1;
   };
@@ -199,7 +203,6 @@ void connected_cracks(const dem::DemSystem& sys, const std::vector<Index>& id_in
   joint.clear();
   // Sweeps until nothing new is reached (a chain of n cracks needs at most n sweeps; the
   // cracks reached are then listed in log order, whatever the sweep that found them).
-  std::vector<char> edge_done(ev.size() + joints.size(), 0);
   for (bool grew = true; grew;) {
     grew = false;
     for (std::size_t k = 0; k < ev.size() + joints.size(); ++k) {

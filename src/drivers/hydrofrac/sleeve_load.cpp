@@ -20,6 +20,9 @@ void SleeveLoad::begin(const dem::DemSystem& sys, const BoreholeGeometry& hole, 
   id_index_ = index_of_ids(sys.particles);
   wetted_.clear();
   wetted_.reserve(sys.bonds.size() + joints_.size());
+  visited_.reserve(sys.particles.size() + sys.bonds.size() + joints_.size() + sys.cracks.events.size());
+  ev_.reserve(sys.bonds.size() + sys.cracks.events.size());
+  jt_.reserve(joints_.size());
   if (s_.penetration) find_wetted(sys);
 }
 
@@ -119,6 +122,9 @@ void SleeveLoad::load(CheckpointReader& r, const dem::DemSystem& sys) {
   r.get("sleeve.joints", joints_);
   r.get("sleeve.wetted", wetted_);
   wetted_.reserve(sys.bonds.size() + joints_.size() + wetted_.size());
+  visited_.reserve(sys.particles.size() + sys.bonds.size() + joints_.size() + sys.cracks.events.size());
+  ev_.reserve(sys.bonds.size() + sys.cracks.events.size());
+  jt_.reserve(joints_.size());
   id_index_ = index_of_ids(sys.particles);
 }
 
