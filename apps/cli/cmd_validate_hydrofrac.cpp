@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <sys/utsname.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <ctime>
@@ -33,7 +34,7 @@ struct Args {
   std::vector<double> sigma_h = {1e6, 2e6, 3e6, 4e6};
   double sigma_H = 4e6;
   double width = 30e-3, radius_min = 0.3e-3, radius_max = 0.45e-3, hole = 3.5e-3, ramp = 2e10;
-  int seed = 1, threads = 1;
+  int seed = 1, threads = 1, packings = 3;
   bool overwrite = false;
 };
 
@@ -144,19 +145,38 @@ int run_validate(const Args& a) {
     drivers::hydrofrac::BreakdownPoint p;
     p.sigma_H = a.sigma_H;
     p.sigma_h = sh;
-    const std::vector<std::string> sets = {fmt::format("insitu.sigma_h={}", sh)};
-    const auto js = run_one(block, sets, out / fmt::format("sleeve_sh{:g}MPa", 1e-6 * sh), a.threads);
-    p.sleeve_breakdown = number_or_nan(js["breakdown"]["pressure_Pa"]);
-    p.sleeve_initiation = number_or_nan(js["breakdown"]["initiation_pressure_Pa"]);
-    p.sleeve_azimuth_deg = js["breakdown"].contains("fracture") ? number_or_nan(js["breakdown"]["fracture"]["azimuth_deg"])
-                                                               : std::numeric_limits<double>::quiet_NaN();
-    p.particles = js["sample"]["particles"];
-    p.wall_time_s = js["wall_time_s"];
-    auto sets_p = sets;
-    sets_p.push_back("injection.penetration=true");
-    const auto jp = run_one(block, sets_p, out / fmt::format("penetration_sh{:g}MPa", 1e-6 * sh), a.threads);
-    p.penetrating_breakdown = number_or_nan(jp["breakdown"]["pressure_Pa"]);
-    p.wall_time_s += number_or_nan(jp["wall_time_s"]);
+    p.packings = a.packings;
+    std::vector<double> init, bd, pen;
+    for (int k = 0; k < a.packings; ++k) {
+      const std::vector<std::string> sets = {fmt::format("insitu.sigma_h={}", sh), fmt::format("sample.seed={}", a.seed + k)};
+      const auto js = run_one(block, sets, out / fmt::format("sleeve_sh{:g}MPa_seed{}", 1e-6 * sh, a.seed + k), a.threads);
+      bd.push_back(number_or_nan(js["breakdown"]["pressure_Pa"]));
+      init.push_back(number_or_nan(js["breakdown"]["initiation_pressure_Pa"]));
+      if (k == 0) {
+        p.sleeve_azimuth_deg = js["breakdown"].contains("fracture") ? number_or_nan(js["breakdown"]["fracture"]["azimuth_deg"])
+                                                                   : std::numeric_limits<double>::quiet_NaN();
+        p.particles = js["sample"]["particles"];
+        p.wall_time_s = js["wall_time_s"];
+      }
+      auto sets_p = sets;
+      sets_p.push_back("injection.penetration=true");
+      const auto jp = run_one(block, sets_p, out / fmt::format("penetration_sh{:g}MPa_seed{}", 1e-6 * sh, a.seed + k), a.threads);
+      pen.push_back(number_or_nan(jp["breakdown"]["pressure_Pa"]));
+      if (k == 0) p.wall_time_s += number_or_nan(jp["wall_time_s"]);
+    }
+    // Means (NaN when a packing found no breakdown: the point is then not fitted) and ranges.
+    auto mean = [](const std::vector<double>& v) {
+      double s = 0;
+      for (double x : v) s += x;
+      return s / static_cast<double>(v.size());
+    };
+    auto range = [](const std::vector<double>& v) { return *std::max_element(v.begin(), v.end()) - *std::min_element(v.begin(), v.end()); };
+    p.sleeve_initiation = mean(init);
+    p.sleeve_breakdown = mean(bd);
+    p.penetrating_breakdown = mean(pen);
+    p.initiation_range = range(init);
+    p.breakdown_range = range(bd);
+    p.penetrating_range = range(pen);
     pts.push_back(p);
   }
   // The figure: DEM points and both theories against sigma_h.
@@ -188,7 +208,7 @@ int run_validate(const Args& a) {
   utsname u{};
   uname(&u);
   ctx.machine = fmt::format("{} {}, {} thread(s)", u.sysname, u.machine, a.threads);
-  ctx.command = fmt::format("fracflow validate-hydrofrac --sigma-H {:g} --sigma-h {}", a.sigma_H, [&] {
+  ctx.command = fmt::format("fracflow validate-hydrofrac --packings {} --sigma-H {:g} --sigma-h {}", a.packings, a.sigma_H, [&] {
     std::string s;
     for (double v : a.sigma_h) s += (s.empty() ? "" : ",") + fmt::format("{:g}", v);
     return s;
@@ -221,7 +241,10 @@ const bool registered = ff::cli::register_command({"validate-hydrofrac", [](CLI:
   sub->add_option("--radius-max", a->radius_max, "largest grain radius [m]")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--hole", a->hole, "borehole radius [m]")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--ramp", a->ramp, "pressure ramp rate [Pa/s]")->check(CLI::PositiveNumber)->capture_default_str();
-  sub->add_option("--seed", a->seed, "packing seed")->capture_default_str();
+  sub->add_option("--seed", a->seed, "first packing seed")->capture_default_str();
+  sub->add_option("--packings", a->packings, "packings (seeds) per sigma_h; the report gives their mean and range")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   sub->add_option("--threads,-t", a->threads, "OpenMP threads per run")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_flag("--overwrite", a->overwrite, "replace an existing --out folder");
   return ff::cli::Command::Run([a] { return run_validate(*a); });

@@ -57,21 +57,23 @@ std::string breakdown_report(const std::vector<BreakdownPoint>& pts, const Sweep
                  "it lies between (3 sigma_h - sigma_H + T)/2 (eta = 0) and Hubbert-Willis (eta = 0.5). Both give a "
                  "slope of 3 (H&W) or 3/(2 - 2 eta) against sigma_h at fixed sigma_H.\n\n");
   fmt::format_to(out, "| sigma_H [MPa] | sigma_h [MPa] | initiation (sleeve) | breakdown (sleeve) | breakdown (penetration) | "
-                      "H&W | H&F, eta = 0 | fracture azimuth (sleeve) [deg] | particles | wall time [s] |\n");
-  fmt::format_to(out, "|---|---|---|---|---|---|---|---|---|---|\n");
+                      "H&W | H&F, eta = 0 | fracture azimuth (sleeve) [deg] | particles | wall time [s] | packings | range: initiation / "
+                      "breakdown / penetration |\n");
+  fmt::format_to(out, "|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   std::vector<Real> x, yi, yb, yp;
   for (const auto& p : pts) {
-    fmt::format_to(out, "| {} | {} | {} | {} | {} | {} | {} | {:.1f} | {} | {:.1f} |\n", mpa(p.sigma_H), mpa(p.sigma_h),
-                   mpa(p.sleeve_initiation), mpa(p.sleeve_breakdown), mpa(p.penetrating_breakdown),
+    fmt::format_to(out, "| {} | {} | {} | {} | {} | {} | {} | {:.1f} | {} | {:.1f} | {} | {} / {} / {} |\n", mpa(p.sigma_H),
+                   mpa(p.sigma_h), mpa(p.sleeve_initiation), mpa(p.sleeve_breakdown), mpa(p.penetrating_breakdown),
                    mpa(hubbert_willis(p.sigma_H, p.sigma_h, T)), mpa(haimson_fairhurst(p.sigma_H, p.sigma_h, T, 0)),
-                   p.sleeve_azimuth_deg, p.particles, p.wall_time_s);
+                   p.sleeve_azimuth_deg, p.particles, p.wall_time_s, p.packings, mpa(p.initiation_range),
+                   mpa(p.breakdown_range), mpa(p.penetrating_range));
     x.push_back(p.sigma_h);
     yi.push_back(p.sleeve_initiation);
     yb.push_back(p.sleeve_breakdown);
     yp.push_back(p.penetrating_breakdown);
   }
   const Real sH = pts.empty() ? 0 : pts.front().sigma_H;
-  fmt::format_to(out, "\nPressures in MPa. Straight lines P = slope x sigma_h + offset through the points:\n\n");
+  fmt::format_to(out, "\nPressures in MPa (means over the packings; azimuth and wall time: the first packing's). Straight lines P = slope x sigma_h + offset through the points:\n\n");
   fmt::format_to(out, "| series | slope | offset [MPa] | R^2 | theory slope | theory offset [MPa] |\n|---|---|---|---|---|---|\n");
   auto line = [&](const char* name, const std::vector<Real>& y, Real ts, Real to) {
     const LineFit f = fit_line(x, y);

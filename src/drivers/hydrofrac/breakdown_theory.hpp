@@ -31,6 +31,9 @@ struct BreakdownPoint {
   Real sleeve_azimuth_deg = 0;
   long particles = 0;
   Real wall_time_s = 0;
+  // Over the packings of the point (the pressures above are their means): max - min [Pa].
+  int packings = 1;
+  Real initiation_range = 0, breakdown_range = 0, penetrating_range = 0;
 };
 struct SweepContext {
   Real tensile_strength = 0;      // measured by the direct-tension driver [Pa]
