@@ -1,0 +1,36 @@
+// `fracflow validate-hydrofrac` end to end on a small sweep (2 values of sigma_h, one packing,
+// the unit tests' 560-disk block): it measures T by direct tension, runs the four blocks and
+// writes the report with the table, both fits and the figure's CSV.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "../../unit/program_runner.hpp"
+
+namespace fs = std::filesystem;
+
+TEST(ValidateHydrofrac, SmallSweepWritesTheReport) {
+  ff::test::TestScratch s("validate-hydrofrac");
+  const fs::path doc = s / "doc" / "hydrofrac.md", out = s / "runs";
+  const auto r = ff::test::run_program("validate-hydrofrac --out " + out.string() + " --doc " + doc.string() +
+                                       " --packings 1 --sigma-h 1e6,4e6 --width 24e-3 --radius-min 0.4e-3 "
+                                       "--radius-max 0.6e-3 --hole 2.5e-3");
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::ifstream f(doc);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  const std::string text = ss.str();
+  for (const char* part : {"T = ", "| 4.00 | 1.00 |", "| 4.00 | 4.00 |", "initiation, sleeve (vs H&W)",
+                           "breakdown, penetration (vs H&F, eta = 0)", "Why the DEM differs"})
+    EXPECT_NE(text.find(part), std::string::npos) << part << "\n" << text;
+  EXPECT_TRUE(fs::exists(out / "tension" / "summary.json"));
+  EXPECT_TRUE(fs::exists(out / "breakdown.csv"));
+  // A second call refuses to overwrite without --overwrite, naming the folder.
+  const auto again = ff::test::run_program("validate-hydrofrac --out " + out.string() + " --doc " + doc.string() +
+                                           " --packings 1 --sigma-h 1e6");
+  EXPECT_NE(again.code, 0);
+  EXPECT_NE(again.output.find("--overwrite"), std::string::npos) << again.output;
+}
