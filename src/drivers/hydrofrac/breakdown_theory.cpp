@@ -87,20 +87,22 @@ std::string breakdown_report(const std::vector<BreakdownPoint>& pts, const Sweep
   line("breakdown, sleeve (vs H&W)", yb, 3, T - sH);
   line("breakdown, penetration (vs H&F, eta = 0)", yp, 1.5, 0.5 * (T - sH));
   fmt::format_to(out,
-                 "\n**Why the DEM differs.** (1) *Sample and grain size*: the hole is only a few grains across, so the "
-                 "wall's tensile stress concentration acts over a grain, not at a point; the wall fails when the hoop "
-                 "tension averaged over a grain-sized zone reaches the bonds' strength, which needs more pressure than "
-                 "the point criterion of Hubbert & Willis (the size effect of laboratory tests, where small holes break "
-                 "at higher pressures: Haimson & Zhao 1991). The offset carries this excess, the slope (the stress "
-                 "concentration of Kirsch's solution) is kept much better. (2) *Breakdown vs initiation*: under a "
-                 "pressure ramp the first broken bond is a grain-scale event; the breakdown defined here also needs the "
-                 "fracture to grow one radius, which a sleeve (no fluid in the crack) resists: the sleeve's load does not "
-                 "reach the crack tip. (3) *Fluid penetration* lowers the breakdown pressure, as Haimson & Fairhurst "
-                 "predict against Hubbert & Willis; the sleeve model's penetration is crack-face pressure only (no pore "
-                 "pressure, no poroelastic stress change), the eta = 0 end of their formula. (4) *Rate*: the ramp is "
-                 "quasi-static (a 4 times slower ramp changed the breakdown by 5%), and the block, finite and bounded "
-                 "by servo walls, is about 4-5 borehole radii wide, which raises the hoop stresses near the wall by a "
-                 "few per cent over Kirsch's infinite plate.\n");
+                 "\n**Why the DEM differs.** (1) *Sample and grain size*: the hole is only a few grains across. The "
+                 "wall's hoop tension is carried by a ring of grains, so it fails when the tension on a grain-sized zone, "
+                 "not at a point, exceeds what the bonds hold; Hubbert & Willis' point criterion predicts less (small "
+                 "laboratory holes also break at higher pressures: Haimson & Zhao 1991). The offsets carry this excess. "
+                 "(2) *Initiation* is the first broken bond at the wall: the weakest wall bonds of a packing, which break "
+                 "in the same places whatever sigma_h; a grain's own contacts shape its hoop load, so the initiation "
+                 "feels the far field less than Kirsch's continuum value (slope below 3) and scatters by a few MPa "
+                 "between packings. (3) *Breakdown* (the fracture one radius long) needs growth away from the wall, "
+                 "which a sleeve does not drive (no pressure on the crack faces): it is set by the far-field hoop "
+                 "concentration of Kirsch's solution around the hole, hence a slope close to 3 with a large offset. "
+                 "(4) *Fluid penetration* lowers the breakdown, as Haimson & Fairhurst predict against Hubbert & Willis; "
+                 "the sleeve model's penetration is crack-face pressure only (no pore pressure, no poroelastic stress "
+                 "change), the eta = 0 end of their formula (slope 1.5). (5) *Rate and boundaries*: the ramp is "
+                 "quasi-static (a 4 times slower ramp changed one breakdown pressure by 5%, docs/hydrofrac.md); the "
+                 "block is about 4 borehole radii from the hole's axis to its faces, held by servo walls, which raises "
+                 "the hoop stresses near the wall by a few per cent over Kirsch's infinite plate.\n");
   return s;
 }
 
