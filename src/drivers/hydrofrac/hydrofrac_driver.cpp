@@ -849,7 +849,9 @@ void HydrofracRun::plots() {
 }
 
 RunStatus run(const Config& cfg, const RunOptions& opt) {
-  validate(cfg);
+  // On resume the scenario is the results folder's copy: files it names (dfn.file) are relative
+  // to the original scenario's folder, and the block is in the checkpoint.
+  if (!opt.resume) validate(cfg);
   return HydrofracRun(cfg, opt).run();
 }
 

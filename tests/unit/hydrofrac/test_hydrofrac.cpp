@@ -287,6 +287,14 @@ TEST(Hydrofrac, NaturalFracturesCutBonds) {
   const auto f = run_scenario(file, s / "file", " --set dfn.file=\"joints.csv\" --set injection.max_pressure=5e6");
   EXPECT_GT(f["borehole"]["natural_fracture_bonds"].get<long>(), 0);
   EXPECT_LT(f["borehole"]["natural_fracture_bonds"].get<long>(), g["borehole"]["natural_fracture_bonds"].get<long>());
+  // A run with a DFN file resumes from its results folder (the file is not read again).
+  const fs::path parts = s / "file_parts";
+  auto r = fracflow("run " + file.string() + " --out " + parts.string() +
+                    " -q -j1 --max-steps 1500 --set dfn.file=\"joints.csv\" --set injection.max_pressure=5e6");
+  ASSERT_EQ(r.code, 0) << r.output;
+  r = fracflow("resume " + parts.string() + " -q -j1");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(ff::test::read_json(parts / "summary.json")["borehole"], f["borehole"]);
 }
 
 // `check` refuses what `run` refuses, naming the key.
