@@ -156,6 +156,7 @@ Geometry validate_geometry(const Config& cfg) {
 void validate(const Config& cfg) {
   validate_geometry(cfg);
   const auto sc = coupling::derive_scales(fluid_spec(cfg));  // throws InputError naming fluid.*
+  log::info("{}", sc.describe());  // `fracflow check` shows the derived step, sound speed, K_eff and Mach number
   for (auto& w : sc.warnings) log::warn("{}", w);
 }
 
@@ -326,7 +327,6 @@ RunStatus SedimentationRun<L, T>::run() {
   RunControl control(cfg_, opt_);
   build();
   const std::size_t np = dem_.particles.size();
-  log::info("{}", sc_.describe());
   log::info("lattice {} {} x {} x {} cells ({}), {} particles; DEM step {:.4g} s, {} DEM sub-steps per LBM step",
             L::name, geo_.n[0], geo_.n[1], geo_.n[2], sizeof(T) == 8 ? "double" : "float", np, cpl_->dem_dt(),
             cpl_->sub_steps());
