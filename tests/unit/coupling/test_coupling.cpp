@@ -289,3 +289,57 @@ TEST(Coupler, OneAndTwoThreadsIdentical) {
   for (std::size_t k = 0; k < a.size(); ++k)
     for (int i = 0; i < 3; ++i) EXPECT_EQ(a[k][i], b[k][i]);
 }
+
+// The lattice part of the pressure through the PSM itself: a wall of overlapping disks (fixed)
+// across a closed 2D channel separates fluid at p0 + K_eff delta (left) from fluid at p0
+// (right); both sides are wet, so the load is the PSM's momentum exchange alone, and p0 cancels.
+// Expected (hydrostatics): F_x = K_eff (rho_L - rho_R) H, H the channel height, per metre of depth.
+// DISABLED: it fails, and the failure is a finding about the PSM (src/lbm/psm.cpp, not this
+// module), left for its owner: the force on the wall decays to ~1% of K_eff (rho_L - rho_R) H
+// within 3000 steps (t = 300: 0.0044 N/m, 1500: 3.9e-4, 2700: 3.7e-5; expected 2.8e-3 N/m from the
+// densities then, 1.001244 | 1.000777) while the pressure difference stays: the fully covered
+// cells (B = 1) keep their own density profile and carry the jump in their populations' momentum
+// flux (rho 1.00232 ... 0.99969 across the wall), with a slow leak (u_x ~ 3e-7). Same with
+// tau 0.6, and walls 2-6 cells thick. docs/coupling.md, "Known limitation".
+TEST(Coupler, DISABLED_PressureDifferenceAcrossParticleWallThroughPsm) {
+  FluidSpec fs;
+  fs.density = 1000;
+  fs.viscosity = 1e-4;
+  fs.dx = 1e-3;
+  fs.tau = 0.9;
+  fs.background_pressure = 5e6;
+  const FluidScales sc = derive_scales(fs);
+  const int nx = 48, ny = 32, xw = 24;
+  const double delta = 0.002;
+  auto fluid = make_fluid<lbm::D2Q9>(sc, nx, ny, 1, {false, false, true});
+  for (int f = 0; f < 4; ++f) fluid.set_face(f, lbm::FaceCondition{});
+  fluid.finalize();
+  fluid.initialize([&](int x, int, int, double& rho, Vec3& u) {
+    rho = x < xw ? 1 + delta : 1;
+    u = Vec3::Zero();
+  });
+  auto dem = free_particles(2, 2600);
+  const double dx = fs.dx;
+  for (int k = 0; k <= 8; ++k) add_particle(dem, Vec3((xw + 0.5) * dx, (0.5 + 4.0 * k) * dx, 0), 4 * dx);
+  dem.settings.dt = sc.dt();
+  dem.initialise();
+  for (std::size_t i = 0; i < dem.particles.size(); ++i) dem.particles.inv_mass[i] = dem.particles.inv_inertia[i] = 0;
+  CouplerSettings cs;
+  cs.origin = Vec3(0.5 * dx, 0.5 * dx, 0);
+  cs.buoyancy = false;
+  DemLbmCoupler<lbm::D2Q9, double> c(dem, fluid, sc, cs);
+  double sum = 0;
+  int n = 0;
+  for (int t = 0; t < 3000; ++t) {
+    c.step(t == 2999);
+    if (t >= 2900) {
+      for (auto& f : c.hydro_force()) sum += f.x();
+      ++n;
+    }
+  }
+  // Expected from the densities the run ends with (the leak lowers the difference slowly).
+  const double F = sum / n, want = sc.bulk_modulus * (fluid.density(10, 16, 0) - fluid.density(40, 16, 0)) * ny * dx;
+  std::printf("particle wall between wet regions: F_x = %.6g N/m, K delta H = %.6g N/m, error %+.2e\n", F, want,
+              F / want - 1);
+  EXPECT_LT(std::abs(F / want - 1), 0.03);
+}
