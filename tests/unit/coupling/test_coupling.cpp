@@ -5,6 +5,7 @@
 #include <omp.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 
 #include "core/error.hpp"
@@ -290,18 +291,14 @@ TEST(Coupler, OneAndTwoThreadsIdentical) {
     for (int i = 0; i < 3; ++i) EXPECT_EQ(a[k][i], b[k][i]);
 }
 
-// The lattice part of the pressure through the PSM itself: a wall of overlapping disks (fixed)
-// across a closed 2D channel separates fluid at p0 + K_eff delta (left) from fluid at p0
-// (right); both sides are wet, so the load is the PSM's momentum exchange alone, and p0 cancels.
-// Expected (hydrostatics): F_x = K_eff (rho_L - rho_R) H, H the channel height, per metre of depth.
-// DISABLED: it fails, and the failure is a finding about the PSM (src/lbm/psm.cpp, not this
-// module), left for its owner: the force on the wall decays to ~1% of K_eff (rho_L - rho_R) H
-// within 3000 steps (t = 300: 0.0044 N/m, 1500: 3.9e-4, 2700: 3.7e-5; expected 2.8e-3 N/m from the
-// densities then, 1.001244 | 1.000777) while the pressure difference stays: the fully covered
-// cells (B = 1) keep their own density profile and carry the jump in their populations' momentum
-// flux (rho 1.00232 ... 0.99969 across the wall), with a slow leak (u_x ~ 3e-7). Same with
-// tau 0.6, and walls 2-6 cells thick. docs/coupling.md, "Known limitation".
-TEST(Coupler, DISABLED_PressureDifferenceAcrossParticleWallThroughPsm) {
+namespace {
+
+// A wall of overlapping disks (fixed, r = 4 cells, 4 cells apart) across a 2D channel closed at
+// x- and x+ separates fluid at p0 + K_eff delta (left) from fluid at p0 (right). The channel is
+// periodic in y (a wall of infinite extent) or bounded by no-slip walls that the end disks
+// overlap. Both sides are wet, so the load is the PSM's momentum exchange alone and p0 cancels.
+// Returns, every 300 steps, (t, force on the wall F_x, K_eff (rho_L - rho_R) H) per metre of depth.
+std::vector<std::array<double, 3>> wet_wall_load(bool channel_walls) {
   FluidSpec fs;
   fs.density = 1000;
   fs.viscosity = 1e-4;
@@ -310,17 +307,16 @@ TEST(Coupler, DISABLED_PressureDifferenceAcrossParticleWallThroughPsm) {
   fs.background_pressure = 5e6;
   const FluidScales sc = derive_scales(fs);
   const int nx = 48, ny = 32, xw = 24;
-  const double delta = 0.002;
-  auto fluid = make_fluid<lbm::D2Q9>(sc, nx, ny, 1, {false, false, true});
-  for (int f = 0; f < 4; ++f) fluid.set_face(f, lbm::FaceCondition{});
+  auto fluid = make_fluid<lbm::D2Q9>(sc, nx, ny, 1, {false, !channel_walls, true});
+  for (int f = 0; f < (channel_walls ? 4 : 2); ++f) fluid.set_face(f, lbm::FaceCondition{});
   fluid.finalize();
   fluid.initialize([&](int x, int, int, double& rho, Vec3& u) {
-    rho = x < xw ? 1 + delta : 1;
+    rho = x < xw ? 1.002 : 1;
     u = Vec3::Zero();
   });
   auto dem = free_particles(2, 2600);
   const double dx = fs.dx;
-  for (int k = 0; k <= 8; ++k) add_particle(dem, Vec3((xw + 0.5) * dx, (0.5 + 4.0 * k) * dx, 0), 4 * dx);
+  for (int k = 0; k < (channel_walls ? 9 : 8); ++k) add_particle(dem, Vec3((xw + 0.5) * dx, (0.5 + 4.0 * k) * dx, 0), 4 * dx);
   dem.settings.dt = sc.dt();
   dem.initialise();
   for (std::size_t i = 0; i < dem.particles.size(); ++i) dem.particles.inv_mass[i] = dem.particles.inv_inertia[i] = 0;
@@ -328,18 +324,53 @@ TEST(Coupler, DISABLED_PressureDifferenceAcrossParticleWallThroughPsm) {
   cs.origin = Vec3(0.5 * dx, 0.5 * dx, 0);
   cs.buoyancy = false;
   DemLbmCoupler<lbm::D2Q9, double> c(dem, fluid, sc, cs);
-  double sum = 0;
-  int n = 0;
-  for (int t = 0; t < 3000; ++t) {
-    c.step(t == 2999);
-    if (t >= 2900) {
-      for (auto& f : c.hydro_force()) sum += f.x();
-      ++n;
-    }
+  std::vector<std::array<double, 3>> out;
+  for (int t = 0; t <= 3000; ++t) {
+    const bool sample = t > 0 && t % 300 == 0;
+    c.step(sample);
+    if (!sample) continue;
+    double F = 0;
+    for (auto& f : c.hydro_force()) F += f.x();
+    // Densities of the start of the step, like the force (the PSM reads the same state).
+    out.push_back({double(t), F, sc.bulk_modulus * (fluid.density(10, 16, 0) - fluid.density(40, 16, 0)) * ny * dx});
   }
-  // Expected from the densities the run ends with (the leak lowers the difference slowly).
-  const double F = sum / n, want = sc.bulk_modulus * (fluid.density(10, 16, 0) - fluid.density(40, 16, 0)) * ny * dx;
-  std::printf("particle wall between wet regions: F_x = %.6g N/m, K delta H = %.6g N/m, error %+.2e\n", F, want,
-              F / want - 1);
-  EXPECT_LT(std::abs(F / want - 1), 0.03);
+  return out;
+}
+
+}  // namespace
+
+// The lattice part of the pressure through the PSM: the load on a particle wall between two wet
+// regions equals the physical pressure difference across it, F_x = (p_L - p_R) H (hydrostatics;
+// p = p0 + K_eff (rho_lb - 1), p0 = 5 MPa cancels). The PSM wall is permeable: mass diffuses
+// through the fully covered cells (N&T's solid operator keeps the equilibrium at the cell's own
+// density, which streams on), so the difference decays (about halving every 300 steps here); the
+// load follows it. Compared every 300 steps while the difference is above 5% of the initial one.
+// Tolerance 3%: acoustic ringing of the initial jump (period ~ 2 L / c_s = 80 steps) in the
+// two probe densities.
+TEST(Coupler, PressureDifferenceAcrossParticleWallThroughPsm) {
+  const auto s = wet_wall_load(false);
+  const double first = s.front()[2];
+  int checked = 0;
+  for (const auto& [t, F, want] : s) {
+    std::printf("wet wall, step %.0f: F_x = %.5g N/m, (p_L - p_R) H = %.5g N/m, error %+.2e\n", t, F, want,
+                F / want - 1);
+    if (want < 0.05 * first) continue;
+    EXPECT_LT(std::abs(F / want - 1), 0.03) << "step " << t;
+    ++checked;
+  }
+  EXPECT_GE(checked, 4);
+}
+
+// The same wall in a channel with no-slip walls that the end disks overlap. DISABLED: it fails,
+// and the failure is a finding about the PSM in boundary cells (src/lbm, not this module), left
+// for its owner: the load decays to ~1% of (p_L - p_R) H within 3000 steps (step 300: 0.0044
+// N/m; 2700: 3.7e-5, expected 2.8e-3 from the densities then, 1.001244 | 1.000777) while the
+// pressure difference stays (no leak equalises it, unlike the periodic case): the x-momentum goes
+// to the channel walls through the covered wall cells instead of the particles. Same with tau 0.6
+// and walls 2-6 cells thick. docs/coupling.md, "Known limitation".
+TEST(Coupler, DISABLED_PressureDifferenceAcrossParticleWallInWalledChannel) {
+  for (const auto& [t, F, want] : wet_wall_load(true)) {
+    std::printf("walled channel, step %.0f: F_x = %.5g N/m, (p_L - p_R) H = %.5g N/m\n", t, F, want);
+    EXPECT_LT(std::abs(F / want - 1), 0.03) << "step " << t;
+  }
 }
