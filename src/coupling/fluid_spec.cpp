@@ -18,7 +18,9 @@ FluidScales derive_scales(const FluidSpec& s) {
     throw InputError(fmt::format("{}: {}", key(k), what));
   };
   if (!(s.density > 0)) fail("density", fmt::format("must be positive (got {})", s.density));
-  if (!(s.viscosity > 0)) fail("viscosity", fmt::format("must be positive (got {})", s.viscosity));
+  if (s.dynamic_viscosity < 0) fail("dynamic_viscosity", fmt::format("must be positive (got {})", s.dynamic_viscosity));
+  if (s.dynamic_viscosity == 0 && !(s.viscosity > 0))
+    fail("viscosity", fmt::format("must be positive (got {})", s.viscosity));
   if (!(s.dx > 0)) fail("dx", fmt::format("the lattice spacing must be positive (got {})", s.dx));
   std::vector<const char*> set;
   if (s.tau != 0) set.push_back("tau");
@@ -33,7 +35,7 @@ FluidScales derive_scales(const FluidSpec& s) {
   FluidScales r;
   r.fixed_by = key(set[0]);
   double dt = 0;
-  const double nu = s.viscosity, dx = s.dx;
+  const double nu = s.dynamic_viscosity > 0 ? s.dynamic_viscosity / s.density : s.viscosity, dx = s.dx;
   if (s.tau != 0) {
     if (!(s.tau > 0.5)) fail("tau", fmt::format("must exceed 1/2 (got {})", s.tau));
     dt = (s.tau - 0.5) * dx * dx / (3.0 * nu);

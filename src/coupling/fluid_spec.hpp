@@ -20,7 +20,8 @@ namespace ff::coupling {
 
 struct FluidSpec {
   double density = 1000;        // rho_f [kg/m^3]
-  double viscosity = 1e-6;      // kinematic nu [m^2/s] (dynamic: nu = mu / rho_f)
+  double viscosity = 1e-6;      // kinematic nu [m^2/s]
+  double dynamic_viscosity = 0; // mu [Pa s]; when > 0 it replaces viscosity: nu = mu / rho_f
   double dx = 0;                // lattice spacing [m]
   // Exactly one of these fixes the LBM step (the others stay 0):
   double tau = 0;               // relaxation time: dt = (tau - 1/2) dx^2 / (3 nu)

@@ -68,6 +68,9 @@ void declare(ParamTable& t) {
   t.real("dem.damping_ratio", 0.3, "-", "normal viscous damping of contacts, fraction of critical").range(0, 1);
   t.real("dem.time_step_safety", 0.2, "-", "DEM step = this x the critical contact step (sub-cycled in the LBM step)")
       .open_range(0, 1);
+  t.real("dem.time_step", 0.0, "s",
+         "DEM step wanted (0: dem.time_step_safety x the critical step); either way it is rounded down to the LBM step / n")
+      .non_negative();
   t.real("run.end_time", 5.0, "s", "simulated time").positive();
   t.real("reference.terminal_velocity", 0.0, "m/s",
          "measured terminal velocity to compare with (summary.json: error of the largest settling speed; 0: none)")
@@ -81,8 +84,9 @@ int dim_of(const Config& cfg) { return cfg.string("lbm.lattice") == "D3Q19" ? 3 
 coupling::FluidSpec fluid_spec(const Config& cfg) {
   coupling::FluidSpec s;
   s.density = cfg.real("fluid.density");
-  s.viscosity = cfg.real("fluid.dynamic_viscosity") > 0 ? cfg.real("fluid.dynamic_viscosity") / s.density
-                                                       : cfg.real("fluid.viscosity");
+  s.viscosity = cfg.real("fluid.viscosity");
+  s.dynamic_viscosity = cfg.real("fluid.dynamic_viscosity");
+  const double nu = s.dynamic_viscosity > 0 ? s.dynamic_viscosity / s.density : s.viscosity;
   s.dx = cfg.real("lbm.dx");
   s.tau = cfg.real("fluid.tau");
   s.time_step = cfg.real("fluid.time_step");
@@ -94,7 +98,7 @@ coupling::FluidSpec fluid_spec(const Config& cfg) {
     const auto& r = cfg.real_list("particles.radius");
     const double a = *std::max_element(r.begin(), r.end()), g = cfg.real("box.gravity");
     const double drho = std::abs(cfg.real("particles.density") - s.density);
-    const double stokes = 2.0 / 9.0 * drho * g * a * a / (s.density * s.viscosity);
+    const double stokes = 2.0 / 9.0 * drho * g * a * a / (s.density * nu);
     s.reference_velocity = std::min(stokes, std::sqrt(2 * g * 2 * a));
   }
   return s;
@@ -153,8 +157,54 @@ Geometry validate_geometry(const Config& cfg) {
   return g;
 }
 
+// The particles, walls, contact law and DEM step (the checks `fracflow check` makes too).
+void build_dem(const Config& cfg, const Geometry& geo, dem::DemSystem& sys) {
+  const int d = geo.dim;
+  sys.settings.dim = d;
+  sys.settings.local_damping = 0;  // hydrodynamic loads must not be damped
+  sys.settings.gravity = -cfg.real("box.gravity") * (geo.dim == 3 ? Vec3::UnitZ() : Vec3::UnitY());
+  const double rmin = *std::min_element(geo.radius.begin(), geo.radius.end());
+  sys.settings.skin = 0.2 * rmin;
+  sys.materials.group_names = {"particle"};
+  sys.materials.density = {cfg.real("particles.density")};
+  dem::LinearContact::Params lc;
+  lc.emod = cfg.real("dem.contact_modulus");
+  lc.kratio = 1.5;
+  lc.fric = cfg.real("dem.friction");
+  sys.materials.contact_params<dem::LinearContact>() = {lc};
+  sys.materials.set_bond_law<dem::NoBond>();
+  sys.materials.normal_damping_ratio = cfg.real("dem.damping_ratio");
+  for (std::size_t i = 0; i < geo.centre.size(); ++i) {
+    sys.particles.resize(i + 1);
+    sys.particles.pos[i] = geo.centre[i];
+    sys.particles.radius[i] = geo.radius[i];
+    sys.particles.set_mass_from_density(i, sys.materials.density[0], d);
+  }
+  const auto& Lb = cfg.real_list("box.size");
+  for (int a = 0; a < d; ++a)
+    for (int side = 0; side < 2; ++side) {
+      dem::Wall w;
+      w.name = fmt::format("wall {}{}", "xyz"[a], side ? '+' : '-');
+      w.point = Vec3::Zero();
+      w.point[a] = side ? Lb[std::size_t(a)] : 0.0;
+      w.normal = Vec3::Zero();
+      w.normal[a] = side ? -1.0 : 1.0;
+      w.friction = cfg.real("dem.friction");
+      sys.walls.push_back(w);
+    }
+  sys.initialise();
+  const double dt_auto = coupling::coupled_dem_time_step(sys, cfg.real("dem.time_step_safety"));
+  const double dt_user = cfg.real("dem.time_step");
+  if (dt_user > dt_auto)
+    cfg.fail("dem.time_step", fmt::format("{:.4g} s is above the stable limit {:.4g} s (dem.time_step_safety {} x the "
+                                           "critical contact step); set 0 for automatic or a value <= {:.4g}",
+                                           dt_user, dt_auto, cfg.real("dem.time_step_safety"), dt_auto));
+  sys.settings.dt = dt_user > 0 ? dt_user : dt_auto;
+}
+
 void validate(const Config& cfg) {
-  validate_geometry(cfg);
+  dem::DemSystem probe;
+  build_dem(cfg, validate_geometry(cfg), probe);  // the DEM step against its stability limit
   const auto sc = coupling::derive_scales(fluid_spec(cfg));  // throws InputError naming fluid.*
   log::info("{}", sc.describe());  // `fracflow check` shows the derived step, sound speed, K_eff and Mach number
   for (auto& w : sc.warnings) log::warn("{}", w);
@@ -208,40 +258,7 @@ class SedimentationRun {
 template <class L, class T>
 void SedimentationRun<L, T>::build() {
   const int d = L::D;
-  dem_.settings.dim = d;
-  dem_.settings.local_damping = 0;  // hydrodynamic loads must not be damped
-  dem_.settings.gravity = -cfg_.real("box.gravity") * up();
-  const double rmin = *std::min_element(geo_.radius.begin(), geo_.radius.end());
-  dem_.settings.skin = 0.2 * rmin;
-  dem_.materials.group_names = {"particle"};
-  dem_.materials.density = {cfg_.real("particles.density")};
-  dem::LinearContact::Params lc;
-  lc.emod = cfg_.real("dem.contact_modulus");
-  lc.kratio = 1.5;
-  lc.fric = cfg_.real("dem.friction");
-  dem_.materials.contact_params<dem::LinearContact>() = {lc};
-  dem_.materials.set_bond_law<dem::NoBond>();
-  dem_.materials.normal_damping_ratio = cfg_.real("dem.damping_ratio");
-  for (std::size_t i = 0; i < geo_.centre.size(); ++i) {
-    dem_.particles.resize(i + 1);
-    dem_.particles.pos[i] = geo_.centre[i];
-    dem_.particles.radius[i] = geo_.radius[i];
-    dem_.particles.set_mass_from_density(i, dem_.materials.density[0], d);
-  }
-  const auto& Lb = cfg_.real_list("box.size");
-  for (int a = 0; a < d; ++a)
-    for (int side = 0; side < 2; ++side) {
-      dem::Wall w;
-      w.name = fmt::format("wall {}{}", "xyz"[a], side ? '+' : '-');
-      w.point = Vec3::Zero();
-      w.point[a] = side ? Lb[std::size_t(a)] : 0.0;
-      w.normal = Vec3::Zero();
-      w.normal[a] = side ? -1.0 : 1.0;
-      w.friction = cfg_.real("dem.friction");
-      dem_.walls.push_back(w);
-    }
-  dem_.initialise();
-  dem_.settings.dt = coupling::coupled_dem_time_step(dem_, cfg_.real("dem.time_step_safety"));
+  build_dem(cfg_, geo_, dem_);
   lbm::Grid g(d, geo_.n[0], geo_.n[1], geo_.n[2], {false, false, d == 2});
   lbm::SolverSettings s;
   s.tau = sc_.units.tau();

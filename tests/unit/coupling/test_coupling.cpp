@@ -56,6 +56,12 @@ TEST(FluidScales, FourWaysToTheSameStep) {
     EXPECT_NEAR(t.dt(), dt, 1e-12 * dt);
     EXPECT_NEAR(t.units.tau(), 0.8, 1e-12);
   }
+  // The dynamic viscosity instead of the kinematic one: the same step.
+  FluidSpec m = water(1e-3);
+  m.viscosity = 0;
+  m.dynamic_viscosity = 1e-3;
+  m.tau = 0.8;
+  EXPECT_NEAR(derive_scales(m).dt(), dt, 1e-12 * dt);
   // p = p0 + K (rho_lb - 1) and back.
   a.background_pressure = 2e7;
   const FluidScales p = derive_scales(a);

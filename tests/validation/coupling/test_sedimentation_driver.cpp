@@ -108,4 +108,5 @@ TEST(SedimentationDriver, BadInputNamesTheKey) {
   EXPECT_NE(message({"fluid.tau=0.8"}).find("fluid.tau"), std::string::npos);
   EXPECT_NE(message({"fluid.sound_speed=0", "fluid.bulk_modulus=2.2e9"}).find("too close to 1/2"), std::string::npos);
   EXPECT_NE(message({"lbm.dx=7e-4"}).find("lbm.dx"), std::string::npos);
+  EXPECT_NE(message({"dem.time_step=1e-3"}).find("dem.time_step"), std::string::npos);  // above the contact limit
 }
