@@ -9,6 +9,7 @@ namespace ff::porenet {
 namespace {
 void check(const Network2D& net, const Particles2D& p, std::span<const Real> pp, std::span<Real> fx,
            std::span<Real> fy) {
+  if (net.dim != 2) throw InputError("porenet: the B26-B28 grain forces are implemented for 2D networks only");
   const auto n = static_cast<std::size_t>(net.n_particles);
   if (p.x.size() != n || fx.size() != n || fy.size() != n || pp.size() != static_cast<std::size_t>(net.n_pores()))
     throw InputError(fmt::format("porenet: force arrays sized {} / {} / {} particles and {} pressures; the network "

@@ -269,6 +269,7 @@ Network2D build_network_2d(const Particles2D& p, const PairList& pairs, const Ne
 }
 
 void update_network_2d(Network2D& net, const Particles2D& p, const PairList& pairs) {
+  if (net.dim != 2) throw InputError("porenet: update_network_2d called on a 3D network");
   if (static_cast<Index>(p.x.size()) != net.n_particles)
     throw InputError(fmt::format("porenet: update with {} particles, network built with {}", p.x.size(),
                                  net.n_particles));
@@ -279,6 +280,11 @@ void update_network_2d(Network2D& net, const Particles2D& p, const PairList& pai
   const Index np = net.n_pores(), nc = net.n_channels();
 #pragma omp parallel for schedule(static)
   for (Index k = 0; k < np; ++k) pore_geometry(net, p, k);
+  Real mean_cell = 0;  // serial: a fixed-order sum
+  for (Index k = 0; k < np; ++k) mean_cell += net.pore_cell[k];
+  mean_cell /= static_cast<Real>(np);
+  const Real floor_v = net.params.min_void_relative * mean_cell;
+  for (Index k = 0; k < np; ++k) net.pore_void[k] = std::max(net.pore_void[k], floor_v);
 #pragma omp parallel for schedule(static)
   for (Index c = 0; c < nc; ++c) channel_geometry(net, p, pairs, c);
 }

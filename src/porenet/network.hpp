@@ -70,12 +70,18 @@ struct NetworkParams {
   B2Edge b2_edge = B2Edge::Gap;
   Real min_aperture = 0;         // floor for every channel [m]
   Real min_void_fraction = 0.01;  // floor on a pore's void / triangle area (overlapping discs)
+  // Floor on a pore's void relative to the mean cell volume: hull slivers (near-zero area or
+  // volume) would otherwise set the explicit step and drown in the implicit solver's residual.
+  Real min_void_relative = 1e-3;
+  Real max_cond_ratio = 100;  // 3D: throat conductance <= this x the median (cf. YADE maxKdivKmean)
 };
 
-// The network. Pore k has corners pore_v[3k..3k+2] (particle indices, counter-clockwise).
-// Channel c joins pores ch_pore[2c] < ch_pore[2c+1] across the edge of particles
-// ch_part[2c], ch_part[2c+1].
+// The network. In 2D pore k has corners pore_v[3k..3k+2] (particle indices, counter-clockwise) and
+// channel c joins pores ch_pore[2c] < ch_pore[2c+1] across the edge of particles ch_part[2c],
+// ch_part[2c+1]. In 3D (build_network_3d) pores are tetrahedra with corners pore_v[4k..4k+3], channels
+// are the throats through shared facets and ch_part, ch_edge, ch_sin_omega, pw_* and pp_* are empty.
 struct Network2D {
+  int dim = 2;
   NetworkParams params;
   Index n_particles = 0;
   // pores
@@ -83,7 +89,7 @@ struct Network2D {
   std::vector<Real> pore_area;    // triangle area [m^2]
   std::vector<Real> pore_cell;    // cell volume = area * t [m^3]
   std::vector<Real> pore_void;    // void volume V_i [m^3] (area minus disc sectors, times t)
-  std::vector<Real> pore_cx, pore_cy;  // centroid [m]
+  std::vector<Real> pore_cx, pore_cy, pore_cz;  // centroid [m] (pore_cz: 3D only)
   std::vector<std::uint8_t> pore_hull;  // 1 if one of its edges is on the convex hull
   // channels
   std::vector<Index> ch_pore, ch_part;
@@ -104,6 +110,8 @@ struct Network2D {
   Index n_pairs = 0;          // size of the PairList the network was built with
   Index unmatched_pairs = 0;  // pairs of the list that are not Delaunay edges (no channel)
 
+  Index hidden_particles = 0;  // 3D regular triangulation: spheres with an empty power cell (no pore)
+
   Index n_pores() const { return static_cast<Index>(pore_area.size()); }
   Index n_channels() const { return static_cast<Index>(ch_length.size()); }
 };
@@ -118,7 +126,24 @@ Network2D build_network_2d(const Particles2D& particles, const PairList& pairs,
 // network was built with (same order), with updated sigma_n / opening / state.
 void update_network_2d(Network2D& net, const Particles2D& particles, const PairList& pairs);
 
+// Particles as SoA spans in 3D.
+struct Particles3D {
+  std::span<const Real> x, y, z, radius;
+  std::span<const std::int64_t> gid;
+};
+
+// 3D network, PFV style (Chareyre et al. 2012, Transp. Porous Media 94:595; METHODS.md §5.1–5.3a):
+// regular (weighted, w = R^2) Delaunay triangulation of the sphere centres (CGAL
+// Regular_triangulation_3); pores = tetrahedra with void V = V_tet - sum_k Omega_k R_k^3 / 3 (solid
+// angles); throats = shared facets with fluid area A_f = A - sum_k theta_k R_k^2 / 2, hydraulic radius
+// R_h = A_f / (sum_k theta_k R_k) (the facet's wetted perimeter: a 2D simplification of PFV's
+// volume/surface ratio) and conductance g = pfv_factor A_f R_h^2 / (2 mu L) (ch_cond = g mu),
+// L the centroid distance. Contacts/bonds do not form extra channels in 3D (not yet).
+Network2D build_network_3d(const Particles3D& particles, const NetworkParams& params = {}, Real pfv_factor = 1.0);
+
 // Eq. B1 aperture for a contact/bond channel (+ opening for a broken bond).
 Real aperture_b1(const NetworkParams& p, PairState state, Real sigma_n, Real opening);
+
+using Network = Network2D;
 
 }  // namespace ff::porenet

@@ -32,6 +32,7 @@ StratifiedRates stratified_channel_flow(Real G, Real hq, Real hp, Real muq, Real
 
 TwoPhaseFlow::TwoPhaseFlow(const Network2D& net, const TwoPhaseParams& params)
     : net_(net), prm_(params), np_(net.n_pores()), nc_(net.n_channels()) {
+  if (net.dim != 2) throw InputError("porenet: two-phase flow (stratified slit channels, B3-B7) needs a 2D network");
   if (!(params.mu_liquid > 0 && params.mu_gas > 0))
     throw InputError(fmt::format("porenet: viscosities must be > 0 (liquid {}, gas {} Pa s)", params.mu_liquid,
                                  params.mu_gas));
