@@ -81,6 +81,18 @@ void SinglePhaseFlow::set_bc(Index pore, PoreBc kind, Real value) {
     if (bc_[i] == PoreBc::Pressure) bc_pressure_pores_.push_back(i);
 }
 
+void SinglePhaseFlow::load_masses(std::span<const Real> m) {
+  if (m.size() != static_cast<std::size_t>(np_))
+    throw InputError(fmt::format("porenet: {} masses for a network of {} pores", m.size(), np_));
+  v_.assign(net_.pore_void.begin(), net_.pore_void.end());
+  for (Index i = 0; i < np_; ++i) {
+    m_[i] = m[i];
+    p_[i] = pressure_from_mass(i, m_[i], p_[i]);
+    v_[i] = void_at(i, p_[i]);
+    rho_[i] = m_[i] / v_[i];
+  }
+}
+
 Real SinglePhaseFlow::void_at(Index i, Real p) const {
   if (prm_.matrix_modulus <= 0) return net_.pore_void[i];
   return v0_[i] - net_.pore_cell[i] * (sigma_ - p - sigma_eff0_) / prm_.matrix_modulus;

@@ -57,6 +57,9 @@ class SinglePhaseFlow {
   void set_bc(Index pore, PoreBc kind, Real value);
   void set_total_stress(Real sigma) { sigma_ = sigma; }
 
+  // Replaces the pore masses (after a remeshing) and recomputes pressures and densities.
+  void load_masses(std::span<const Real> m);
+
   Real stable_dt() const;
   void step_explicit(Real dt);
   void step_implicit(Real dt);

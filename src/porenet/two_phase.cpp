@@ -70,6 +70,22 @@ void TwoPhaseFlow::set_bc(Index pore, PoreBc kind, Real value, Real alpha_bc) {
   if (kind == PoreBc::Pressure) set_pore_state(pore, value, alpha_bc);
 }
 
+void TwoPhaseFlow::load_masses(std::span<const Real> mq, std::span<const Real> mp) {
+  if (mq.size() != static_cast<std::size_t>(np_) || mp.size() != static_cast<std::size_t>(np_))
+    throw InputError(fmt::format("porenet: {} / {} phase masses for a network of {} pores", mq.size(), mp.size(), np_));
+  for (Index i = 0; i < np_; ++i) {
+    mq_[i] = mq[i];
+    mp_[i] = mp[i];
+    const Real V = net_.pore_void[i];
+    Real p;
+    const Real a = solve_shared_pressure(mq_[i], mp_[i], V, 0.5, p);
+    alpha_[i] = a;
+    p_[i] = p;
+    rq_[i] = a > 0 ? mq_[i] / (a * V) : prm_.liquid.density(p > 0 ? p : 1.0, true);
+    rp_[i] = a < 1 ? mp_[i] / ((1 - a) * V) : prm_.gas.density(p > 0 ? p : 1.0, false);
+  }
+}
+
 Real TwoPhaseFlow::solve_shared_pressure(Real mq, Real mp, Real V, Real a0, Real& p) const {
   const Eos& L = prm_.liquid;
   const Eos& Gs = prm_.gas;

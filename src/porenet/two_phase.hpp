@@ -52,6 +52,9 @@ class TwoPhaseFlow {
 
   // Explicit limit: min over pores of the pressure-diffusion bound V (alpha/K_q + (1-alpha)/K_p) / sum_j lambda_ij
   // (lambda the channel's total volumetric mobility) and of the transport bound m / outflow per phase.
+  // Replaces the phase masses (after a remeshing); solves B23 for every pore.
+  void load_masses(std::span<const Real> mq, std::span<const Real> mp);
+
   Real stable_dt();
   void step_explicit(Real dt);
 
@@ -59,6 +62,8 @@ class TwoPhaseFlow {
   std::span<const Real> liquid_fraction() const { return alpha_; }
   std::span<const Real> liquid_mass() const { return mq_; }
   std::span<const Real> gas_mass() const { return mp_; }
+  std::span<const Real> liquid_density() const { return rq_; }
+  std::span<const Real> gas_density() const { return rp_; }
   Real total_liquid_mass();
   Real total_gas_mass();
   Real saturation();  // sum alpha V / sum V
