@@ -4,6 +4,7 @@
 set -euo pipefail
 PKGS=(g++ cmake make libeigen3-dev libtomlplusplus-dev libcli11-dev libfmt-dev
       libgtest-dev googletest nlohmann-json3-dev libomp-dev clang libclang-rt-14-dev
+      libcgal-dev libgmp-dev libmpfr-dev
       python3 python3-matplotlib python3-numpy)
 missing=()
 for p in "${PKGS[@]}"; do

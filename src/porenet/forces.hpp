@@ -1,0 +1,23 @@
+// Fluid forces on the grains (seed 004 Eqs. B25–B28), as per-particle arrays.
+//  - pressure (B26–B27): F_P,j = -sum_i P_i n A_k with A_k = 2 r_j e_k: the fluid in pore i pushes on
+//    the arc of disc j inside that triangle, over a height 2 r_j (the seed's cylinder section). The
+//    arc is integrated exactly (the limit of the seed's discretised edges e_k):
+//    int_arc n dl = R_j rot(-90°)(u_2 - u_1), u_1, u_2 the unit vectors from the centre to the two
+//    other corners (counter-clockwise). A disc surrounded by pores at one pressure gets zero net force.
+//  - channel shear (B25, B28): tau = (h/2) (P_i - P_j) / L on both walls of each channel, acting
+//    along the centre line in the flow direction over A_k = 2 r_j L.
+// Forces are added to fx, fy [N] (one entry per particle); each particle sums its own pores and
+// channels in CSR order, so the result is independent of the thread count.
+#pragma once
+#include <span>
+
+#include "porenet/network.hpp"
+
+namespace ff::porenet {
+
+void add_pressure_forces(const Network2D& net, const Particles2D& particles, std::span<const Real> pore_pressure,
+                         std::span<Real> fx, std::span<Real> fy);
+void add_shear_forces(const Network2D& net, const Particles2D& particles, std::span<const Real> pore_pressure,
+                      std::span<Real> fx, std::span<Real> fy);
+
+}  // namespace ff::porenet

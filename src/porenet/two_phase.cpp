@@ -1,0 +1,232 @@
+#include "porenet/two_phase.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+#include <limits>
+
+#include "core/error.hpp"
+#include "porenet/reduce.hpp"
+
+namespace ff::porenet {
+
+StratifiedRates stratified_channel_flow(Real G, Real hq, Real hp, Real muq, Real mup) {
+  StratifiedRates r;
+  if (hq <= 0 && hp <= 0) return r;
+  if (hq <= 0) {
+    r.q_gas = G * hp * hp * hp / (12 * mup);
+    return r;
+  }
+  if (hp <= 0) {
+    r.q_liquid = G * hq * hq * hq / (12 * muq);
+    return r;
+  }
+  // Momentum (B4, steady, fully developed) in each layer: mu u'' = -G; B5–B7 fix the constants.
+  const Real tau0 = G * (hp * hp / mup - hq * hq / muq) / (2 * (hq / muq + hp / mup));
+  const Real C = G * hq * hq / (2 * muq) + tau0 * hq / muq;
+  r.q_liquid = -G * hq * hq * hq / (6 * muq) - tau0 * hq * hq / (2 * muq) + C * hq;
+  r.q_gas = -G * hp * hp * hp / (6 * mup) + tau0 * hp * hp / (2 * mup) + C * hp;
+  r.tau_interface = tau0;
+  return r;
+}
+
+TwoPhaseFlow::TwoPhaseFlow(const Network2D& net, const TwoPhaseParams& params)
+    : net_(net), prm_(params), np_(net.n_pores()), nc_(net.n_channels()) {
+  if (net.dim != 2) throw InputError("porenet: two-phase flow (stratified slit channels, B3-B7) needs a 2D network");
+  if (!(params.mu_liquid > 0 && params.mu_gas > 0))
+    throw InputError(fmt::format("porenet: viscosities must be > 0 (liquid {}, gas {} Pa s)", params.mu_liquid,
+                                 params.mu_gas));
+  const auto n = static_cast<std::size_t>(np_);
+  p_.assign(n, 0);
+  alpha_ = mq_ = mp_ = rq_ = rp_ = bc_value_ = bc_alpha_ = p_;
+  bc_.assign(n, PoreBc::None);
+  fq_.assign(static_cast<std::size_t>(nc_), 0);
+  fp_ = fq_;
+  scratch_.assign(static_cast<std::size_t>(std::max<Index>(reduce_blocks(std::max(np_, nc_)), 1)), 0);
+}
+
+void TwoPhaseFlow::set_pore_state(Index i, Real p, Real S) {
+  if (i < 0 || i >= np_) throw InputError(fmt::format("porenet: pore {} out of range 0..{}", i, np_ - 1));
+  if (!(S >= 0 && S <= 1)) throw InputError(fmt::format("porenet: saturation {} outside [0, 1]", S));
+  const Real V = net_.pore_void[i];
+  p_[i] = p;
+  alpha_[i] = S;
+  rq_[i] = prm_.liquid.density(p, true);
+  rp_[i] = prm_.gas.density(p, false);
+  mq_[i] = S * V * rq_[i];
+  mp_[i] = (1 - S) * V * rp_[i];
+}
+
+void TwoPhaseFlow::init(Real p, Real S) {
+  for (Index i = 0; i < np_; ++i) set_pore_state(i, p, S);
+  injected_ = 0;
+}
+
+void TwoPhaseFlow::set_bc(Index pore, PoreBc kind, Real value, Real alpha_bc) {
+  if (pore < 0 || pore >= np_) throw InputError(fmt::format("porenet: pore {} out of range 0..{}", pore, np_ - 1));
+  bc_[pore] = kind;
+  bc_value_[pore] = value;
+  bc_alpha_[pore] = alpha_bc;
+  if (kind == PoreBc::Pressure) set_pore_state(pore, value, alpha_bc);
+}
+
+void TwoPhaseFlow::load_masses(std::span<const Real> mq, std::span<const Real> mp) {
+  if (mq.size() != static_cast<std::size_t>(np_) || mp.size() != static_cast<std::size_t>(np_))
+    throw InputError(fmt::format("porenet: {} / {} phase masses for a network of {} pores", mq.size(), mp.size(), np_));
+  for (Index i = 0; i < np_; ++i) {
+    mq_[i] = mq[i];
+    mp_[i] = mp[i];
+    const Real V = net_.pore_void[i];
+    Real p;
+    const Real a = solve_shared_pressure(mq_[i], mp_[i], V, 0.5, p);
+    alpha_[i] = a;
+    p_[i] = p;
+    rq_[i] = a > 0 ? mq_[i] / (a * V) : prm_.liquid.density(p > 0 ? p : 1.0, true);
+    rp_[i] = a < 1 ? mp_[i] / ((1 - a) * V) : prm_.gas.density(p > 0 ? p : 1.0, false);
+  }
+}
+
+Real TwoPhaseFlow::solve_shared_pressure(Real mq, Real mp, Real V, Real a0, Real& p) const {
+  const Eos& L = prm_.liquid;
+  const Eos& Gs = prm_.gas;
+  if (mp <= 0) {
+    p = L.pressure(mq / V);
+    return 1;
+  }
+  if (mq <= 0) {
+    p = Gs.pressure(mp / V);
+    return 0;
+  }
+  // Bracket: liquid denser than its maximum below lo; above hi the gas is over-compressed or the
+  // liquid is past its spinodal (PR loop).
+  Real lo = mq / (V * L.max_density());
+  Real hi = 1 - mp / (V * Gs.max_density());
+  const Real rmin = L.min_liquid_density();
+  if (rmin > 0) hi = std::min(hi, mq / (V * rmin));
+  lo = std::nextafter(lo, 2.0);
+  hi = std::nextafter(hi, -1.0);
+  auto f = [&](Real a, Real& df) {
+    const Real rq = mq / (a * V), rp = mp / ((1 - a) * V);
+    const Real pq = L.pressure(rq), pp = Gs.pressure(rp);
+    // d/dalpha: dp/drho = K/rho; drho_q/dalpha = -rho_q/alpha, drho_p/dalpha = rho_p/(1-alpha).
+    df = -L.bulk_modulus(rq) / a - Gs.bulk_modulus(rp) / (1 - a);
+    return pq - pp;
+  };
+  Real a = std::clamp(a0, lo, hi);
+  if (!(a > lo && a < hi)) a = 0.5 * (lo + hi);
+  for (int it = 0; it < 200; ++it) {
+    Real df;
+    const Real fa = f(a, df);
+    if (fa > 0)
+      lo = a;
+    else
+      hi = a;
+    Real an = a - fa / df;
+    if (!(an > lo && an < hi) || !std::isfinite(an)) an = 0.5 * (lo + hi);
+    if (std::abs(an - a) <= 1e-15 * a || hi - lo <= 1e-16) {
+      a = an;
+      break;
+    }
+    a = an;
+  }
+  p = L.pressure(mq / (a * V));
+  return a;
+}
+
+void TwoPhaseFlow::compute_rates() {
+  const Real t = net_.params.thickness;
+#pragma omp parallel for schedule(static)
+  for (Index c = 0; c < nc_; ++c) {
+    const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
+    const Index u = p_[a] >= p_[b] ? a : b;  // upstream pore: face values (B8)
+    const Real h = net_.ch_aperture[c];
+    const Real G = (p_[a] - p_[b]) / net_.ch_length[c];
+    const StratifiedRates r =
+        stratified_channel_flow(G, alpha_[u] * h, (1 - alpha_[u]) * h, prm_.mu_liquid, prm_.mu_gas);
+    fq_[c] = rq_[u] * r.q_liquid * t;  // M_q,f [kg/s], a -> b
+    fp_[c] = rp_[u] * r.q_gas * t;
+  }
+}
+
+Real TwoPhaseFlow::stable_dt() {
+  compute_rates();
+  const Real t = net_.params.thickness;
+  Real dt = std::numeric_limits<Real>::infinity();
+#pragma omp parallel for schedule(static) reduction(min : dt)
+  for (Index i = 0; i < np_; ++i) {
+    if (bc_[i] == PoreBc::Pressure) continue;
+    Real mob = 0, outq = 0, outp = 0;
+    for (Index e = net_.pc_start[i]; e < net_.pc_start[i + 1]; ++e) {
+      const Index c = net_.pc_ch[e];
+      const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
+      const Index u = p_[a] >= p_[b] ? a : b;
+      const Real h = net_.ch_aperture[c];
+      const StratifiedRates r =
+          stratified_channel_flow(1.0, alpha_[u] * h, (1 - alpha_[u]) * h, prm_.mu_liquid, prm_.mu_gas);
+      mob += (r.q_liquid + r.q_gas) * t / net_.ch_length[c];
+      const Real sgn = a == i ? 1 : -1;
+      outq += std::max(sgn * fq_[c], 0.0);
+      outp += std::max(sgn * fp_[c], 0.0);
+    }
+    Real comp = 0;  // V dalpha-weighted compressibility
+    if (alpha_[i] > 0) comp += alpha_[i] / prm_.liquid.bulk_modulus(rq_[i]);
+    if (alpha_[i] < 1) comp += (1 - alpha_[i]) / prm_.gas.bulk_modulus(rp_[i]);
+    if (mob > 0) dt = std::min(dt, net_.pore_void[i] * comp / mob);
+    if (outq > 0) dt = std::min(dt, mq_[i] / outq);
+    if (outp > 0) dt = std::min(dt, mp_[i] / outp);
+  }
+  return dt;
+}
+
+void TwoPhaseFlow::step_explicit(Real dt) {
+  compute_rates();
+  Index bad = -1;
+#pragma omp parallel for schedule(static) reduction(max : bad)
+  for (Index i = 0; i < np_; ++i) {
+    if (bc_[i] == PoreBc::Pressure) {
+      // Fixed state at the new void volume.
+      const Real V = net_.pore_void[i];
+      mq_[i] = bc_alpha_[i] * V * rq_[i];
+      mp_[i] = (1 - bc_alpha_[i]) * V * rp_[i];
+      continue;
+    }
+    Real outq = 0, outp = 0;
+    for (Index e = net_.pc_start[i]; e < net_.pc_start[i + 1]; ++e) {
+      const Index c = net_.pc_ch[e];
+      const bool first = net_.ch_pore[2 * c] == i;
+      outq += first ? fq_[c] : -fq_[c];
+      outp += first ? fp_[c] : -fp_[c];
+    }
+    mq_[i] -= dt * outq;  // B18
+    mp_[i] -= dt * outp;
+    if (bc_[i] == PoreBc::Flux) mq_[i] += dt * bc_value_[i];
+    // Round-off can leave a drained phase at -eps: a mass below 1e-14 of the pore's total is none.
+    const Real tiny = 1e-14 * (std::abs(mq_[i]) + std::abs(mp_[i]));
+    if (mq_[i] < -tiny || mp_[i] < -tiny || mq_[i] + mp_[i] <= 0) {
+      bad = std::max(bad, i);
+      continue;
+    }
+    const Real V = net_.pore_void[i];  // B19: the new void volume
+    Real p;
+    const Real a = solve_shared_pressure(std::max(mq_[i], 0.0), std::max(mp_[i], 0.0), V, alpha_[i], p);
+    alpha_[i] = a;
+    p_[i] = p;
+    rq_[i] = a > 0 ? mq_[i] / (a * V) : prm_.liquid.density(p > 0 ? p : 1.0, true);  // B20
+    rp_[i] = a < 1 ? mp_[i] / ((1 - a) * V) : prm_.gas.density(p > 0 ? p : 1.0, false);
+  }
+  if (bad >= 0)
+    throw NumericalError(fmt::format("porenet: pore {} phase masses ({}, {}) kg after a step of {} s; reduce dt "
+                                     "below stable_dt()", bad, mq_[bad], mp_[bad], dt));
+  for (Index i = 0; i < np_; ++i)
+    if (bc_[i] == PoreBc::Flux) injected_ += dt * bc_value_[i];
+}
+
+Real TwoPhaseFlow::total_liquid_mass() { return fixed_order_sum(np_, [&](Index i) { return mq_[i]; }, scratch_); }
+Real TwoPhaseFlow::total_gas_mass() { return fixed_order_sum(np_, [&](Index i) { return mp_[i]; }, scratch_); }
+Real TwoPhaseFlow::saturation() {
+  const Real lv = fixed_order_sum(np_, [&](Index i) { return alpha_[i] * net_.pore_void[i]; }, scratch_);
+  const Real v = fixed_order_sum(np_, [&](Index i) { return net_.pore_void[i]; }, scratch_);
+  return lv / v;
+}
+
+}  // namespace ff::porenet

@@ -1,0 +1,86 @@
+// Two-phase (liquid q / gas p) compressible flow on the pore network, seed 004 Appendix B:
+//  - channels: stratified laminar two-layer flow between parallel plates (B3–B7; Barmak et al.
+//    2016, Phys. Fluids 28:044101): the liquid layer h_q = alpha_f h below the gas layer
+//    h_p = (1 - alpha_f) h, one pressure gradient G = (p_i - p_j)/L, no slip at the walls (B5),
+//    continuous velocity and shear stress at the interface (B6–B7). alpha_f is the liquid
+//    fraction of the upstream pore (the face value of B8/B18), the densities those of the
+//    upstream pore. Closed form (per unit depth, derived in docs/porenet.md):
+//      tau_0 = G (h_p^2/mu_p - h_q^2/mu_q) / (2 (h_q/mu_q + h_p/mu_p)),
+//      C = G h_q^2 / (2 mu_q) + tau_0 h_q / mu_q   (interface velocity),
+//      Q_q = -G h_q^3/(6 mu_q) - tau_0 h_q^2/(2 mu_q) + C h_q,
+//      Q_p = -G h_p^3/(6 mu_p) + tau_0 h_p^2/(2 mu_p) + C h_p.
+//  - pores: explicit mass balance of each phase (B18–B20) with the new void volume (B19), then the
+//    shared pressure (B23): the liquid fraction alpha solves p_q(m_q / (alpha V)) = p_p(m_p / ((1 - alpha) V))
+//    with the phases' EOS (Peng–Robinson + Peneloux for water, B10–B22; or ideal gas), by
+//    safeguarded Newton on the liquid branch (the PR liquid density is kept above its spinodal).
+// Both phase masses are conserved to round-off: each channel's two mass rates are computed once.
+// Isothermal (T of the EOS); no capillarity, no phase change (seed 004: mass transfer ignored).
+#pragma once
+#include <span>
+#include <vector>
+
+#include "porenet/eos.hpp"
+#include "porenet/flow.hpp"
+#include "porenet/network.hpp"
+
+namespace ff::porenet {
+
+struct StratifiedRates {
+  Real q_liquid = 0, q_gas = 0;  // volumetric rate per unit depth [m^2/s], positive along G
+  Real tau_interface = 0;        // shear stress at the interface [Pa]
+};
+// G = -dp/dx [Pa/m]; layer thicknesses h_q, h_p >= 0 [m]; viscosities [Pa s].
+StratifiedRates stratified_channel_flow(Real G, Real h_q, Real h_p, Real mu_q, Real mu_p);
+
+struct TwoPhaseParams {
+  Eos liquid = Eos::water_pr(293.15);
+  Eos gas = Eos::air_pr(293.15);
+  Real mu_liquid = 1.0e-3;  // [Pa s]
+  Real mu_gas = 1.8e-5;     // [Pa s]
+};
+
+class TwoPhaseFlow {
+ public:
+  TwoPhaseFlow(const Network2D& net, const TwoPhaseParams& params);
+
+  // Pressure p and liquid saturation S (0..1) in every pore; masses from the EOS at the current voids.
+  void init(Real p, Real saturation);
+  // Sets one pore's state (before stepping), e.g. a non-uniform initial field.
+  void set_pore_state(Index pore, Real p, Real saturation);
+  // Pressure: value = p [Pa] with liquid fraction alpha_bc; Flux: value = liquid mass inflow [kg/s].
+  void set_bc(Index pore, PoreBc kind, Real value, Real alpha_bc = 1.0);
+
+  // Explicit limit: min over pores of the pressure-diffusion bound V (alpha/K_q + (1-alpha)/K_p) / sum_j lambda_ij
+  // (lambda the channel's total volumetric mobility) and of the transport bound m / outflow per phase.
+  // Replaces the phase masses (after a remeshing); solves B23 for every pore.
+  void load_masses(std::span<const Real> mq, std::span<const Real> mp);
+
+  Real stable_dt();
+  void step_explicit(Real dt);
+
+  std::span<const Real> pressure() const { return p_; }
+  std::span<const Real> liquid_fraction() const { return alpha_; }
+  std::span<const Real> liquid_mass() const { return mq_; }
+  std::span<const Real> gas_mass() const { return mp_; }
+  std::span<const Real> liquid_density() const { return rq_; }
+  std::span<const Real> gas_density() const { return rp_; }
+  Real total_liquid_mass();
+  Real total_gas_mass();
+  Real saturation();  // sum alpha V / sum V
+  Real injected_liquid() const { return injected_; }
+
+  // Shared pressure (B23) for masses m_q, m_p in a void V: returns alpha, writes p.
+  Real solve_shared_pressure(Real mq, Real mp, Real V, Real alpha_guess, Real& p) const;
+
+ private:
+  void compute_rates();
+
+  const Network2D& net_;
+  TwoPhaseParams prm_;
+  Index np_, nc_;
+  std::vector<Real> p_, alpha_, mq_, mp_, rq_, rp_, fq_, fp_, bc_value_, bc_alpha_, scratch_;
+  std::vector<PoreBc> bc_;
+  Real injected_ = 0;
+};
+
+}  // namespace ff::porenet

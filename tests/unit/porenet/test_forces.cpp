@@ -1,0 +1,74 @@
+// Fluid forces on grains (seed 004 B25–B28): a uniform pressure gives zero net force on an interior
+// grain; a pressure gradient pushes grains down the gradient; channel shear sums to the pressure
+// drop on the slit.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "packings.hpp"
+#include "porenet/forces.hpp"
+
+using namespace ff;
+using namespace ff::porenet;
+
+TEST(PorenetForces, UniformPressureZeroNetForceOnInteriorGrains) {
+  auto s = test_packings::hex_packing(12, 12, 1e-3, 0.45e-3, 0.1, 0.15);
+  const Network2D net = build_network_2d(s.view(), {});
+  const Real P = 2e6;
+  std::vector<Real> pp(net.n_pores(), P), fx(s.x.size(), 0), fy(s.x.size(), 0);
+  add_pressure_forces(net, s.view(), pp, fx, fy);
+  // Interior grain: not a corner of any hull pore.
+  Real worst = 0, hull_max = 0;
+  int interior = 0;
+  for (Index j = 0; j < net.n_particles; ++j) {
+    bool on_hull = false;
+    for (Index e = net.pp_start[j]; e < net.pp_start[j + 1]; ++e) on_hull |= net.pore_hull[net.pp_pore[e]] != 0;
+    const Real scale = P * 2 * s.r[j] * 2 * kPi * s.r[j];  // pressure x the whole lateral area
+    const Real f = std::hypot(fx[j], fy[j]) / scale;
+    if (on_hull) {
+      hull_max = std::max(hull_max, f);
+    } else {
+      worst = std::max(worst, f);
+      ++interior;
+    }
+  }
+  std::printf("uniform %.1e Pa: %d interior grains, max |F| / (P 2r 2 pi r) = %.2e; hull grains up to %.3f\n", P,
+              interior, worst, hull_max);
+  EXPECT_GT(interior, 50);
+  EXPECT_LT(worst, 1e-14);
+  EXPECT_GT(hull_max, 0.05);  // the outside is not wetted: boundary grains are pushed out
+}
+
+TEST(PorenetForces, GradientAndShear) {
+  // Linear pressure field p = p0 - G x sampled at the pore centroids. On the regular lattice each
+  // grain has six 60° arcs whose pore centroids lie at R_c = d / sqrt(3) at angles phi_k, so
+  // F_x = 2 r R G R_c sum cos^2 phi_k = 6 r R G R_c, i.e. 3 R_c / (pi R) = 1.2252 times the continuum
+  // value G pi R^2 2r (a pressure taken uniform over each arc overestimates, cf. seed 004 after B25).
+  auto s = test_packings::hex_packing(12, 12, 1e-3, 0.45e-3, 0.0, 0.0);
+  const Network2D net = build_network_2d(s.view(), {});
+  const Real G = 1e8;
+  std::vector<Real> pp(net.n_pores()), fx(s.x.size(), 0), fy(s.x.size(), 0);
+  for (Index k = 0; k < net.n_pores(); ++k) pp[k] = 1e6 - G * net.pore_cx[k];
+  add_pressure_forces(net, s.view(), pp, fx, fy);
+  const Index j = 6 * 12 + 6;  // interior grain of the regular lattice
+  const Real expect = G * kPi * s.r[j] * s.r[j] * 2 * s.r[j];
+  std::printf("gradient: F_x = %.4e N, G pi r^2 2r = %.4e N (ratio %.4f), F_y = %.2e N\n", fx[j], expect,
+              fx[j] / expect, fy[j]);
+  EXPECT_GT(fx[j], 0);
+  EXPECT_NEAR(fx[j], 6 * s.r[j] * s.r[j] * G * 1e-3 / std::sqrt(3.0), 1e-9 * fx[j]);
+  EXPECT_LT(std::abs(fy[j]), 1e-6 * std::abs(fx[j]));
+  // Shear: per channel, the two walls together take h * (r_a + r_b) * (P_a - P_b) (B25 x B28).
+  std::vector<Real> sx(s.x.size(), 0), sy(s.x.size(), 0);
+  add_shear_forces(net, s.view(), pp, sx, sy);
+  Real total = 0, expect_total = 0;
+  for (Index j2 = 0; j2 < net.n_particles; ++j2) total += sx[j2];
+  for (Index c = 0; c < net.n_channels(); ++c) {
+    const Index a = net.ch_pore[2 * c], b = net.ch_pore[2 * c + 1];
+    const Real lx = net.pore_cx[b] - net.pore_cx[a];
+    const Real ra = s.r[net.ch_part[2 * c]], rb = s.r[net.ch_part[2 * c + 1]];
+    expect_total += net.ch_aperture[c] * (ra + rb) * (pp[a] - pp[b]) * lx / net.ch_length[c];
+  }
+  std::printf("shear: sum F_x = %.6e N, expected %.6e N\n", total, expect_total);
+  EXPECT_NEAR(total, expect_total, 1e-12 * std::abs(expect_total));
+  EXPECT_GT(total, 0);
+}

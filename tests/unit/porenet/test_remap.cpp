@@ -1,0 +1,86 @@
+// Retriangulation: the fluid carried over to a new network conserves each phase's mass
+// (issue 16 item 1); pressures change only by the remeshing's local volume changes.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/rng.hpp"
+#include "packings.hpp"
+#include "porenet/remap.hpp"
+
+using namespace ff;
+using namespace ff::porenet;
+
+namespace {
+// Shear the packing by 3 % and jitter it by 2 % of a diameter: enough to change the Delaunay topology.
+test_packings::Discs deform(const test_packings::Discs& s) {
+  test_packings::Discs t = s;
+  Rng rng(11);
+  for (std::size_t k = 0; k < t.x.size(); ++k) {
+    t.x[k] += 0.03 * t.y[k] + 0.02e-3 * rng.uniform(-1, 1);
+    t.y[k] += 0.02e-3 * rng.uniform(-1, 1);
+  }
+  return t;
+}
+}  // namespace
+
+TEST(PorenetRemap, SinglePhaseMassConserved) {
+  auto s = test_packings::hex_packing(30, 30, 1e-3, 0.45e-3, 0.05, 0.1);
+  Network2D old_net = build_network_2d(s.view(), {});
+  SinglePhaseParams prm;
+  prm.fluid = Eos::barotropic(1000, 1e5, 2.2e9);
+  SinglePhaseFlow f(old_net, prm);
+  for (Index k = 0; k < old_net.n_pores(); ++k)
+    if (old_net.pore_cx[k] < 3e-3) f.set_bc(k, PoreBc::Flux, 1e-3);
+  f.init(1e5);
+  for (int n = 0; n < 20; ++n) f.step_implicit(1e-7);
+  const auto t = deform(s);
+  update_network_2d(old_net, t.view(), {});  // old topology at the new positions
+  f.load_masses(std::vector<Real>(f.mass().begin(), f.mass().end()));
+  const Real m_old = f.total_mass();
+  const Network2D new_net = build_network_2d(t.view(), {});
+  Index changed = 0;  // topology change: pores whose corner triple is new
+  SinglePhaseFlow g(new_net, prm);
+  remap_single_phase(old_net, f, new_net, g);
+  const Real m_new = g.total_mass();
+  const auto near = nearest_pores(old_net, new_net);
+  Real dp = 0, pmax = 0;
+  for (Index k = 0; k < new_net.n_pores(); ++k) {
+    dp = std::max(dp, std::abs(g.pressure()[k] - f.pressure()[near[k]]));
+    pmax = std::max(pmax, f.pressure()[near[k]] - 1e5);
+    bool differs = false;
+    for (Index o = near[k], c = 0; c < 3; ++c) differs |= new_net.pore_v[3 * k + c] != old_net.pore_v[3 * o + c];
+    changed += differs ? 1 : 0;
+  }
+  std::printf("remap: %d -> %d pores (%d differ from their source), mass error %.2e, max |dp| %.3e Pa of a %.3e Pa "
+              "rise\n", old_net.n_pores(), new_net.n_pores(), changed, std::abs(m_new - m_old) / m_old, dp, pmax);
+  EXPECT_GT(changed, 10);
+  EXPECT_LT(std::abs(m_new - m_old) / m_old, 1e-14);
+  EXPECT_LT(dp, 0.05 * pmax + 0.01 * 1e5);
+}
+
+TEST(PorenetRemap, TwoPhaseMassConserved) {
+  auto s = test_packings::hex_packing(20, 20, 1e-3, 0.45e-3, 0.05, 0.1);
+  Network2D old_net = build_network_2d(s.view(), {});
+  TwoPhaseFlow f(old_net, {});
+  f.init(1e5, 0.5);
+  for (Index k = 0; k < old_net.n_pores(); ++k)
+    if (old_net.pore_cx[k] < 8e-3) f.set_pore_state(k, 2e5, 0.8);
+  const Real dt = 0.5 * f.stable_dt();
+  for (int n = 0; n < 50; ++n) f.step_explicit(dt);
+  const auto t = deform(s);
+  update_network_2d(old_net, t.view(), {});
+  f.load_masses(std::vector<Real>(f.liquid_mass().begin(), f.liquid_mass().end()),
+                std::vector<Real>(f.gas_mass().begin(), f.gas_mass().end()));
+  const Real q0 = f.total_liquid_mass(), g0 = f.total_gas_mass();
+  const Network2D new_net = build_network_2d(t.view(), {});
+  TwoPhaseFlow g(new_net, {});
+  remap_two_phase(old_net, f, new_net, g);
+  const Real eq = std::abs(g.total_liquid_mass() - q0) / q0, eg = std::abs(g.total_gas_mass() - g0) / g0;
+  std::printf("two-phase remap: liquid mass error %.2e, gas %.2e; saturation %.4f -> %.4f\n", eq, eg, f.saturation(),
+              g.saturation());
+  EXPECT_LT(eq, 1e-14);
+  EXPECT_LT(eg, 1e-14);
+  EXPECT_NEAR(g.saturation(), f.saturation(), 0.02);
+}

@@ -1,0 +1,90 @@
+// Two-phase liquid/gas network flow (seed 004 B3–B7, B18–B23): the stratified channel solution,
+// the shared-pressure solve, and the conservation of each phase's mass in a closed network.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "packings.hpp"
+#include "porenet/two_phase.hpp"
+
+using namespace ff;
+using namespace ff::porenet;
+
+TEST(PorenetTwoPhase, StratifiedChannelFlow) {
+  const Real G = 1e5, h = 1e-4;
+  // Equal viscosities: any split gives the single-phase plane Poiseuille rate G h^3 / (12 mu), and
+  // each layer carries the integral of the parabola over its part.
+  for (const Real a : {0.0, 0.2, 0.5, 0.9, 1.0}) {
+    const auto r = stratified_channel_flow(G, a * h, (1 - a) * h, 1e-3, 1e-3);
+    EXPECT_NEAR(r.q_liquid + r.q_gas, G * h * h * h / 12e-3, 1e-12 * G * h * h * h / 12e-3);
+    // Liquid in y in [0, a h]: integral of G/(2 mu) y (h - y) = G/(2 mu) (h (ah)^2/2 - (ah)^3/3).
+    const Real ql = G / 2e-3 * (h * a * h * a * h / 2 - a * h * a * h * a * h / 3);
+    EXPECT_NEAR(r.q_liquid, ql, 1e-12 * G * h * h * h / 12e-3);
+  }
+  // Different viscosities: check the boundary conditions (B5–B7) by rebuilding the profile.
+  const Real muq = 1e-3, mup = 1.8e-5, hq = 0.3 * h, hp = 0.7 * h;
+  const auto r = stratified_channel_flow(G, hq, hp, muq, mup);
+  const Real C = G * hq * hq / (2 * muq) + r.tau_interface * hq / muq;
+  auto uq = [&](Real y) { return -G / (2 * muq) * y * y + r.tau_interface / muq * y + C; };
+  auto up = [&](Real y) { return -G / (2 * mup) * y * y + r.tau_interface / mup * y + C; };
+  EXPECT_NEAR(uq(-hq), 0, 1e-12 * C);  // no slip, lower wall
+  EXPECT_NEAR(up(hp), 0, 1e-12 * C);   // no slip, upper wall
+  // Flow rates = integrals of the profiles (Simpson is exact for parabolas).
+  EXPECT_NEAR(r.q_liquid, hq / 6 * (uq(-hq) + 4 * uq(-hq / 2) + uq(0)), 1e-12 * r.q_gas);
+  EXPECT_NEAR(r.q_gas, hp / 6 * (up(0) + 4 * up(hp / 2) + up(hp)), 1e-12 * r.q_gas);
+  // The less viscous gas layer carries more per unit thickness.
+  EXPECT_GT(r.q_gas / hp, r.q_liquid / hq);
+}
+
+TEST(PorenetTwoPhase, SharedPressureRoundTrip) {
+  auto s = test_packings::hex_packing(4, 4, 1e-3, 0.45e-3, 0.0, 0.0);
+  const Network2D net = build_network_2d(s.view(), {});
+  TwoPhaseFlow f(net, {});
+  const Real V = 1e-7;
+  for (const Real p : {1e5, 1e6, 2e7})
+    for (const Real a : {0.05, 0.5, 0.95}) {
+      const Real mq = a * V * Eos::water_pr(293.15).density(p, true);
+      const Real mp = (1 - a) * V * Eos::air_pr(293.15).density(p, false);
+      Real pout;
+      const Real aout = f.solve_shared_pressure(mq, mp, V, 0.5, pout);
+      EXPECT_NEAR(aout, a, 1e-9);
+      EXPECT_NEAR(pout, p, 1e-6 * p);
+    }
+}
+
+TEST(PorenetTwoPhase, ClosedNetworkConservesEachPhase) {
+  auto s = test_packings::hex_packing(30, 30, 1e-3, 0.45e-3, 0.05, 0.1);
+  const Network2D net = build_network_2d(s.view(), {});
+  auto run = [&](int threads, bool report) {
+    omp_set_num_threads(threads);
+    TwoPhaseFlow f(net, {});
+    f.init(1e5, 0.5);
+    // A high-pressure, wetter left half drives both phases to the right.
+    for (Index k = 0; k < net.n_pores(); ++k)
+      if (net.pore_cx[k] < 10e-3) f.set_pore_state(k, 3e5, 0.8);
+    const Real mq0 = f.total_liquid_mass(), mp0 = f.total_gas_mass(), S0 = f.saturation();
+    const Real dt = 0.5 * f.stable_dt();
+    for (int n = 0; n < 300; ++n) f.step_explicit(dt);
+    const Real eq = std::abs(f.total_liquid_mass() - mq0) / mq0, ep = std::abs(f.total_gas_mass() - mp0) / mp0;
+    const auto [lo, hi] = std::minmax_element(f.pressure().begin(), f.pressure().end());
+    if (report)
+      std::printf("two-phase closed network, dt %.3e s x 300: liquid mass error %.2e, gas %.2e; saturation %.4f -> "
+                  "%.4f; p in [%.4e, %.4e] Pa\n", dt, eq, ep, S0, f.saturation(), *lo, *hi);
+    EXPECT_LT(eq, 1e-13);
+    EXPECT_LT(ep, 1e-13);
+    // A pressure front has formed: pores between the two initial levels.
+    const auto front = std::count_if(f.pressure().begin(), f.pressure().end(),
+                                     [](Real p) { return p > 1.01e5 && p < 2.99e5; });
+    if (report) std::printf("pores inside the front: %ld\n", static_cast<long>(front));
+    EXPECT_GT(front, 20);
+    EXPECT_LE(*hi, 3e5 * (1 + 1e-6));  // PR liquid: K = 7 GPa turns density round-off into ~1e-6 Pa
+    EXPECT_GE(*lo, 1e5 * (1 - 1e-6));
+    return std::vector<Real>(f.pressure().begin(), f.pressure().end());
+  };
+  const auto p1 = run(1, true), p2 = run(2, false);
+  omp_set_num_threads(omp_get_num_procs());
+  EXPECT_EQ(0, std::memcmp(p1.data(), p2.data(), p1.size() * sizeof(Real)));
+}
