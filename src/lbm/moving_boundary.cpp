@@ -23,7 +23,14 @@ const char* particle_scheme_name(ParticleScheme s) {
 
 template <class L, class T>
 MovingBoundary<L, T>::MovingBoundary(const Grid& grid, ParticleScheme scheme, bool incompressible)
-    : grid_(grid), scheme_(scheme), incompressible_(incompressible) {}
+    : grid_(grid), scheme_(scheme), incompressible_(incompressible) {
+  const CellIndex N = grid_.padded_size();
+  for (int q = 0; q < Q; ++q) {
+    const std::int64_t cq = L::c[q][0] + grid_.px * (L::c[q][1] + grid_.py * L::c[q][2]);
+    pre_off_[0][q] = q * N;
+    pre_off_[1][q] = q == 0 ? 0 : L::opp[q] * N - cq;
+  }
+}
 
 template <class L, class T>
 void MovingBoundary<L, T>::set_fluid_mask(std::vector<std::uint8_t> fluid) {
@@ -110,6 +117,8 @@ void MovingBoundary<L, T>::set_particles(const ParticleSet& p, T* f, bool odd, b
           sc.arm = arm;
           const Vec3 us = v + w.cross(arm);
           for (int a = 0; a < 3; ++a) sc.us[a] = T(a < D ? us[a] : 0.0);
+          sc.edge = false;
+          for (int a = 0; a < D; ++a) sc.edge = sc.edge || (grid_.periodic[a] && (c[a] == 0 || c[a] == n[a] - 1));
           new_cells_.push_back(sc);
         }
   }
@@ -234,6 +243,15 @@ void MovingBoundary<L, T>::build_links(const ParticleSet& p) {
       k.arm = ax - delta * c;
       const Vec3 uw = p.velocity[s] + w.cross(k.arm);
       for (int a = 0; a < 3; ++a) k.uw[a] = T(a < D ? uw[a] : 0.0);
+      const int o = L::opp[q];
+      const int x2[3] = {grid_.step(k.x[0], L::c[q][0], 0), grid_.step(k.x[1], L::c[q][1], 1),
+                         grid_.step(k.x[2], L::c[q][2], 2)};
+      for (int odd = 0; odd < 2; ++odd) {
+        k.slot[odd][0] = post(k.x, o, odd);
+        k.slot[odd][1] = post(k.x, q, odd);
+        k.slot[odd][2] = post(x2, o, odd);
+        k.slot[odd][3] = pre(k.x, q, !odd);
+      }
       links_.push_back(k);
     }
   }
@@ -252,18 +270,17 @@ void MovingBoundary<L, T>::apply(T* f, bool odd) {
   for (std::int64_t l = 0; l < nl; ++l) {
     const MovingLink& k = links_[std::size_t(l)];
     const int q = k.q, o = L::opp[q];
-    const T A = f[post(k.x, o, odd)];  // g*_o(x, t), sent into the wall
+    const CellIndex* sl = k.slot[odd];
+    const T A = f[sl[0]];  // g*_o(x, t), sent into the wall
     T B = 0, C = 0;
     if (ws == WallScheme::Bouzidi && k.has_second) {
-      B = f[post(k.x, q, odd)];  // g*_q(x, t)
-      const int x2[3] = {grid_.step(k.x[0], L::c[q][0], 0), grid_.step(k.x[1], L::c[q][1], 1),
-                         grid_.step(k.x[2], L::c[q][2], 2)};
-      C = f[post(x2, o, odd)];  // g*_o(x + c_q, t)
+      B = f[sl[1]];  // g*_q(x, t)
+      C = f[sl[2]];  // g*_o(x + c_q, t)
     }
     const T cu = L::c[q][0] * k.uw[0] + L::c[q][1] * k.uw[1] + L::c[q][2] * k.uw[2];
     const T mw = T(6 * L::w[q]) * cu;
     const T g = reflect<T>(ws, k.delta, k.has_second, A, B, C, mw);
-    f[pre(k.x, q, next)] = g;
+    f[sl[3]] = g;
     for (int a = 0; a < 3; ++a) link_force_[3 * std::size_t(l) + std::size_t(a)] = double(L::c[o][a]) * (double(A) + double(g));
   }
   // Solid cells: f^eq(1, u_s) in the slots they read next step (finite values, sampled u = u_s).
@@ -273,7 +290,11 @@ void MovingBoundary<L, T>::apply(T* f, bool odd) {
     const SolidCell& sc = cells_[std::size_t(i)];
     T geq[Q];
     equilibrium<L, T>(T(1), sc.us, geq, incompressible_);
-    for (int q = 0; q < Q; ++q) f[pre(sc.x, q, next)] = geq[q];
+    if (sc.edge) {
+      for (int q = 0; q < Q; ++q) f[pre(sc.x, q, next)] = geq[q];
+    } else {
+      for (int q = 0; q < Q; ++q) f[sc.cell + pre_off_[next][q]] = geq[q];
+    }
   }
 }
 

@@ -104,6 +104,7 @@ class MovingBoundary {
     std::uint64_t id;  // the particle's id (its index if the set has no ids), for refill attribution
     Vec3 arm;          // cell centre minus particle centre (unwrapped)
     T us[3];           // particle velocity at the cell centre
+    bool edge;         // on a periodic lattice edge: neighbours wrap (slow path)
   };
   struct MovingLink {
     int x[3];          // fluid cell
@@ -113,6 +114,8 @@ class MovingBoundary {
     T delta;           // wall fraction along the link from x
     T uw[3];           // wall velocity at x_w
     Vec3 arm;          // x_w minus particle centre
+    // Slots per step parity: g*_o(x), g*_q(x), g*_o(x + c_q) of this step, g_q(x) of the next.
+    CellIndex slot[2][4];
   };
   CellIndex pre(const int* x, int q, bool odd) const;   // slot g_q is read from in a step of parity odd
   CellIndex post(const int* x, int q, bool odd) const;  // slot g*_q is written to
@@ -122,6 +125,7 @@ class MovingBoundary {
   Grid grid_;
   ParticleScheme scheme_;
   bool incompressible_;
+  std::int64_t pre_off_[2][Q];        // pre() as an offset from the cell index where nothing wraps
   std::vector<std::uint8_t> fluid_;   // per padded cell: static fluid
   std::vector<std::int32_t> owner_;   // per padded cell: index into cells_ of the current set, -1 if fluid
   std::vector<std::int32_t> next_;    // per padded cell: scratch for the new set
