@@ -71,12 +71,8 @@ void MovingBoundary<L, T>::set_particles(const ParticleSet& p, T* f, bool odd, b
   if (fluid_.empty()) throw Error("internal: MovingBoundary used before set_fluid_mask()");
   const int D = L::D;
   const int n[3] = {grid_.nx, grid_.ny, grid_.nz};
-  stats_ = MovingBoundaryStats{};
-  impulse_.assign(np, Vec3::Zero());
-  impulse_torque_.assign(np, Vec3::Zero());
 
-  // 1. The new solid cells: centres strictly inside a particle, first particle wins.
-  new_cells_.clear();
+  // Checked before anything changes, so that bad input leaves the current set intact.
   for (std::size_t s = 0; s < np; ++s) {
     const Vec3& X = p.position[s];
     const double r = p.radius[s];
@@ -86,6 +82,15 @@ void MovingBoundary<L, T>::set_particles(const ParticleSet& p, T* f, bool odd, b
       throw InputError(fmt::format("{} particle {} (id {}): radius {} at ({}, {}, {}) must be finite and positive "
                                    "(and below half the lattice along a periodic axis), position finite",
                                    name, s, p.id.empty() ? s : p.id[s], r, X[0], X[1], X[2]));
+  }
+  stats_ = MovingBoundaryStats{};
+  impulse_.assign(np, Vec3::Zero());
+  impulse_torque_.assign(np, Vec3::Zero());
+  // 1. The new solid cells: centres strictly inside a particle, first particle wins.
+  new_cells_.clear();
+  for (std::size_t s = 0; s < np; ++s) {
+    const Vec3& X = p.position[s];
+    const double r = p.radius[s];
     int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
     for (int a = 0; a < D; ++a) {
       lo[a] = int(std::ceil(X[a] - r));

@@ -264,10 +264,12 @@ TEST(MovingBoundary, ThreadsAndResumeBitIdentical) {
   }
 }
 
-// Bad input names the scheme and the particle.
+// Bad input names the scheme and the particle, and leaves the current set as it was.
 TEST(MovingBoundary, BadParticleInput) {
   auto sol = box<D2Q9>(30, 20, 1, ParticleScheme::StairwiseBounceBack);
   ParticleSet p = moving_set(2, 0);
+  sol.set_particles(p);
+  const std::size_t cells = sol.moving_boundary()->num_cells(), links = sol.moving_boundary()->num_links();
   p.radius[1] = -1;
   try {
     sol.set_particles(p);
@@ -275,4 +277,10 @@ TEST(MovingBoundary, BadParticleInput) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("stairwise_bounce_back particle 1"), std::string::npos) << e.what();
   }
+  EXPECT_EQ(sol.moving_boundary()->num_cells(), cells);
+  EXPECT_EQ(sol.moving_boundary()->num_links(), links);
+  p.radius[1] = 4.1;
+  sol.set_particles(p);  // the same set again: nothing changes
+  EXPECT_EQ(sol.moving_boundary()->stats().covered + sol.moving_boundary()->stats().uncovered, 0);
+  EXPECT_EQ(sol.moving_boundary()->num_cells(), cells);
 }
