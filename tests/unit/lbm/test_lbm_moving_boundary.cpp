@@ -211,7 +211,7 @@ TEST(MovingBoundary, ComovingParticleExchangesNoMomentum) {
 }
 
 // 1 and 2 threads give identical populations and forces (3D lattice above the parallel thresholds,
-// particles touching the walls: boundary-cell path, > 1024 links: parallel post-pass); a run resumed
+// particles touching the walls: boundary-cell path, > 8192 links and solid cells: parallel post-pass); a run resumed
 // at step 9 from the populations and the last step's particle set continues bit-for-bit.
 TEST(MovingBoundary, ThreadsAndResumeBitIdentical) {
   for (ParticleScheme scheme : kSchemes) {
@@ -220,7 +220,7 @@ TEST(MovingBoundary, ThreadsAndResumeBitIdentical) {
       p.resize(6);
       for (int s = 0; s < 6; ++s) {
         p.id[s] = std::uint64_t(7 * s + 1);
-        p.radius[s] = 5.5 + 0.3 * s;
+        p.radius[s] = 7.6 + 0.3 * s;
         p.velocity[s] = Vec3(0.04 * std::sin(s + 1.0), 0.03 * std::cos(s + 1.0), 0.02 * std::sin(2.0 * s));
         p.omega[s] = Vec3(0.002 * (s % 3 - 1), 0.003, -0.002 * (s % 2));
         p.position[s] = Vec3(6.0 + 11.0 * (s % 3), s < 3 ? 3.5 : 18.0, 6.0 + 5.0 * s) + double(t) * p.velocity[s];
@@ -246,7 +246,8 @@ TEST(MovingBoundary, ThreadsAndResumeBitIdentical) {
     auto half = run(1, 9, nullptr);
     auto c = run(2, 20, &half);
     omp_set_num_threads(saved);
-    ASSERT_GT(a.moving_boundary()->num_links(), 1024u);
+    ASSERT_GT(a.moving_boundary()->num_links(), 8192u);  // the parallel post-pass
+    ASSERT_GT(a.moving_boundary()->num_cells(), 8192u);
     ASSERT_GT(a.moving_boundary()->stats().covered + a.moving_boundary()->stats().uncovered, 0);
     const auto& fa = a.populations();
     for (std::size_t i = 0; i < fa.size(); ++i) {
