@@ -10,6 +10,7 @@
 #include "drivers/triaxial/triaxial_driver.hpp"
 #include "drivers/ucs/ucs_driver.hpp"
 #include "drivers/flow/flow_drivers.hpp"
+#include "drivers/saturated/saturated_ucs_driver.hpp"
 // Each driver's header declares one function returning its Driver record.
 // (Add the include and the entry below; the first entry is the default driver.)
 
@@ -25,6 +26,7 @@ const std::vector<Driver>& driver_list() {
       drivers::flow_poiseuille_driver(),
       drivers::flow_cavity_driver(),
       drivers::flow_cylinder_driver(),
+      drivers::saturated_ucs_driver(),
   };
   return list;
 }
