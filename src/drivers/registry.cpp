@@ -12,6 +12,7 @@
 #include "drivers/flow/flow_drivers.hpp"
 #include "drivers/hydrofrac/hydrofrac_driver.hpp"
 #include "drivers/sedimentation/sedimentation_driver.hpp"
+#include "drivers/saturated/saturated_ucs_driver.hpp"
 // Each driver's header declares one function returning its Driver record.
 // (Add the include and the entry below; the first entry is the default driver.)
 
@@ -29,6 +30,7 @@ const std::vector<Driver>& driver_list() {
       drivers::flow_cylinder_driver(),
       drivers::hydrofrac_driver(),
       drivers::sedimentation_driver(),
+      drivers::saturated_ucs_driver(),
   };
   return list;
 }

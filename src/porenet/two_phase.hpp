@@ -19,6 +19,7 @@
 #include <span>
 #include <vector>
 
+#include "core/error.hpp"
 #include "porenet/eos.hpp"
 #include "porenet/flow.hpp"
 #include "porenet/network.hpp"
@@ -57,6 +58,20 @@ class TwoPhaseFlow {
 
   Real stable_dt();
   void step_explicit(Real dt);
+  // Checkpoint resume (src/coupling/porenet): the full per-pore state as it was, so a resumed run
+  // continues bit-for-bit (load_masses would re-solve B23 from another guess: last-bit differences).
+  void restore_state(std::span<const Real> p, std::span<const Real> alpha, std::span<const Real> mq,
+                     std::span<const Real> mp, std::span<const Real> rq, std::span<const Real> rp) {
+    const auto n = static_cast<std::size_t>(np_);
+    if (p.size() != n || alpha.size() != n || mq.size() != n || mp.size() != n || rq.size() != n || rp.size() != n)
+      throw InputError("porenet: restore_state needs one value per pore in each array");
+    p_.assign(p.begin(), p.end());
+    alpha_.assign(alpha.begin(), alpha.end());
+    mq_.assign(mq.begin(), mq.end());
+    mp_.assign(mp.begin(), mp.end());
+    rq_.assign(rq.begin(), rq.end());
+    rp_.assign(rp.begin(), rp.end());
+  }
 
   std::span<const Real> pressure() const { return p_; }
   std::span<const Real> liquid_fraction() const { return alpha_; }

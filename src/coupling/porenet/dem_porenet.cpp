@@ -1,0 +1,267 @@
+#include "coupling/porenet/dem_porenet.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <span>
+
+#include "core/error.hpp"
+#include "porenet/forces.hpp"
+#include "porenet/remap.hpp"
+
+namespace ff::coupling {
+
+namespace {
+std::uint64_t pair_key(Index a, Index b) {
+  const auto lo = static_cast<std::uint64_t>(std::min(a, b)), hi = static_cast<std::uint64_t>(std::max(a, b));
+  return lo << 32 | hi;
+}
+}  // namespace
+
+void DemPorenetCoupling::gather_positions(const dem::DemSystem& sys) {
+  const auto n = sys.particles.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    x_[k] = sys.particles.pos[k].x();
+    y_[k] = sys.particles.pos[k].y();
+    r_[k] = sys.particles.radius[k];
+  }
+}
+
+// Bonds (intact or broken) and touching neighbour pairs that are not bonds.
+void DemPorenetCoupling::build_pairs(const dem::DemSystem& sys) {
+  pairs_ = porenet::PairList{};
+  pair_bond_.clear();
+  std::vector<std::uint64_t> bonded;
+  bonded.reserve(sys.bonds.size());
+  for (std::size_t b = 0; b < sys.bonds.size(); ++b) {
+    const Index a = sys.bonds.i[b], c = sys.bonds.j[b];
+    pairs_.add(a, c, sys.bonds.broken[b] ? porenet::PairState::BrokenBond : porenet::PairState::Bond);
+    pair_bond_.push_back(static_cast<Index>(b));
+    bonded.push_back(pair_key(a, c));
+  }
+  std::sort(bonded.begin(), bonded.end());
+  const auto first = sys.neighbors().first(), second = sys.neighbors().second();
+  for (std::size_t k = 0; k < first.size(); ++k) {
+    const Index a = first[k], c = second[k];
+    const Vec3 d = sys.particles.pos[c] - sys.particles.pos[a];
+    if (d.norm() >= sys.particles.radius[a] + sys.particles.radius[c]) continue;
+    if (std::binary_search(bonded.begin(), bonded.end(), pair_key(a, c))) continue;
+    pairs_.add(a, c, porenet::PairState::Contact);
+    pair_bond_.push_back(-1);
+  }
+}
+
+// sigma_n = F_n / (2 min(R) t) from the bond's and the contact's loads of this step (F on the second
+// particle; compression pushes it away from the first: F.n > 0).
+void DemPorenetCoupling::fill_pair_state(const dem::DemSystem& sys) {
+  const auto& P = sys.particles;
+  const auto adj_off = sys.neighbors().adjacency_offsets();
+  const auto adj = sys.neighbors().adjacency();
+  const auto first = sys.neighbors().first(), second = sys.neighbors().second();
+  const auto& pl = sys.pair_loads();
+  const Real t = prm_.network.thickness;
+  const auto n = static_cast<Index>(pairs_.size());
+#pragma omp parallel for schedule(static)
+  for (Index q = 0; q < n; ++q) {
+    const Index a = pairs_.i[q], b = pairs_.j[q];
+    const Vec3 d = P.pos[b] - P.pos[a];
+    const Real dist = d.norm();
+    const Vec3 nrm = d / dist;
+    Real fn = 0;
+    const Index bond = pair_bond_[q];
+    if (bond >= 0) {
+      const Vec3& f = sys.bond_loads()[bond].f;
+      fn += (sys.bonds.i[bond] == a ? 1.0 : -1.0) * f.dot(nrm);
+      if (sys.bonds.broken[bond]) pairs_.state[q] = porenet::PairState::BrokenBond;
+    }
+    for (auto e = adj_off[a]; e < adj_off[a + 1]; ++e) {  // the contact slot of (a, b), if listed
+      const auto k = static_cast<std::size_t>(adj[e] >> 1);
+      const Index other = (adj[e] & 1) ? first[k] : second[k];
+      if (other != b || k >= pl.size()) continue;
+      fn += (first[k] == a ? 1.0 : -1.0) * pl[k].f.dot(nrm);
+    }
+    pairs_.sigma_n[q] = std::max(fn, 0.0) / (2 * std::min(P.radius[a], P.radius[b]) * t);
+    pairs_.opening[q] = pairs_.state[q] == porenet::PairState::BrokenBond
+                            ? std::max(dist - P.radius[a] - P.radius[b], 0.0)
+                            : 0.0;
+  }
+}
+
+void DemPorenetCoupling::set_boundaries(porenet::TwoPhaseFlow& flow, const porenet::Network2D& net) {
+  if (prm_.drainage != Drainage::Sides) return;
+  Real xmin = x_[0], xmax = x_[0], rmax = 0;
+  for (std::size_t k = 0; k < x_.size(); ++k) {
+    xmin = std::min(xmin, x_[k]);
+    xmax = std::max(xmax, x_[k]);
+    rmax = std::max(rmax, r_[k]);
+  }
+  for (Index i = 0; i < net.n_pores(); ++i)
+    if (net.pore_hull[i] && (net.pore_cx[i] < xmin + 2 * rmax || net.pore_cx[i] > xmax - 2 * rmax))
+      flow.set_bc(i, porenet::PoreBc::Pressure, prm_.ambient_pressure, prm_.saturation);
+}
+
+void DemPorenetCoupling::make_network_and_flow(std::unique_ptr<porenet::Network2D>& net,
+                                               std::unique_ptr<porenet::TwoPhaseFlow>& flow) {
+  const porenet::Particles2D parts{x_, y_, r_, {}};
+  net = std::make_unique<porenet::Network2D>(porenet::build_network_2d(parts, pairs_, prm_.network));
+  flow = std::make_unique<porenet::TwoPhaseFlow>(*net, prm_.fluid);
+  ref_x_ = x_;
+  ref_y_ = y_;
+}
+
+void DemPorenetCoupling::init(dem::DemSystem& sys, const PorenetCouplingParams& params) {
+  if (sys.settings.dim != 2)
+    throw InputError("coupling.porenet: the DEM/pore-network coupling runs on 2D disc samples (dem.dim = 2)");
+  if (!(params.saturation >= 0 && params.saturation <= 1))
+    throw InputError(fmt::format("coupling.porenet: saturation {} outside [0, 1]", params.saturation));
+  if (!(params.retriangulation_tolerance > 0))
+    throw InputError("coupling.porenet: retriangulation_tolerance must be > 0");
+  prm_ = params;
+  const auto n = sys.particles.size();
+  x_.assign(n, 0);
+  y_ = r_ = fx_ = fy_ = x_;
+  gather_positions(sys);
+  mean_radius_ = 0;
+  for (Real r : r_) mean_radius_ += r;
+  mean_radius_ /= static_cast<Real>(n);
+  build_pairs(sys);
+  make_network_and_flow(net_, flow_);
+  flow_->init(prm_.initial_pressure, prm_.saturation);
+  set_boundaries(*flow_, *net_);
+  pg_.assign(static_cast<std::size_t>(net_->n_pores()), 0);
+  stats_ = {};
+}
+
+void DemPorenetCoupling::set_uniform_state(Real p, Real s) {
+  for (Index i = 0; i < net_->n_pores(); ++i) flow_->set_pore_state(i, p, s);
+}
+
+void DemPorenetCoupling::retriangulate(const dem::DemSystem& sys) {
+  // Old network at the current positions (centroids for the nearest-pore map), then a new one.
+  porenet::update_network_2d(*net_, porenet::Particles2D{x_, y_, r_, {}}, pairs_);
+  auto old_net = std::move(net_);
+  auto old_flow = std::move(flow_);
+  build_pairs(sys);
+  fill_pair_state(sys);
+  make_network_and_flow(net_, flow_);
+  flow_->init(prm_.initial_pressure, prm_.saturation);
+  set_boundaries(*flow_, *net_);
+  porenet::remap_two_phase(*old_net, *old_flow, *net_, *flow_);
+  pg_.assign(static_cast<std::size_t>(net_->n_pores()), 0);
+  ++stats_.retriangulations;
+}
+
+void DemPorenetCoupling::add_forces(dem::DemSystem& sys) {
+  const auto p = flow_->pressure();
+  for (std::size_t i = 0; i < pg_.size(); ++i) pg_[i] = p[i] - prm_.ambient_pressure;
+  std::fill(fx_.begin(), fx_.end(), 0.0);
+  std::fill(fy_.begin(), fy_.end(), 0.0);
+  const porenet::Particles2D parts{x_, y_, r_, {}};
+  porenet::add_pressure_forces(*net_, parts, pg_, fx_, fy_);
+  if (prm_.shear_forces) porenet::add_shear_forces(*net_, parts, pg_, fx_, fy_);
+  for (std::size_t k = 0; k < fx_.size(); ++k) {
+    sys.particles.ext_force[k].x() += fx_[k];
+    sys.particles.ext_force[k].y() += fy_[k];
+  }
+}
+
+void DemPorenetCoupling::step(dem::DemSystem& sys) {
+  sys.update_neighbors();
+  sys.compute_forces();
+  gather_positions(sys);
+  Real dmax2 = 0;
+  for (std::size_t k = 0; k < x_.size(); ++k)
+    dmax2 = std::max(dmax2, (x_[k] - ref_x_[k]) * (x_[k] - ref_x_[k]) + (y_[k] - ref_y_[k]) * (y_[k] - ref_y_[k]));
+  stats_.max_displacement = std::sqrt(dmax2);
+  fill_pair_state(sys);
+  if (stats_.max_displacement > prm_.retriangulation_tolerance * mean_radius_) {
+    retriangulate(sys);
+    stats_.max_displacement = 0;
+  } else {
+    porenet::update_network_2d(*net_, porenet::Particles2D{x_, y_, r_, {}}, pairs_);
+  }
+  // Flow sub-steps inside the DEM step (the first one sees V^{n+1}: the compaction source).
+  const Real dt = sys.settings.dt;
+  stats_.last_stable_dt = flow_->stable_dt();
+  const Real limit = prm_.dt_safety * stats_.last_stable_dt;
+  long nsub = 1;
+  if (limit < dt) nsub = static_cast<long>(std::ceil(dt / limit));
+  if (nsub > prm_.max_substeps)
+    throw NumericalError(fmt::format(
+        "coupling.porenet: the flow needs {} sub-steps of {:.3g} s per DEM step of {:.3g} s (more than {}); "
+        "reduce the liquid bulk modulus or the DEM step, or raise the apertures",
+        nsub, limit, dt, prm_.max_substeps));
+  const Real h = dt / static_cast<Real>(nsub);
+  for (long s = 0; s < nsub; ++s) flow_->step_explicit(h);
+  stats_.last_substeps = nsub;
+  stats_.last_flow_dt = h;
+  sys.add_external_loads();
+  add_forces(sys);
+  sys.integrate();
+}
+
+Real DemPorenetCoupling::max_pressure() const {
+  Real m = -std::numeric_limits<Real>::infinity();
+  for (Real p : flow_->pressure()) m = std::max(m, p);
+  return m;
+}
+
+void DemPorenetCoupling::save(CheckpointWriter& w) const {
+  w.put("porenet.ref_x", ref_x_);
+  w.put("porenet.ref_y", ref_y_);
+  w.put("porenet.pair_i", pairs_.i);
+  w.put("porenet.pair_j", pairs_.j);
+  w.put("porenet.pair_state", pairs_.state);
+  w.put("porenet.pair_bond", pair_bond_);
+  const auto vec = [](std::span<const Real> s) { return std::vector<Real>(s.begin(), s.end()); };
+  w.put("porenet.p", vec(flow_->pressure()));
+  w.put("porenet.alpha", vec(flow_->liquid_fraction()));
+  w.put("porenet.mq", vec(flow_->liquid_mass()));
+  w.put("porenet.mp", vec(flow_->gas_mass()));
+  w.put("porenet.rq", vec(flow_->liquid_density()));
+  w.put("porenet.rp", vec(flow_->gas_density()));
+  w.put_value("porenet.stats", stats_);
+}
+
+void DemPorenetCoupling::load(CheckpointReader& r, dem::DemSystem& sys, const PorenetCouplingParams& params) {
+  prm_ = params;
+  const auto n = sys.particles.size();
+  x_.assign(n, 0);
+  y_ = r_ = fx_ = fy_ = x_;
+  gather_positions(sys);
+  mean_radius_ = 0;
+  for (Real rr : r_) mean_radius_ += rr;
+  mean_radius_ /= static_cast<Real>(n);
+  // The network as built at the last triangulation (same positions, same pair list: same numbering).
+  std::vector<Real> cur_x = x_, cur_y = y_;
+  r.get("porenet.ref_x", x_);
+  r.get("porenet.ref_y", y_);
+  pairs_ = porenet::PairList{};
+  r.get("porenet.pair_i", pairs_.i);
+  r.get("porenet.pair_j", pairs_.j);
+  r.get("porenet.pair_state", pairs_.state);
+  r.get("porenet.pair_bond", pair_bond_);
+  pairs_.sigma_n.assign(pairs_.i.size(), 0);
+  pairs_.opening.assign(pairs_.i.size(), 0);
+  make_network_and_flow(net_, flow_);
+  flow_->init(prm_.initial_pressure, prm_.saturation);
+  set_boundaries(*flow_, *net_);  // at the triangulation's positions, as when it was built
+  x_ = cur_x;
+  y_ = cur_y;
+  std::vector<Real> p, a, mq, mp, rq, rp;
+  r.get("porenet.p", p);
+  r.get("porenet.alpha", a);
+  r.get("porenet.mq", mq);
+  r.get("porenet.mp", mp);
+  r.get("porenet.rq", rq);
+  r.get("porenet.rp", rp);
+  if (p.size() != static_cast<std::size_t>(net_->n_pores()))
+    throw InputError(fmt::format("checkpoint: {} pore states for a rebuilt network of {} pores", p.size(), net_->n_pores()));
+  flow_->restore_state(p, a, mq, mp, rq, rp);
+  pg_.assign(static_cast<std::size_t>(net_->n_pores()), 0);
+  stats_ = r.get_value<CouplingStats>("porenet.stats");
+}
+
+}  // namespace ff::coupling

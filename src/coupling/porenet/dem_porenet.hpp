@@ -1,0 +1,101 @@
+// Two-way coupling of the bonded-disc DEM (2D) with the pore network of seed 004 (Krzaczek,
+// Tejchman & Nitka 2024, Granular Matter 26:38, Appendix B; porenet/ holds the network and flow).
+//
+// One coupled step (DemPorenetCoupling::step) uses the DemSystem's public stages:
+//   update_neighbors(); compute_forces();
+//   pair states from the fresh loads: sigma_n = F_n / (2 min(R_a, R_b) t) (compression > 0, clamped
+//     at 0 for Eq. B1), broken bonds with their opening max(0, |d| - R_a - R_b);
+//   retriangulate when the largest particle displacement since the last triangulation exceeds
+//     `retriangulation_tolerance` x the mean radius (phase masses carried by porenet's remap), else
+//     update the network's geometry with the moved discs: the new void volumes V^{n+1} (B19) drive the
+//     pressure (the undrained compaction effect);
+//   n explicit flow sub-steps of dt_dem / n, n = ceil(dt_dem / (safety dt_flow)), dt_flow the
+//     two-phase stable step (docs/porenet.md §3, §5); when dt_flow > dt_dem one flow step per DEM step;
+//   add_external_loads(); grain forces from the gauge pressure p - p_ambient (pressure B26-B27,
+//     channel shear B25, B28) into particles.ext_force; integrate().
+// Contacts and bonds that form between triangulations get their S2S channel at the next one.
+// Results are bit-identical on any thread count (porenet's fixed-order sums; per-particle loops).
+#pragma once
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "dem/dem_system.hpp"
+#include "io/checkpoint.hpp"
+#include "porenet/network.hpp"
+#include "porenet/two_phase.hpp"
+
+namespace ff::coupling {
+
+// Which pores drain: none (closed sample, undrained), or the pores on the convex hull within two
+// max radii of the sample's lateral sides (x extremes), held at the ambient pressure.
+enum class Drainage : std::uint8_t { Closed = 0, Sides = 1 };
+
+struct PorenetCouplingParams {
+  porenet::NetworkParams network;
+  porenet::TwoPhaseParams fluid;
+  Real initial_pressure = 1e5;  // [Pa]
+  Real ambient_pressure = 1e5;  // outside the sample [Pa]; forces use p - ambient
+  Real saturation = 1.0;        // initial liquid saturation, 0..1
+  Real retriangulation_tolerance = 0.25;  // x mean radius (cf. YADE defTolerance)
+  Real dt_safety = 0.9;                   // flow sub-step <= safety x stable step
+  long max_substeps = 200000;             // a flow step this small is an error, not a slow run
+  bool shear_forces = true;
+  Drainage drainage = Drainage::Closed;
+};
+
+struct CouplingStats {
+  long retriangulations = 0;
+  long last_substeps = 0;
+  Real last_flow_dt = 0;    // sub-step used [s]
+  Real last_stable_dt = 0;  // two-phase stable step [s]
+  Real max_displacement = 0;  // since the last triangulation [m]
+};
+
+class DemPorenetCoupling {
+ public:
+  // Builds pairs, network and flow from the system's current state (2D, after sys.initialise()).
+  void init(dem::DemSystem& sys, const PorenetCouplingParams& params);
+  void step(dem::DemSystem& sys);
+  void run(dem::DemSystem& sys, long steps) {
+    for (long s = 0; s < steps; ++s) step(sys);
+  }
+
+  const porenet::Network2D& network() const { return *net_; }
+  porenet::TwoPhaseFlow& flow() { return *flow_; }
+  const porenet::TwoPhaseFlow& flow() const { return *flow_; }
+  const porenet::PairList& pairs() const { return pairs_; }
+  const CouplingStats& stats() const { return stats_; }
+  const PorenetCouplingParams& params() const { return prm_; }
+  Real max_pressure() const;
+  // Fluid force of the last step on particle k [N] (x, y).
+  Real fluid_fx(Index k) const { return fx_[static_cast<std::size_t>(k)]; }
+  Real fluid_fy(Index k) const { return fy_[static_cast<std::size_t>(k)]; }
+  // Sets every pore's pressure and saturation (tests, initial states).
+  void set_uniform_state(Real p, Real saturation);
+
+  // Checkpoint sections (prefix "porenet."): reference positions, pair list, per-pore state.
+  void save(CheckpointWriter& w) const;
+  // After the DemSystem was restored; params as at init.
+  void load(CheckpointReader& r, dem::DemSystem& sys, const PorenetCouplingParams& params);
+
+ private:
+  void gather_positions(const dem::DemSystem& sys);
+  void build_pairs(const dem::DemSystem& sys);
+  void fill_pair_state(const dem::DemSystem& sys);
+  void make_network_and_flow(std::unique_ptr<porenet::Network2D>& net, std::unique_ptr<porenet::TwoPhaseFlow>& flow);
+  void set_boundaries(porenet::TwoPhaseFlow& flow, const porenet::Network2D& net);
+  void retriangulate(const dem::DemSystem& sys);
+  void add_forces(dem::DemSystem& sys);
+
+  PorenetCouplingParams prm_;
+  std::unique_ptr<porenet::Network2D> net_;
+  std::unique_ptr<porenet::TwoPhaseFlow> flow_;
+  porenet::PairList pairs_;
+  std::vector<Index> pair_bond_;  // bond index per pair, -1 for a contact
+  std::vector<Real> x_, y_, r_, ref_x_, ref_y_, fx_, fy_, pg_;
+  Real mean_radius_ = 0;
+  CouplingStats stats_;
+};
+
+}  // namespace ff::coupling
