@@ -11,6 +11,7 @@
 #include "drivers/ucs/ucs_driver.hpp"
 #include "drivers/flow/flow_drivers.hpp"
 #include "drivers/hydrofrac/hydrofrac_driver.hpp"
+#include "drivers/sedimentation/sedimentation_driver.hpp"
 // Each driver's header declares one function returning its Driver record.
 // (Add the include and the entry below; the first entry is the default driver.)
 
@@ -27,6 +28,7 @@ const std::vector<Driver>& driver_list() {
       drivers::flow_cavity_driver(),
       drivers::flow_cylinder_driver(),
       drivers::hydrofrac_driver(),
+      drivers::sedimentation_driver(),
   };
   return list;
 }

@@ -1,0 +1,259 @@
+#include "coupling/dem_lbm_coupler.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "core/error.hpp"
+#include "dem/diagnostics.hpp"
+
+namespace ff::coupling {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// Gauss-Legendre nodes and weights on [-1, 1] (Newton on P_m; Press et al., Numerical Recipes,
+// 3rd ed., Sec. 4.6).
+void gauss_legendre(int m, std::vector<double>& x, std::vector<double>& w) {
+  x.assign(std::size_t(m), 0.0);
+  w.assign(std::size_t(m), 0.0);
+  for (int i = 0; i < (m + 1) / 2; ++i) {
+    double z = std::cos(M_PI * (i + 0.75) / (m + 0.5)), pp = 0;
+    for (int it = 0; it < 100; ++it) {
+      double p1 = 1, p2 = 0;
+      for (int j = 0; j < m; ++j) {
+        const double p3 = p2;
+        p2 = p1;
+        p1 = ((2.0 * j + 1.0) * z * p2 - j * p3) / (j + 1.0);
+      }
+      pp = m * (z * p1 - p2) / (z * z - 1.0);
+      const double dz = p1 / pp;
+      z -= dz;
+      if (std::abs(dz) < 1e-15) break;
+    }
+    x[std::size_t(i)] = -z;
+    x[std::size_t(m - 1 - i)] = z;
+    w[std::size_t(i)] = w[std::size_t(m - 1 - i)] = 2.0 / ((1.0 - z * z) * pp * pp);
+  }
+}
+
+}  // namespace
+
+double coupled_dem_time_step(const dem::DemSystem& s, double safety) {
+  double dt = dem::critical_time_step(s);
+  const auto& p = s.particles;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const int pt = s.materials.pair(p.group[i], p.group[i]);
+    const double k = dem::pair_stiffness(s, pt, p.radius[i], p.radius[i], 0.01 * p.radius[i]);
+    if (k > 0 && p.inv_mass[i] > 0) dt = std::min(dt, std::sqrt(1.0 / (p.inv_mass[i] * k)));
+  }
+  if (!std::isfinite(dt) || !(dt > 0))
+    throw InputError("coupling: no DEM time step follows from the particles (no stiffness); set the DEM step");
+  return safety * dt;
+}
+
+template <class L, class T>
+DemLbmCoupler<L, T>::DemLbmCoupler(dem::DemSystem& dem, lbm::Solver<L, T>& fluid, const FluidScales& scales,
+                                   const CouplerSettings& s)
+    : dem_(dem), fluid_(fluid), scales_(scales), cs_(s), dx_(scales.units.dx()) {
+  if (dem.settings.dim != L::D)
+    throw InputError(fmt::format("coupling: the DEM is {}D but the lattice {} is {}D", dem.settings.dim, L::name, L::D));
+  if (std::abs(fluid.settings().tau - scales.units.tau()) > 1e-12 * scales.units.tau())
+    throw InputError(fmt::format("coupling: the solver's tau {} differs from the fluid scales' {}", fluid.settings().tau,
+                                 scales.units.tau()));
+  n_sub_ = ff::coupling::sub_steps(scales.dt(), dem.settings.dt);
+  dem_.settings.dt = scales.dt() / double(n_sub_);
+  // Surface quadrature: symmetric under n -> -n, so the weights of a closed surface sum n dA to 0.
+  if (L::D == 2) {
+    const int n = std::max(8, cs_.quadrature);
+    for (int k = 0; k < n; ++k) {
+      const double a = 2.0 * M_PI * (k + 0.5) / n;
+      qn_.emplace_back(std::cos(a), std::sin(a), 0.0);
+      qw_.push_back(2.0 * M_PI / n);
+    }
+  } else {
+    const int m = std::max(4, cs_.quadrature / 8), nphi = 2 * m;
+    std::vector<double> x, w;
+    gauss_legendre(m, x, w);
+    for (int i = 0; i < m; ++i)
+      for (int k = 0; k < nphi; ++k) {
+        const double phi = 2.0 * M_PI * (k + 0.5) / nphi, st = std::sqrt(1.0 - x[std::size_t(i)] * x[std::size_t(i)]);
+        qn_.emplace_back(st * std::cos(phi), st * std::sin(phi), x[std::size_t(i)]);
+        qw_.push_back(w[std::size_t(i)] * 2.0 * M_PI / nphi);
+      }
+  }
+  resize(dem.particles.size());
+}
+
+template <class L, class T>
+void DemLbmCoupler<L, T>::resize(std::size_t n) {
+  set_.resize(n);
+  force_.assign(n, Vec3::Zero());
+  torque_.assign(n, Vec3::Zero());
+  dry_force_.assign(n, Vec3::Zero());
+  p_particle_.assign(n, scales_.background_pressure);
+  has_dry_.assign(n, 0);
+}
+
+template <class L, class T>
+bool DemLbmCoupler<L, T>::dry(const Vec3& xl) const {
+  const auto& g = fluid_.grid();
+  int c[3] = {0, 0, 0};
+  for (int a = 0; a < L::D; ++a) {
+    int v = int(std::floor(xl[a] + 0.5));
+    const int n = g.n(a);
+    if (g.periodic[std::size_t(a)]) {
+      v %= n;
+      if (v < 0) v += n;
+    } else if (v < 0 || v >= n) {
+      return fluid_.face(2 * a + (v < 0 ? 0 : 1)).kind == lbm::FaceCondition::Kind::Wall;
+    }
+    c[a] = v;
+  }
+  return fluid_.is_solid(c[0], c[1], c[2]);
+}
+
+template <class L, class T>
+void DemLbmCoupler<L, T>::build_set() {
+  const auto& p = dem_.particles;
+  const double dt = scales_.dt(), vf = dt / dx_;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    set_.id[i] = std::uint64_t(p.id[i]);
+    set_.position[i] = to_lattice(p.pos[i]);
+    set_.radius[i] = p.radius[i] / dx_;
+    set_.velocity[i] = p.vel[i] * vf;
+    set_.omega[i] = p.omega[i] * dt;
+    if (L::D == 2) {
+      set_.position[i].z() = 0;
+      set_.velocity[i].z() = 0;
+      set_.omega[i].x() = set_.omega[i].y() = 0;
+    }
+  }
+}
+
+template <class L, class T>
+void DemLbmCoupler<L, T>::pressure_loads() {
+  const auto& g = fluid_.grid();
+  const auto& p = dem_.particles;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    dry_force_[i] = Vec3::Zero();
+    if (!has_dry_[i]) continue;
+    // p_s: mean physical pressure of the fluid cells within r + 1.5 cells of the centre.
+    const Vec3 c = set_.position[i];
+    const double reach = set_.radius[i] + 1.5;
+    double sum = 0;
+    long cnt = 0;
+    const int z0 = L::D == 3 ? int(std::floor(c.z() - reach)) : 0, z1 = L::D == 3 ? int(std::ceil(c.z() + reach)) : 0;
+    for (int z = z0; z <= z1; ++z)
+      for (int y = int(std::floor(c.y() - reach)); y <= int(std::ceil(c.y() + reach)); ++y)
+        for (int x = int(std::floor(c.x() - reach)); x <= int(std::ceil(c.x() + reach)); ++x) {
+          const Vec3 d(x - c.x(), y - c.y(), L::D == 3 ? z - c.z() : 0.0);
+          if (d.squaredNorm() > reach * reach) continue;
+          const int xs = g.periodic[0] ? g.step(x, 0, 0) : x, ys = g.periodic[1] ? g.step(y, 0, 1) : y;
+          const int zs = L::D == 3 && g.periodic[2] ? g.step(z, 0, 2) : z;
+          // step() wraps one period at most; particles lie within one period of the box.
+          if (!g.is_interior(xs, ys, zs) || fluid_.is_solid(xs, ys, zs)) continue;
+          sum += fluid_.density(xs, ys, zs);
+          ++cnt;
+        }
+    if (cnt == 0) continue;  // entirely dry: no fluid presses on it
+    const double ps = scales_.pressure(sum / double(cnt));
+    p_particle_[i] = ps;
+    const double r = p.radius[i], area = L::D == 3 ? r * r : r;  // 2D: per metre of depth (unit-thickness disk)
+    const double rl = set_.radius[i];  // points on the surface
+    Vec3 f = Vec3::Zero();
+    for (std::size_t k = 0; k < qn_.size(); ++k)
+      if (dry(c + rl * qn_[k])) f += qn_[k] * qw_[k];
+    dry_force_[i] = f * (ps * area);
+  }
+}
+
+template <class L, class T>
+void DemLbmCoupler<L, T>::step(bool sample_fluid) {
+  auto t0 = Clock::now();
+  auto& p = dem_.particles;
+  if (set_.size() != p.size()) resize(p.size());  // particles added or removed (not in a plain run)
+  build_set();
+  bool any_dry = false;
+  if (cs_.pressure_load)
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      char d = 0;
+      const double rl = set_.radius[i];
+      for (std::size_t k = 0; k < qn_.size() && !d; ++k) d = dry(set_.position[i] + rl * qn_[k]) ? 1 : 0;
+      has_dry_[i] = d;
+      any_dry = any_dry || d;
+    }
+  fluid_.set_particles(set_);
+  times.coupling += seconds_since(t0);
+  t0 = Clock::now();
+  fluid_.step(sample_fluid || any_dry);
+  times.lbm += seconds_since(t0);
+  t0 = Clock::now();
+  if (any_dry) pressure_loads();
+  const auto& F = fluid_.particle_forces();
+  const auto& M = fluid_.particle_torques();
+  const auto& u = scales_.units;
+  const Vec3 g = dem_.settings.gravity;
+  const double rho_f = u.rho();
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    Vec3 f(u.to_si_force(F[i].x(), L::D), u.to_si_force(F[i].y(), L::D), u.to_si_force(F[i].z(), L::D));
+    Vec3 m(u.to_si_torque(M[i].x(), L::D), u.to_si_torque(M[i].y(), L::D), u.to_si_torque(M[i].z(), L::D));
+    if (L::D == 2) {
+      f.z() = 0;
+      m.x() = m.y() = 0;
+    }
+    if (cs_.pressure_load) f += dry_force_[i];
+    if (cs_.buoyancy) {
+      const double r = p.radius[i];
+      const double vol = L::D == 3 ? 4.0 / 3.0 * M_PI * r * r * r : M_PI * r * r;
+      f -= rho_f * vol * g;
+    }
+    force_[i] = f;
+    torque_[i] = m;
+  }
+  times.coupling += seconds_since(t0);
+  t0 = Clock::now();
+  for (long s = 0; s < n_sub_; ++s) {
+    dem_.update_neighbors();
+    dem_.compute_forces();
+    dem_.add_external_loads();
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      p.ext_force[i] += force_[i];
+      p.ext_moment[i] += torque_[i];
+    }
+    dem_.integrate();
+  }
+  times.dem += seconds_since(t0);
+}
+
+template <class L, class T>
+Vec3 DemLbmCoupler<L, T>::fluid_momentum() const {
+  // From the populations of the state before the next step (AA pattern: even t: g_q(x) in f[q][x];
+  // odd t: in f[opp q][x - c_q], so the box sum is -sum c_p f[p]); exact in a periodic box.
+  const auto& g = fluid_.grid();
+  const auto& f = fluid_.populations();
+  const lbm::CellIndex N = g.padded_size();
+  long double P[3] = {0, 0, 0};
+  for (int z = 0; z < g.nz; ++z)
+    for (int y = 0; y < g.ny; ++y)
+      for (int x = 0; x < g.nx; ++x) {
+        if (fluid_.is_solid(x, y, z)) continue;
+        for (int q = 1; q < L::Q; ++q)
+          for (int a = 0; a < L::D; ++a) P[a] += (long double)(L::c[q][a]) * f[std::size_t(q * N + g.index(x, y, z))];
+      }
+  const double sign = fluid_.time_step() % 2 == 0 ? 1.0 : -1.0;
+  const auto& u = scales_.units;
+  const double scale = u.rho() * std::pow(dx_, L::D) * u.velocity_factor();
+  return sign * scale * Vec3(double(P[0]), double(P[1]), double(P[2]));
+}
+
+template class DemLbmCoupler<lbm::D2Q9, double>;
+template class DemLbmCoupler<lbm::D2Q9, float>;
+template class DemLbmCoupler<lbm::D3Q19, double>;
+template class DemLbmCoupler<lbm::D3Q19, float>;
+
+}  // namespace ff::coupling

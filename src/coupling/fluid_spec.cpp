@@ -1,0 +1,113 @@
+#include "coupling/fluid_spec.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "core/error.hpp"
+
+namespace ff::coupling {
+
+namespace {
+const double kSqrt3 = std::sqrt(3.0);
+}
+
+FluidScales derive_scales(const FluidSpec& s) {
+  auto key = [&](const char* k) { return s.prefix + "." + k; };
+  auto fail = [&](const char* k, const std::string& what) {
+    throw InputError(fmt::format("{}: {}", key(k), what));
+  };
+  if (!(s.density > 0)) fail("density", fmt::format("must be positive (got {})", s.density));
+  if (s.dynamic_viscosity < 0) fail("dynamic_viscosity", fmt::format("must be positive (got {})", s.dynamic_viscosity));
+  if (s.dynamic_viscosity == 0 && !(s.viscosity > 0))
+    fail("viscosity", fmt::format("must be positive (got {})", s.viscosity));
+  if (!(s.dx > 0)) fail("dx", fmt::format("the lattice spacing must be positive (got {})", s.dx));
+  std::vector<const char*> set;
+  if (s.tau != 0) set.push_back("tau");
+  if (s.time_step != 0) set.push_back("time_step");
+  if (s.sound_speed != 0) set.push_back("sound_speed");
+  if (s.bulk_modulus != 0) set.push_back("bulk_modulus");
+  if (set.size() != 1)
+    fail(set.empty() ? "tau" : set[1],
+         fmt::format("set exactly one of {0}.tau, {0}.time_step, {0}.sound_speed and {0}.bulk_modulus (each fixes the "
+                     "LBM time step; {1} set)",
+                     s.prefix, set.empty() ? std::string("none is") : fmt::format("{} and {} are both", set[0], set[1])));
+  FluidScales r;
+  r.fixed_by = key(set[0]);
+  double dt = 0;
+  const double nu = s.dynamic_viscosity > 0 ? s.dynamic_viscosity / s.density : s.viscosity, dx = s.dx;
+  if (s.tau != 0) {
+    if (!(s.tau > 0.5)) fail("tau", fmt::format("must exceed 1/2 (got {})", s.tau));
+    dt = (s.tau - 0.5) * dx * dx / (3.0 * nu);
+  } else if (s.time_step != 0) {
+    if (!(s.time_step > 0)) fail("time_step", fmt::format("must be positive (got {})", s.time_step));
+    dt = s.time_step;
+  } else {
+    double c = s.sound_speed;
+    if (s.bulk_modulus != 0) {
+      if (!(s.bulk_modulus > 0)) fail("bulk_modulus", fmt::format("must be positive (got {})", s.bulk_modulus));
+      c = std::sqrt(s.bulk_modulus / s.density);
+    } else if (!(c > 0)) {
+      fail("sound_speed", fmt::format("must be positive (got {})", c));
+    }
+    dt = dx / (kSqrt3 * c);  // c_s,lb = 1/sqrt(3) = c dt / dx
+  }
+  r.units = lbm::Units::from_time_step(dx, dt, nu, s.density);
+  r.sound_speed = dx / (kSqrt3 * dt);
+  r.bulk_modulus = s.density * r.sound_speed * r.sound_speed;
+  r.background_pressure = s.background_pressure;
+  r.mach = s.reference_velocity / r.sound_speed;
+  r.density_variation = s.pressure_range / r.bulk_modulus;
+  const double tau = r.units.tau();
+  if (tau - 0.5 < kMinTauMinusHalf)
+    fail(set[0], fmt::format("gives tau = {:.6g}, too close to 1/2 (tau - 1/2 = {:.3g} < {}): the LBM is unstable there. "
+                             "To fix it, {}",
+                             tau, tau - 0.5, kMinTauMinusHalf,
+                             fmt::format("raise the time step (a larger {} or a lower {}.sound_speed / bulk_modulus), "
+                                         "raise {} or use a coarser {} (tau - 1/2 = 3 nu dt / dx^2)",
+                                         r.fixed_by, s.prefix, key("viscosity"), key("dx"))));
+  if (tau > kMaxTau)
+    fail(set[0], fmt::format("gives tau = {:.6g} > {}: the partially saturated cells' drag error grows with tau "
+                             "(docs/lbm.md); use a shorter time step or a finer {}",
+                             tau, kMaxTau, key("dx")));
+  if (tau - 0.5 < kWarnTauMinusHalf)
+    r.warnings.push_back(fmt::format("tau = {:.5g} is close to 1/2: TRT stays stable there, but under-resolved flow may "
+                                     "ring",
+                                     tau));
+  if (r.mach > kMaxMach)
+    fail(set[0], fmt::format("gives the sound speed {:.4g} m/s, and {} = {:.4g} m/s is Mach {:.3g} > {}: the LBM is "
+                             "then far from incompressible. Raise the sound speed (a shorter time step)",
+                             r.sound_speed, key("reference_velocity"), s.reference_velocity, r.mach, kMaxMach));
+  if (r.mach > kWarnMach)
+    r.warnings.push_back(fmt::format("Mach number {:.3g} > {}: compressibility error about Ma^2 = {:.2g}", r.mach,
+                                     kWarnMach, r.mach * r.mach));
+  if (r.density_variation > kMaxDensityVariation)
+    fail(set[0], fmt::format("gives K_eff = {:.4g} Pa, and {} = {:.4g} Pa is a lattice density variation of {:.3g} > "
+                             "{}: raise the sound speed or bulk modulus",
+                             r.bulk_modulus, key("pressure_range"), s.pressure_range, r.density_variation,
+                             kMaxDensityVariation));
+  if (r.density_variation > kWarnDensityVariation)
+    r.warnings.push_back(fmt::format("pressure changes of {:.4g} Pa are lattice density changes of {:.3g}: the "
+                                     "fluid is {:.3g} times as compressible as at K = 2.2 GPa (water)",
+                                     s.pressure_range, r.density_variation, 2.2e9 / r.bulk_modulus));
+  return r;
+}
+
+std::string FluidScales::describe() const {
+  return fmt::format(
+      "fluid: LBM step dt = {:.6g} s (from {}), tau = {:.5g}, dx = {:.6g} m; sound speed {:.5g} m/s, effective bulk "
+      "modulus K_eff = rho c_s^2 = {:.5g} Pa; Mach number {:.3g}; background pressure p0 = {:.6g} Pa carried outside "
+      "the populations (p = p0 + K_eff (rho_lb - 1))",
+      units.dt(), fixed_by, units.tau(), units.dx(), sound_speed, bulk_modulus, mach, background_pressure);
+}
+
+long sub_steps(double dt_lbm, double dt_dem) {
+  if (!(dt_dem > 0) || !(dt_lbm > 0)) throw InputError("coupling: the LBM and DEM time steps must be positive");
+  const double q = dt_lbm / dt_dem;
+  long n = long(std::ceil(q));
+  // dt_lbm an exact multiple of dt_dem up to round-off: no extra sub-step.
+  if (n > 1 && double(n - 1) >= q * (1 - 1e-12)) --n;
+  return std::max(1L, n);
+}
+
+}  // namespace ff::coupling
