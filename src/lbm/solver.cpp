@@ -201,7 +201,7 @@ double Solver<L, T>::total_mass() const {
     for (int y = 0; y < grid_.ny; ++y)
       for (int x = 0; x < grid_.nx; ++x) {
         const CellIndex i = grid_.index(x, y, z);
-        if (type_[i] == CellType::Fluid) m += 1.0 + double(drho_[i]);
+        if (type_[i] == CellType::Fluid && !(mb_ && mb_->solid(i))) m += 1.0 + double(drho_[i]);
       }
   return m;
 }
@@ -216,9 +216,16 @@ void Solver<L, T>::step(bool sample) {
   const bool psm = psm_ && psm_->active();
   if (psm && psm_kinds_stale_)
     throw Error("internal: LBM geometry finalized after set_particles(): set the particles again before stepping");
+  if (mb_ && mb_->active() && psm_kinds_stale_)
+    throw Error("internal: LBM geometry finalized after set_particles(): set the particles again before stepping");
   bulk_sweep(odd, sample);  // covered bulk cells: Psm::save_span / apply_span around their span
   boundary_sweep(odd, sample);
   if (psm) psm_->reduce();
+  // Solid particle cells: the links' bounce-back into the slots of the next step, then the reset.
+  if (mb_) {
+    if (mb_->active()) mb_->apply(f_.data(), odd);
+    mb_->reduce();
+  }
   reduce_forces();
   ++time_;
 }
@@ -416,7 +423,25 @@ void Solver<L, T>::update_boundary_cell(std::size_t i, bool odd, bool sample) {
 }
 
 template <class L, class T>
+void Solver<L, T>::moving_particles(const ParticleSet& p, bool bookkeeping) {
+  if (!mb_) mb_ = std::make_unique<MovingBoundary<L, T>>(grid_, settings_.particle_scheme, settings_.incompressible);
+  if (psm_kinds_stale_) {
+    std::vector<std::uint8_t> fluid(std::size_t(n_()), 0);
+    for (std::size_t i = 0; i < fluid.size(); ++i) fluid[i] = type_[i] == CellType::Fluid;
+    mb_->set_fluid_mask(std::move(fluid));
+    psm_kinds_stale_ = false;
+  }
+  mb_->set_particles(p, f_.data(), (time_ & 1) != 0, bookkeeping);
+}
+
+template <class L, class T>
+void Solver<L, T>::restore_particles(const ParticleSet& last) {
+  if (settings_.particle_scheme != ParticleScheme::Psm) moving_particles(last, false);
+}
+
+template <class L, class T>
 void Solver<L, T>::set_particles(const ParticleSet& p) {
+  if (settings_.particle_scheme != ParticleScheme::Psm) return moving_particles(p, true);
   if (!psm_) psm_ = std::make_unique<Psm<L, T>>(grid_, settings_.tau);
   if (psm_kinds_stale_) {
     std::vector<std::int32_t> span_of(std::size_t(n_()), Psm<L, T>::kNotFluid);
@@ -433,12 +458,14 @@ void Solver<L, T>::set_particles(const ParticleSet& p) {
 template <class L, class T>
 const std::vector<Vec3>& Solver<L, T>::particle_forces() const {
   static const std::vector<Vec3> none;
+  if (mb_) return mb_->forces();
   return psm_ ? psm_->forces() : none;
 }
 
 template <class L, class T>
 const std::vector<Vec3>& Solver<L, T>::particle_torques() const {
   static const std::vector<Vec3> none;
+  if (mb_) return mb_->torques();
   return psm_ ? psm_->torques() : none;
 }
 
@@ -452,6 +479,7 @@ void Solver<L, T>::reduce_forces() {
   for (std::size_t l = 0; l < links_.size(); ++l) {
     const Link& k = links_[l];
     const BoundaryCell& b = bcells_[k.cell];
+    if (mb_ && mb_->solid(b.cell)) continue;  // a particle covers the cell: its wall sees no fluid there
     SolidObject& obj = objects_[k.object];
     const Vec3 F(link_force_[3 * l], link_force_[3 * l + 1], link_force_[3 * l + 2]);
     const int o = L::opp[k.q];

@@ -32,6 +32,7 @@
 #include "lbm/collision.hpp"
 #include "lbm/descriptor.hpp"
 #include "lbm/grid.hpp"
+#include "lbm/moving_boundary.hpp"
 #include "lbm/psm.hpp"
 #include "lbm/shapes.hpp"
 
@@ -69,6 +70,8 @@ struct SolverSettings {
   Vec3 body_force = Vec3::Zero();    // force density, lattice units (Guo forcing)
   // He & Luo (1997) incompressible equilibrium (collision.hpp): rho_0 = 1 in the momentum terms.
   bool incompressible = false;
+  // How set_particles() puts moving particles into the fluid (lbm/moving_boundary.hpp), fixed per solver.
+  ParticleScheme particle_scheme = ParticleScheme::Psm;
 };
 
 // A solid body (or a wall of the box) and the hydrodynamic load on it.
@@ -139,10 +142,17 @@ class Solver {
   // ---- moving particles as partially saturated cells (lbm/psm.hpp), set before each step(); the
   // covered cells' update then uses this set until the next call. Forces and torques of the
   // last step on each particle (lattice units, indexed like the set; Units::to_si_force and to_si_torque).
+  // With SolverSettings::particle_scheme a bounce-back scheme, the particles are solid cells instead
+  // (lbm/moving_boundary.hpp); the same calls apply.
   void set_particles(const ParticleSet& p);
   const std::vector<Vec3>& particle_forces() const;
   const std::vector<Vec3>& particle_torques() const;
   const Psm<L, T>* psm() const { return psm_.get(); }
+  const MovingBoundary<L, T>* moving_boundary() const { return mb_.get(); }
+  // Resume with a bounce-back scheme: after restore(), the set of the last step before the
+  // checkpoint (its solid cells are state: the next set_particles() refills the cells it uncovers).
+  // Nothing to do for the PSM.
+  void restore_particles(const ParticleSet& last);
 
   // Convective outflow: the speed U of the face's last step (set or the mean outflow speed).
   double outflow_velocity(int face) const { return double(convective_u_[face]); }
@@ -207,6 +217,8 @@ class Solver {
   std::vector<BulkDonor> bulk_donors_;
   std::array<T, kNumFaces> convective_u_{};
   std::unique_ptr<Psm<L, T>> psm_;     // created by the first set_particles()
+  std::unique_ptr<MovingBoundary<L, T>> mb_;  // the same for the bounce-back schemes
+  void moving_particles(const ParticleSet& p, bool bookkeeping);
   bool psm_kinds_stale_ = true;        // finalize() changed the cell classification
 };
 
