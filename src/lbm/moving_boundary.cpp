@@ -306,18 +306,6 @@ void MovingBoundary<L, T>::apply(T* f, bool odd) {
 }
 
 template <class L, class T>
-void MovingBoundary<L, T>::rest_loads(std::vector<Vec3>& force, std::vector<Vec3>& torque) const {
-  force.assign(force_.size(), Vec3::Zero());
-  torque.assign(force_.size(), Vec3::Zero());
-  for (const MovingLink& k : links_) {
-    const int o = L::opp[k.q];
-    const Vec3 F = 2.0 * L::w[k.q] * Vec3(L::c[o][0], L::c[o][1], L::c[o][2]);
-    force[std::size_t(k.particle)] += F;
-    torque[std::size_t(k.particle)] += k.arm.cross(F);
-  }
-}
-
-template <class L, class T>
 void MovingBoundary<L, T>::reduce() {
   // The change of the set is counted once, with the first step after it.
   force_ = impulse_;

@@ -88,10 +88,6 @@ class MovingBoundary {
   void apply(T* f, bool odd);
   void reduce();
 
-  // Loads of a fluid at rest at rho = 1 on the current links, per particle (lattice units): the
-  // reference pressure c_s^2 of the momentum exchange, 2 w_q c_o on each link (equilibrium in and
-  // out). A coupled run subtracts rho_ref times it to load a particle with p - p_ref only.
-  void rest_loads(std::vector<Vec3>& force, std::vector<Vec3>& torque) const;
   bool active() const { return !cells_.empty(); }
   bool solid(CellIndex cell) const { return !owner_.empty() && owner_[std::size_t(cell)] >= 0; }
   const std::vector<Vec3>& forces() const { return force_; }

@@ -311,15 +311,18 @@ class LbmLoad final : public LbmLoadBase {
     // Loads: the momentum exchange minus that of the reference fluid at rest (p0) on the same links.
     const auto& F = fluid_->particle_forces();
     const auto& M = fluid_->particle_torques();
-    const auto* mb = fluid_->moving_boundary();
-    if (mb) mb->rest_loads(ref_f_, ref_t_);
+    flood();
     const auto& u = info_.scales.units;
+    const double dx = s_.fluid.dx;
     for (std::size_t i = 0; i < force_.size(); ++i) {
-      Vec3 f = F[i], m = M[i];
-      if (mb) {
-        f -= ref_f_[i];
-        m -= ref_t_[i];
+      // Dry rock: only particles that touch fluid connected to the hole carry a fluid load; the
+      // pore pockets between intact grains are sealed, and their trapped fluid (a stiff spring at
+      // K_eff) would only make the explicit coupling unstable.
+      if (!touches_wet(set_.position[i], sys.particles.radius[i] / dx)) {
+        force_[i] = torque_[i] = Vec3::Zero();
+        continue;
       }
+      const Vec3 f = F[i], m = M[i];
       Vec3 fs(u.to_si_force(f.x(), L::D), u.to_si_force(f.y(), L::D), u.to_si_force(f.z(), L::D));
       Vec3 ms(u.to_si_torque(m.x(), L::D), u.to_si_torque(m.y(), L::D), u.to_si_torque(m.z(), L::D));
       if (L::D == 2) {
@@ -330,6 +333,48 @@ class LbmLoad final : public LbmLoadBase {
       torque_[i] = ms;
     }
     count_wetted(sys);  // O(cracks) per LBM step
+  }
+
+  // The fluid connected to the hole now: flood over uncovered cells (4 / 6 neighbours) from the
+  // hole's cells; cost proportional to the connected region.
+  void flood() {
+    const auto& g = fluid_->grid();
+    if (wet_.size() != std::size_t(g.nx) * g.ny * g.nz) wet_.assign(std::size_t(g.nx) * g.ny * g.nz, 0);
+    for (std::size_t k : wet_list_) wet_[k] = 0;
+    wet_list_.clear();
+    auto lin = [&](int x, int y, int z) { return std::size_t(x) + std::size_t(g.nx) * (std::size_t(y) + std::size_t(g.ny) * z); };
+    auto push = [&](int x, int y, int z) {
+      if (!g.is_interior(x, y, z)) return;
+      const std::size_t k = lin(x, y, z);
+      if (wet_[k] || fluid_->covered(x, y, z)) return;
+      wet_[k] = 1;
+      wet_list_.push_back(k);
+    };
+    for (const auto& c : hole_cells_) push(c[0], c[1], c[2]);
+    for (std::size_t h = 0; h < wet_list_.size(); ++h) {
+      const std::size_t k = wet_list_[h];
+      const int x = int(k % std::size_t(g.nx)), y = int((k / std::size_t(g.nx)) % std::size_t(g.ny)),
+                z = int(k / (std::size_t(g.nx) * g.ny));
+      push(x - 1, y, z);
+      push(x + 1, y, z);
+      push(x, y - 1, z);
+      push(x, y + 1, z);
+      if (L::D == 3) {
+        push(x, y, z - 1);
+        push(x, y, z + 1);
+      }
+    }
+  }
+  bool touches_wet(const Vec3& c, double r) const {
+    const auto& g = fluid_->grid();
+    const double reach = r + 1.0;
+    const int z0 = L::D == 3 ? std::max(0, int(std::floor(c.z() - reach))) : 0,
+              z1 = L::D == 3 ? std::min(g.nz - 1, int(std::ceil(c.z() + reach))) : 0;
+    for (int z = z0; z <= z1; ++z)
+      for (int y = std::max(0, int(std::floor(c.y() - reach))); y <= std::min(g.ny - 1, int(std::ceil(c.y() + reach))); ++y)
+        for (int x = std::max(0, int(std::floor(c.x() - reach))); x <= std::min(g.nx - 1, int(std::ceil(c.x() + reach))); ++x)
+          if (wet_[std::size_t(x) + std::size_t(g.nx) * (std::size_t(y) + std::size_t(g.ny) * z)]) return true;
+    return false;
   }
 
   // Wetted cracks: crack points (broken bonds and joints) whose lattice cell is fluid with p - p0
@@ -363,9 +408,11 @@ class LbmLoad final : public LbmLoadBase {
   std::unique_ptr<Solver> fluid_;
   std::vector<std::array<int, 3>> hole_cells_;
   lbm::ParticleSet set_;
-  std::vector<Vec3> force_, torque_, ref_f_, ref_t_;
+  std::vector<Vec3> force_, torque_;
   State st_;
   long wetted_cracks_ = 0;
+  std::vector<std::uint8_t> wet_;
+  std::vector<std::size_t> wet_list_;
 };
 
 }  // namespace
