@@ -35,6 +35,7 @@
 #include "drivers/hydrofrac/sleeve_load.hpp"
 #include "drivers/hydrofrac/lbm_load.hpp"
 #include "io/pvd.hpp"
+#include "coupling/fluid_spec.hpp"
 #include "drivers/run_control.hpp"
 #include "drivers/run_estimate.hpp"
 #include "drivers/run_record.hpp"
@@ -154,13 +155,29 @@ Block block_of(const Config& cfg) {
   return b;
 }
 
+// The fluid of injection.fluid = "lbm" (keys fluid.*), in SI.
+coupling::FluidSpec lbm_fluid_spec(const Config& cfg) {
+  coupling::FluidSpec f;
+  f.density = cfg.real("fluid.density");
+  f.viscosity = cfg.real("fluid.viscosity");
+  f.dynamic_viscosity = cfg.real("fluid.dynamic_viscosity");
+  f.dx = cfg.real("fluid.dx") > 0 ? cfg.real("fluid.dx") : cfg.real("sample.radius_min") / cfg.real("fluid.cells_per_radius");
+  f.bulk_modulus = cfg.real("fluid.bulk_modulus");
+  f.sound_speed = cfg.real("fluid.sound_speed");
+  f.time_step = cfg.real("fluid.time_step");
+  f.tau = cfg.real("fluid.tau");
+  f.background_pressure = cfg.real("fluid.background_pressure");
+  f.reference_velocity = cfg.real("fluid.reference_velocity");
+  f.pressure_range = cfg.real("fluid.pressure_range") > 0 ? cfg.real("fluid.pressure_range") : cfg.real("injection.max_pressure");
+  return f;
+}
+
 void validate(const Config& cfg) {
   dem::validate_dem_sample(cfg);
   if (cfg.string("sample.shape") != "box")
     cfg.fail("sample.shape", "the hydrofrac block is a box: shape = \"box\" (2D rectangle in x-y; 3D box with the borehole along z)");
-  if (cfg.string("injection.fluid") == "lbm" && cfg.real("fluid.dx") == 0 &&
-      cfg.real("sample.radius_min") / cfg.real("fluid.cells_per_radius") <= 0)
-    cfg.fail("fluid.dx", "no lattice spacing: set fluid.dx or fluid.cells_per_radius");
+  // The fluid's own checks (tau, Mach, density variation; the DEM step rounds dt_lbm later).
+  if (cfg.string("injection.fluid") == "lbm") (void)coupling::derive_scales(lbm_fluid_spec(cfg));
   const Block b = block_of(cfg);
   const Real R = cfg.real("borehole.radius"), rmax = cfg.real("sample.radius_max");
   const Real lmin = std::min(b.lx, b.ly);
@@ -323,18 +340,7 @@ void HydrofracRun::make_fluid() {
     return;
   }
   hydrofrac::LbmSettings l;
-  auto& f = l.fluid;
-  f.density = cfg.real("fluid.density");
-  f.viscosity = cfg.real("fluid.viscosity");
-  f.dynamic_viscosity = cfg.real("fluid.dynamic_viscosity");
-  f.dx = cfg.real("fluid.dx") > 0 ? cfg.real("fluid.dx") : rmin / cfg.real("fluid.cells_per_radius");
-  f.bulk_modulus = cfg.real("fluid.bulk_modulus");
-  f.sound_speed = cfg.real("fluid.sound_speed");
-  f.time_step = cfg.real("fluid.time_step");
-  f.tau = cfg.real("fluid.tau");
-  f.background_pressure = cfg.real("fluid.background_pressure");
-  f.reference_velocity = cfg.real("fluid.reference_velocity");
-  f.pressure_range = cfg.real("fluid.pressure_range") > 0 ? cfg.real("fluid.pressure_range") : cfg.real("injection.max_pressure");
+  l.fluid = lbm_fluid_spec(cfg);
   const std::string scheme = cfg.string("fluid.scheme");
   l.scheme = scheme == "psm"         ? lbm::ParticleScheme::Psm
              : scheme == "stairwise" ? lbm::ParticleScheme::StairwiseBounceBack

@@ -12,10 +12,9 @@
 //      FluidScales::lattice_density(p(t)), rate mode rho_b such that the hole gains the pumped
 //      mass Q dt (a uniform mass source; the pressure is then the mean over the hole's cells);
 //      the mass imposed, integrated, is the injected volume (at the reference density);
-//   3. each particle's load: the momentum exchange of the step minus that of a fluid at rest at
-//      rho_lb = 1 on the same links (MovingBoundary::rest_loads), so the rock feels p - p0 on its
-//      wetted surface (p0 the pore pressure acting all round the grains), converted to SI and held
-//      over the next n DEM steps (added to ext_force / ext_moment in add_forces).
+//   3. each particle touching fluid connected to the hole gets the solver's load (relative to
+//      rho_lb = 1: p - p0), converted to SI and held over the next n DEM steps.
+// Status: experimental; the bounce-back schemes diverge on the test block (docs/hydrofrac.md).
 // No allocation per step once the set has its size; the solver's loops are deterministic, so 1
 // and 2 threads give identical results; the checkpoint holds the populations, the LBM's step and
 // the last particle set, so a resumed run continues bit-for-bit.
