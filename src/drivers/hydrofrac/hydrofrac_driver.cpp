@@ -95,6 +95,9 @@ void declare(ParamTable& t) {
            "lbm: particles in the fluid: interpolated (Bouzidi bounce-back, solid cells), stairwise (half-way "
            "bounce-back), psm (partially saturated cells: intact rock leaks, docs/coupling.md)")
       .one_of({"interpolated", "stairwise", "psm"});
+  t.boolean("fluid.moving_walls", false,
+            "lbm: the particles' velocities enter the fluid's wall condition (false: quasi-static walls; true diverged "
+            "on the test block, docs/hydrofrac.md)");
   t.real("fluid.reference_velocity", 0.0, "m/s", "lbm: expected largest fluid speed, for the Mach check (0: no check)")
       .non_negative();
   t.real("fluid.pressure_range", 0.0, "Pa",
@@ -345,6 +348,7 @@ void HydrofracRun::make_fluid() {
   l.scheme = scheme == "psm"         ? lbm::ParticleScheme::Psm
              : scheme == "stairwise" ? lbm::ParticleScheme::StairwiseBounceBack
                                      : lbm::ParticleScheme::InterpolatedBounceBack;
+  l.moving_walls = cfg.boolean("fluid.moving_walls");
   l.rate_mode = s.rate_mode;
   l.ramp_rate = s.ramp_rate;
   l.initial_pressure = s.initial_pressure;

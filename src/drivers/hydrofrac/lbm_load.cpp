@@ -270,8 +270,11 @@ class LbmLoad final : public LbmLoadBase {
       set_.id[i] = std::uint64_t(p.id[i]);
       set_.position[i] = (p.pos[i] - info_.origin) / dx;
       set_.radius[i] = p.radius[i] / dx;
-      set_.velocity[i] = p.vel[i] * vf;
-      set_.omega[i] = p.omega[i] * dt;
+      // Quasi-static walls unless fluid.moving_walls (the moving-wall term made the bounce-back
+      // runs diverge; docs/hydrofrac.md).
+      const double w = s_.moving_walls ? 1.0 : 0.0;
+      set_.velocity[i] = p.vel[i] * (vf * w);
+      set_.omega[i] = p.omega[i] * (dt * w);
       if (L::D == 2) {
         set_.position[i].z() = 0;
         set_.velocity[i].z() = 0;

@@ -36,6 +36,7 @@ struct LbmSettings {
   bool rate_mode = false;
   Real ramp_rate = 0, initial_pressure = 0, flow_rate = 0;  // [Pa/s], [Pa], [m^3/s] (2D: per metre)
   Real cell = 0, inflate = 0, reach = 0;                    // wall particles (hole_surface)
+  bool moving_walls = false;  // particle velocities enter bounce-back (false: quasi-static walls)
   Real wet_fraction = 0.5;  // a crack is wetted when its cell's p - p0 exceeds this fraction of the hole's
 };
 
