@@ -516,7 +516,7 @@ void HydrofracRun::begin_injection() {
   st_.injection_time = sys.time;
   fluid_->begin(sys, hole_, joints_);
   if (lbm_) log::info("hydrofrac: lattice Boltzmann fluid ({}): {}", cfg.string("fluid.scheme"), lbm_->info().describe());
-  st_.effective_radius = static_cast<hydrofrac::SleeveLoad&>(*fluid_).effective_radius();
+  st_.effective_radius = lbm_ ? lbm_->effective_radius() : static_cast<hydrofrac::SleeveLoad&>(*fluid_).effective_radius();
   insitu_ = snapshot(0);
   const Vec3 ws = wall_stress();
   Real far_xx = 0, far_yy = 0;

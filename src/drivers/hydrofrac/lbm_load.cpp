@@ -83,6 +83,7 @@ class LbmLoad final : public LbmLoadBase {
     st_.injected += fluid_->impose_equilibrium(hole_cells_, rho_b, Vec3::Zero()) * cell_volume();
     const HoleSurface hs = hole_surface(sys, hole, s_.cell, s_.inflate, s_.reach);
     wall_ = hs.particle;
+    effective_radius_ = hs.effective_radius;
   }
 
   void add_forces(dem::DemSystem& sys) override {
@@ -108,6 +109,7 @@ class LbmLoad final : public LbmLoadBase {
   }
   const std::vector<Index>& wall_particles() const override { return wall_; }
   const LbmInfo& info() const override { return info_; }
+  Real effective_radius() const override { return effective_radius_; }
   const std::vector<Vec3>& hydro_force() const override { return force_; }
 
   Real pressure_at(const Vec3& x) const override {
@@ -414,6 +416,7 @@ class LbmLoad final : public LbmLoadBase {
   std::vector<Vec3> force_, torque_;
   State st_;
   long wetted_cracks_ = 0;
+  Real effective_radius_ = 0;
   std::vector<std::uint8_t> wet_;
   std::vector<std::size_t> wet_list_;
 };

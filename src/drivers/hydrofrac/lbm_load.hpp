@@ -53,6 +53,7 @@ struct LbmInfo {
 class LbmLoadBase : public FluidLoad {
  public:
   virtual const LbmInfo& info() const = 0;
+  virtual Real effective_radius() const = 0;  // of the hole's wetted surface (hole_surface), at begin()
   // Lattice fields for the VTK writer: pressure [Pa], velocity [m/s], flag (0 fluid, 1 solid).
   virtual void write_vti(const std::filesystem::path& file) const = 0;
   // Physical pressure of the lattice cell containing x [Pa] (x in SI); p0 where the cell is solid.
