@@ -489,6 +489,44 @@ void Solver<L, T>::reduce_forces() {
   }
 }
 
+// Slot of g_q(x) for the next step (AA pattern, bulk_sweep.cpp): even steps read f[q][x], odd
+// steps f[opp q][x - c_q].
+template <class L, class T>
+bool Solver<L, T>::covered(int x, int y, int z) const {
+  const CellIndex c = grid_.index(x, y, z);
+  return type_[c] != CellType::Fluid || (mb_ && mb_->solid(c));
+}
+
+template <class L, class T>
+double Solver<L, T>::cell_density(int x, int y, int z) const {
+  const bool odd = (time_ & 1) != 0;
+  const CellIndex N = n_(), c = grid_.index(x, y, z);
+  double rho = double(f_[c]);
+  for (int q = 1; q < Q; ++q)
+    rho += odd ? double(f_[L::opp[q] * N + grid_.neighbour(x, y, z, -L::c[q][0], -L::c[q][1], -L::c[q][2])])
+               : double(f_[q * N + c]);
+  return rho;
+}
+
+template <class L, class T>
+double Solver<L, T>::impose_equilibrium(const std::vector<std::array<int, 3>>& cells, double rho, const Vec3& u) {
+  const bool odd = (time_ & 1) != 0;
+  const CellIndex N = n_();
+  T geq[Q];
+  const T uu[3] = {T(u.x()), T(u.y()), T(u.z())};
+  equilibrium<L, T>(T(rho), uu, geq, settings_.incompressible);
+  double added = 0;
+  for (const auto& x : cells) {
+    if (covered(x[0], x[1], x[2])) continue;
+    added += rho - cell_density(x[0], x[1], x[2]);
+    const CellIndex c = grid_.index(x[0], x[1], x[2]);
+    f_[c] = geq[0];
+    for (int q = 1; q < Q; ++q)
+      f_[odd ? L::opp[q] * N + grid_.neighbour(x[0], x[1], x[2], -L::c[q][0], -L::c[q][1], -L::c[q][2]) : q * N + c] = geq[q];
+  }
+  return added;
+}
+
 template class Solver<D2Q9, double>;
 template class Solver<D2Q9, float>;
 template class Solver<D3Q19, double>;

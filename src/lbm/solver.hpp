@@ -154,6 +154,15 @@ class Solver {
   // Nothing to do for the PSM.
   void restore_particles(const ParticleSet& last);
 
+  // ---- fluid state between steps (the populations the next step reads; the AA parity is handled here),
+  // for sources that a coupled driver imposes after a step (e.g. a pressurised borehole).
+  // Static solid or covered by a moving particle (bounce-back schemes) now.
+  bool covered(int x, int y, int z) const;
+  double cell_density(int x, int y, int z) const;  // sum_q g_q of an interior cell
+  // f = f^eq(rho, u) on each listed interior cell that is not covered(); returns the mass added,
+  // sum (rho - rho_before) over those cells (lattice units).
+  double impose_equilibrium(const std::vector<std::array<int, 3>>& cells, double rho, const Vec3& u);
+
   // Convective outflow: the speed U of the face's last step (set or the mean outflow speed).
   double outflow_velocity(int face) const { return double(convective_u_[face]); }
 

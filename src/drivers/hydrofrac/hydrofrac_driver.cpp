@@ -33,6 +33,9 @@
 #include "drivers/hydrofrac/dfn.hpp"
 #include "drivers/hydrofrac/kirsch.hpp"
 #include "drivers/hydrofrac/sleeve_load.hpp"
+#include "drivers/hydrofrac/lbm_load.hpp"
+#include "io/pvd.hpp"
+#include "coupling/fluid_spec.hpp"
 #include "drivers/run_control.hpp"
 #include "drivers/run_estimate.hpp"
 #include "drivers/run_record.hpp"
@@ -71,8 +74,35 @@ void declare(ParamTable& t) {
   t.real("insitu.servo_relaxation", 0.5, "-", "servo relaxation factor alpha (PFC default 0.8)").open_range(0, 1).at_most(1);
   t.string("injection.fluid", "sleeve",
            "fluid model: sleeve (pressure on the hole's wall particles, and on connected crack faces with penetration); "
-           "lbm (lattice Boltzmann coupling: not available yet)")
+           "lbm (lattice Boltzmann fluid over the block, keys fluid.*; docs/hydrofrac.md)")
       .one_of({"sleeve", "lbm"});
+  // The lattice Boltzmann fluid (injection.fluid = "lbm"), SI units (coupling::FluidSpec).
+  t.real("fluid.density", 1000, "kg/m^3", "lbm: fluid density").positive();
+  t.real("fluid.viscosity", 1e-6, "m^2/s", "lbm: kinematic viscosity (set this or fluid.dynamic_viscosity)").positive();
+  t.real("fluid.dynamic_viscosity", 0.0, "Pa s", "lbm: dynamic viscosity; replaces fluid.viscosity when > 0").non_negative();
+  t.real("fluid.bulk_modulus", 0.0, "Pa",
+         "lbm: effective bulk modulus K_eff = rho c_s^2, fixes the LBM step (set exactly one of fluid.bulk_modulus, "
+         "fluid.sound_speed, fluid.time_step, fluid.tau; 0: not set)")
+      .non_negative();
+  t.real("fluid.sound_speed", 0.0, "m/s", "lbm: lattice sound speed c_s = dx / (sqrt(3) dt) (0: not set)").non_negative();
+  t.real("fluid.time_step", 0.0, "s", "lbm: LBM step (0: not set)").non_negative();
+  t.real("fluid.tau", 0.0, "-", "lbm: relaxation time, dt = (tau - 1/2) dx^2 / (3 nu) (0: not set)").non_negative();
+  t.real("fluid.background_pressure", 0.0, "Pa", "lbm: pore pressure p0 outside the populations: p = p0 + K_eff (rho_lb - 1)");
+  t.real("fluid.dx", 0.0, "m", "lbm: lattice spacing (0: sample.radius_min / fluid.cells_per_radius)").non_negative();
+  t.real("fluid.cells_per_radius", 1.5, "-", "lbm: cells per smallest particle radius when fluid.dx = 0 (seed 002: >= 1)")
+      .positive();
+  t.string("fluid.scheme", "interpolated",
+           "lbm: particles in the fluid: interpolated (Bouzidi bounce-back, solid cells), stairwise (half-way "
+           "bounce-back), psm (partially saturated cells: intact rock leaks, docs/coupling.md)")
+      .one_of({"interpolated", "stairwise", "psm"});
+  t.boolean("fluid.moving_walls", false,
+            "lbm: the particles' velocities enter the fluid's wall condition (false: quasi-static walls; true diverged "
+            "on the test block, docs/hydrofrac.md)");
+  t.real("fluid.reference_velocity", 0.0, "m/s", "lbm: expected largest fluid speed, for the Mach check (0: no check)")
+      .non_negative();
+  t.real("fluid.pressure_range", 0.0, "Pa",
+         "lbm: largest p - p0 expected, for the density-variation check (0: injection.max_pressure)")
+      .non_negative();
   t.string("injection.mode", "ramp", "ramp: pressure rises at injection.ramp_rate; rate: pumped at injection.rate into a compressible borehole")
       .one_of({"ramp", "rate"});
   t.real("injection.ramp_rate", 1e10, "Pa/s", "pressure rise rate (ramp mode)").positive();
@@ -128,12 +158,29 @@ Block block_of(const Config& cfg) {
   return b;
 }
 
+// The fluid of injection.fluid = "lbm" (keys fluid.*), in SI.
+coupling::FluidSpec lbm_fluid_spec(const Config& cfg) {
+  coupling::FluidSpec f;
+  f.density = cfg.real("fluid.density");
+  f.viscosity = cfg.real("fluid.viscosity");
+  f.dynamic_viscosity = cfg.real("fluid.dynamic_viscosity");
+  f.dx = cfg.real("fluid.dx") > 0 ? cfg.real("fluid.dx") : cfg.real("sample.radius_min") / cfg.real("fluid.cells_per_radius");
+  f.bulk_modulus = cfg.real("fluid.bulk_modulus");
+  f.sound_speed = cfg.real("fluid.sound_speed");
+  f.time_step = cfg.real("fluid.time_step");
+  f.tau = cfg.real("fluid.tau");
+  f.background_pressure = cfg.real("fluid.background_pressure");
+  f.reference_velocity = cfg.real("fluid.reference_velocity");
+  f.pressure_range = cfg.real("fluid.pressure_range") > 0 ? cfg.real("fluid.pressure_range") : cfg.real("injection.max_pressure");
+  return f;
+}
+
 void validate(const Config& cfg) {
   dem::validate_dem_sample(cfg);
   if (cfg.string("sample.shape") != "box")
     cfg.fail("sample.shape", "the hydrofrac block is a box: shape = \"box\" (2D rectangle in x-y; 3D box with the borehole along z)");
-  if (cfg.string("injection.fluid") == "lbm")
-    cfg.fail("injection.fluid", "the lattice Boltzmann fluid (\"lbm\") is not available in this build yet; use \"sleeve\"");
+  // The fluid's own checks (tau, Mach, density variation; the DEM step rounds dt_lbm later).
+  if (cfg.string("injection.fluid") == "lbm") (void)coupling::derive_scales(lbm_fluid_spec(cfg));
   const Block b = block_of(cfg);
   const Real R = cfg.real("borehole.radius"), rmax = cfg.real("sample.radius_max");
   const Real lmin = std::min(b.lx, b.ly);
@@ -244,6 +291,8 @@ class HydrofracRun {
   BoreholeGeometry hole_;
   std::vector<hydrofrac::JointPair> joints_;
   std::unique_ptr<hydrofrac::FluidLoad> fluid_;
+  hydrofrac::LbmLoadBase* lbm_ = nullptr;  // fluid_ when injection.fluid = "lbm"
+  PvdSeries fluid_pvd_;                    // vtk/fluid.pvd: the lattice, same times as the particles
   HfState st_;
   Vec3 targets_;
   Real servo_v_ = 0, servo_alpha_ = 0;
@@ -289,7 +338,27 @@ void HydrofracRun::make_fluid() {
   s.cell = cell;
   s.inflate = std::min(0.5 * cfg.real("sample.bond_gap"), 0.5 * rmin);
   s.reach = 1.5 * rmax;
-  fluid_ = std::make_unique<hydrofrac::SleeveLoad>(s);
+  if (cfg.string("injection.fluid") != "lbm") {
+    fluid_ = std::make_unique<hydrofrac::SleeveLoad>(s);
+    return;
+  }
+  hydrofrac::LbmSettings l;
+  l.fluid = lbm_fluid_spec(cfg);
+  const std::string scheme = cfg.string("fluid.scheme");
+  l.scheme = scheme == "psm"         ? lbm::ParticleScheme::Psm
+             : scheme == "stairwise" ? lbm::ParticleScheme::StairwiseBounceBack
+                                     : lbm::ParticleScheme::InterpolatedBounceBack;
+  l.moving_walls = cfg.boolean("fluid.moving_walls");
+  l.rate_mode = s.rate_mode;
+  l.ramp_rate = s.ramp_rate;
+  l.initial_pressure = s.initial_pressure;
+  l.flow_rate = s.flow_rate;
+  l.cell = s.cell;
+  l.inflate = s.inflate;
+  l.reach = s.reach;
+  auto lb = hydrofrac::make_lbm_load(l, sys.settings.dim);
+  lbm_ = lb.get();
+  fluid_ = std::move(lb);
 }
 
 void HydrofracRun::set_up() {
@@ -446,7 +515,8 @@ void HydrofracRun::begin_injection() {
   st_.injection_step = sys.step_count;
   st_.injection_time = sys.time;
   fluid_->begin(sys, hole_, joints_);
-  st_.effective_radius = static_cast<hydrofrac::SleeveLoad&>(*fluid_).effective_radius();
+  if (lbm_) log::info("hydrofrac: lattice Boltzmann fluid ({}): {}", cfg.string("fluid.scheme"), lbm_->info().describe());
+  st_.effective_radius = lbm_ ? lbm_->effective_radius() : static_cast<hydrofrac::SleeveLoad&>(*fluid_).effective_radius();
   insitu_ = snapshot(0);
   const Vec3 ws = wall_stress();
   Real far_xx = 0, far_yy = 0;
@@ -466,6 +536,11 @@ void HydrofracRun::begin_injection() {
 void HydrofracRun::vtk() {
   if (!vtk_on_) return;
   const Real extent = 1.6 * std::max(sys.walls[1].point.x() - sys.walls[0].point.x(), sys.walls[3].point.y() - sys.walls[2].point.y());
+  if (lbm_ && st_.stage == 1) {
+    const std::string name = fmt::format("fluid_{:05d}.vti", st_.vtk_index);
+    lbm_->write_vti(opt.out_dir / "vtk" / name);
+    fluid_pvd_.add(sys.time, name);
+  }
   vtk_writer_.write(sys, st_.vtk_index++, extent);
   st_.last_vtk_time = sys.time;
 }
@@ -567,6 +642,7 @@ RunStatus HydrofracRun::run() {
   }
   vtk_on_ = cfg.boolean("output.vtk");
   if (vtk_on_) vtk_writer_.open(opt.out_dir / "vtk", opt.resume, sys.time);
+  if (vtk_on_ && lbm_) fluid_pvd_.open(opt.out_dir / "vtk" / "fluid.pvd", opt.resume, sys.time);
   if (!opt.resume) {
     vtk();
     checkpoint();

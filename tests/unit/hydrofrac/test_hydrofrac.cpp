@@ -305,7 +305,7 @@ TEST(Hydrofrac, CheckRefusesBadInputNamingTheKey) {
     std::string set, key;
   };
   for (const Case& c : {Case{"borehole.radius=0.5e-3", "borehole.radius"}, Case{"sample.shape=\"disc\"", "sample.shape"},
-                        Case{"injection.fluid=\"lbm\"", "injection.fluid"}, Case{"measure.radii=[1.1]", "measure.radii"},
+                        Case{"injection.fluid=\"lbm\"", "fluid.tau"}, Case{"measure.radii=[1.1]", "measure.radii"},
                         Case{"borehole.perforation_length=8e-3", "borehole.perforation_length"},
                         Case{"dfn.file=\"missing.csv\"", "dfn.file"},
                         Case{"dfn.count=3 --set dfn.length_max=1e-3", "dfn.length_max"}}) {

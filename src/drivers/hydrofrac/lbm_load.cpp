@@ -1,0 +1,431 @@
+#include "drivers/hydrofrac/lbm_load.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "core/error.hpp"
+#include "drivers/hydrofrac/borehole.hpp"
+#include "io/vtk.hpp"
+#include "lbm/solver.hpp"
+
+namespace ff::drivers::hydrofrac {
+
+std::string LbmInfo::describe() const {
+  return fmt::format("{}\nLBM lattice {} x {} x {} cells, one LBM step every {} DEM steps (dt_lbm = {:.4g} s)",
+                     scales.describe(), n[0], n[1], n[2], stride, scales.dt());
+}
+
+LbmInfo lbm_info(const LbmSettings& s, Real dem_dt) {
+  LbmInfo in;
+  // The user's keys first (their errors name them), then the LBM step rounded to whole DEM steps:
+  // n = floor(dt_lbm / dt_dem) >= 1 and dt_lbm = n dt_dem (K_eff rises slightly; reported).
+  const coupling::FluidScales first = coupling::derive_scales(s.fluid);
+  in.stride = std::max<long>(1, long(std::floor(first.dt() / dem_dt * (1 + 1e-12))));
+  coupling::FluidSpec f = s.fluid;
+  f.tau = f.sound_speed = f.bulk_modulus = 0;
+  f.time_step = double(in.stride) * dem_dt;
+  try {
+    in.scales = coupling::derive_scales(f);
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{} (the LBM step rounded to {} DEM steps of {:.4g} s; {} fixed {:.4g} s)", e.what(),
+                                 in.stride, dem_dt, first.fixed_by, first.dt()));
+  }
+  in.scales.fixed_by = first.fixed_by + " and the DEM step";
+  return in;
+}
+
+namespace {
+
+template <class L>
+class LbmLoad final : public LbmLoadBase {
+  using Solver = lbm::Solver<L, double>;
+
+ public:
+  explicit LbmLoad(LbmSettings s) : s_(std::move(s)) {}
+
+  void begin(const dem::DemSystem& sys, const BoreholeGeometry& hole, const std::vector<JointPair>& joints) override {
+    hole_ = hole;
+    joints_ = joints;
+    const auto& P = sys.particles;
+    info_ = lbm_info(s_, sys.settings.dt);
+    const double dx = s_.fluid.dx;
+    // The lattice covers every particle plus one cell.
+    Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+    for (std::size_t i = 0; i < P.size(); ++i)
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::min(lo[a], P.pos[i][a] - P.radius[i]);
+        hi[a] = std::max(hi[a], P.pos[i][a] + P.radius[i]);
+      }
+    for (int a = 0; a < L::D; ++a) {
+      lo[a] -= dx;
+      info_.n[a] = int(std::ceil((hi[a] + dx - lo[a]) / dx));
+    }
+    if (L::D == 2) lo.z() = -0.5 * dx;
+    info_.origin = lo + Vec3::Constant(0.5 * dx);
+    const double cells = double(info_.n[0]) * info_.n[1] * info_.n[2];
+    if (cells > 2e8)
+      throw InputError(fmt::format("fluid.dx: {} m gives {:.3g} lattice cells over the block (at most 2e8); raise it", dx, cells));
+    st_ = State{};
+    st_.t0 = sys.time;
+    st_.pressure = s_.initial_pressure;
+    build(sys);
+    fluid_->initialize([](int, int, int, double& rho, Vec3& u) {
+      rho = 1;
+      u = Vec3::Zero();
+    });
+    // The hole's fluid at the initial pressure before the first step.
+    fill_set(sys);
+    fluid_->set_particles(set_);
+    const double rho_b = info_.scales.lattice_density(s_.initial_pressure);
+    st_.injected += fluid_->impose_equilibrium(hole_cells_, rho_b, Vec3::Zero()) * cell_volume();
+    const HoleSurface hs = hole_surface(sys, hole, s_.cell, s_.inflate, s_.reach);
+    wall_ = hs.particle;
+    effective_radius_ = hs.effective_radius;
+  }
+
+  void add_forces(dem::DemSystem& sys) override {
+    if (st_.dem_steps % info_.stride == 0) lbm_step(sys);
+    auto& p = sys.particles;
+    for (std::size_t i = 0; i < p.size() && i < force_.size(); ++i) {
+      p.ext_force[i] += force_[i];
+      p.ext_moment[i] += torque_[i];
+    }
+  }
+  void advance(const dem::DemSystem&) override { ++st_.dem_steps; }
+
+  FluidState state() const override {
+    FluidState f;
+    f.pressure = st_.pressure;
+    f.injected_volume = st_.injected;
+    long nf = 0;
+    for (const auto& c : hole_cells_) nf += fluid_->covered(c[0], c[1], c[2]) ? 0 : 1;
+    f.borehole_volume = double(nf) * cell_volume();
+    f.wetted_particles = long(wall_.size());
+    f.wetted_cracks = wetted_cracks_;
+    return f;
+  }
+  const std::vector<Index>& wall_particles() const override { return wall_; }
+  const LbmInfo& info() const override { return info_; }
+  Real effective_radius() const override { return effective_radius_; }
+  const std::vector<Vec3>& hydro_force() const override { return force_; }
+
+  Real pressure_at(const Vec3& x) const override {
+    int c[3];
+    if (!cell_of(x, c) || fluid_->covered(c[0], c[1], c[2])) return info_.scales.background_pressure;
+    return info_.scales.pressure(fluid_->cell_density(c[0], c[1], c[2]));
+  }
+  bool wet_at(const Vec3& x) const override {
+    int c[3];
+    return cell_of(x, c) && !fluid_->covered(c[0], c[1], c[2]);
+  }
+
+  void write_vti(const std::filesystem::path& file) const override {
+    const auto& g = fluid_->grid();
+    const std::size_t n = std::size_t(g.nx) * g.ny * g.nz;
+    std::vector<double> p(n);
+    std::vector<Vec3> u(n, Vec3::Zero());
+    std::vector<std::uint8_t> flag(n);
+    const double uf = info_.scales.units.velocity_factor();
+    const bool odd = (fluid_->time_step() & 1) != 0;
+    const auto& f = fluid_->populations();
+    const lbm::CellIndex N = g.padded_size();
+    std::size_t k = 0;
+    for (int z = 0; z < g.nz; ++z)
+      for (int y = 0; y < g.ny; ++y)
+        for (int x = 0; x < g.nx; ++x, ++k) {
+          flag[k] = fluid_->covered(x, y, z) ? 1 : 0;
+          if (flag[k]) {
+            p[k] = info_.scales.background_pressure;
+            continue;
+          }
+          // Moments of the populations the next step reads (AA slots as in Solver::cell_density).
+          double rho = 0, j[3] = {0, 0, 0};
+          const lbm::CellIndex c = g.index(x, y, z);
+          for (int q = 0; q < L::Q; ++q) {
+            const double v = q == 0 ? f[c]
+                             : odd  ? f[L::opp[q] * N + g.neighbour(x, y, z, -L::c[q][0], -L::c[q][1], -L::c[q][2])]
+                                    : f[q * N + c];
+            rho += v;
+            for (int a = 0; a < 3; ++a) j[a] += L::c[q][a] * v;
+          }
+          p[k] = info_.scales.pressure(rho);
+          u[k] = Vec3(j[0], j[1], j[2]) * (uf / rho);
+        }
+    const double dx = s_.fluid.dx;
+    const std::array<VtkArray, 3> arrays = {vtk_array("pressure", std::span<const double>(p)),
+                                            vtk_array("velocity", std::span<const Vec3>(u)),
+                                            vtk_array("solid", std::span<const std::uint8_t>(flag))};
+    ff::write_vti(file, {g.nx, g.ny, g.nz}, info_.origin - Vec3::Constant(0.5 * dx),
+              Vec3(dx, dx, L::D == 3 ? dx : dx), arrays);
+  }
+
+  void save(CheckpointWriter& w) const override {
+    w.put_value("lbm.state", st_);
+    const auto& h = hole_;
+    w.put("lbm.hole", std::vector<double>{h.centre.x(), h.centre.y(), h.centre.z(), h.radius, h.perforation_length,
+                                          h.perforation_width, h.perforation_azimuth, double(h.perforation_sides), h.z_lo,
+                                          h.z_hi, double(h.dim)});
+    w.put("lbm.joints", joints_);
+    w.put("lbm.wall", wall_);
+    w.put_value("lbm.origin", info_.origin);
+    w.put("lbm.n", std::vector<int>(info_.n, info_.n + 3));
+    const auto& f = fluid_->populations();
+    w.put("lbm.f", std::vector<double>(f.begin(), f.end()));
+    w.put_value("lbm.time", fluid_->time_step());
+    w.put("lbm.set.id", set_.id);
+    w.put("lbm.set.position", set_.position);
+    w.put("lbm.set.radius", set_.radius);
+    w.put("lbm.set.velocity", set_.velocity);
+    w.put("lbm.set.omega", set_.omega);
+    w.put("lbm.force", force_);
+    w.put("lbm.torque", torque_);
+  }
+
+  void load(CheckpointReader& r, const dem::DemSystem& sys) override {
+    st_ = r.get_value<State>("lbm.state");
+    std::vector<double> h;
+    r.get("lbm.hole", h);
+    if (h.size() != 11) throw InputError("checkpoint: section lbm.hole has the wrong size (another version?)");
+    hole_.centre = Vec3(h[0], h[1], h[2]);
+    hole_.radius = h[3];
+    hole_.perforation_length = h[4];
+    hole_.perforation_width = h[5];
+    hole_.perforation_azimuth = h[6];
+    hole_.perforation_sides = int(h[7]);
+    hole_.z_lo = h[8];
+    hole_.z_hi = h[9];
+    hole_.dim = int(h[10]);
+    r.get("lbm.joints", joints_);
+    r.get("lbm.wall", wall_);
+    info_ = lbm_info(s_, sys.settings.dt);
+    info_.origin = r.get_value<Vec3>("lbm.origin");
+    std::vector<int> n;
+    r.get("lbm.n", n);
+    for (int a = 0; a < 3; ++a) info_.n[a] = n.at(std::size_t(a));
+    build(sys);
+    std::vector<double> f;
+    r.get("lbm.f", f);
+    fluid_->restore(f, r.get_value<long>("lbm.time"));
+    r.get("lbm.set.id", set_.id);
+    r.get("lbm.set.position", set_.position);
+    r.get("lbm.set.radius", set_.radius);
+    r.get("lbm.set.velocity", set_.velocity);
+    r.get("lbm.set.omega", set_.omega);
+    fluid_->restore_particles(set_);
+    r.get("lbm.force", force_);
+    r.get("lbm.torque", torque_);
+    count_wetted(sys);
+  }
+
+ private:
+  struct State {  // trivially copyable (a checkpoint section)
+    Real t0 = 0, pressure = 0, injected = 0;
+    long dem_steps = 0, lbm_steps = 0;
+  };
+
+  double cell_volume() const { return std::pow(s_.fluid.dx, L::D); }  // 2D: per metre
+
+  bool cell_of(const Vec3& x, int* c) const {
+    const Vec3 xl = (x - info_.origin) / s_.fluid.dx;
+    c[2] = 0;
+    for (int a = 0; a < L::D; ++a) {
+      c[a] = int(std::floor(xl[a] + 0.5));
+      if (c[a] < 0 || c[a] >= info_.n[a]) return false;
+    }
+    return true;
+  }
+
+  // The solver (walls on every face; the block's pore space and surroundings start at p0) and
+  // the borehole's cells (centres inside the hole or a perforation).
+  void build(const dem::DemSystem& sys) {
+    lbm::SolverSettings ss;
+    ss.collision = lbm::CollisionModel::Trt;
+    ss.tau = info_.scales.units.tau();
+    ss.particle_scheme = s_.scheme;
+    lbm::Grid g(L::D, info_.n[0], info_.n[1], info_.n[2], {false, false, false});
+    fluid_ = std::make_unique<Solver>(g, ss);
+    fluid_->finalize();
+    hole_cells_.clear();
+    const double dx = s_.fluid.dx;
+    for (int z = 0; z < g.nz; ++z)
+      for (int y = 0; y < g.ny; ++y)
+        for (int x = 0; x < g.nx; ++x) {
+          const Vec3 xs = info_.origin + dx * Vec3(x, y, L::D == 3 ? z : 0);
+          if (in_hole(hole_, xs, 0)) hole_cells_.push_back({x, y, z});
+        }
+    if (hole_cells_.empty())
+      throw InputError(fmt::format("fluid.dx: {} m is too coarse: no lattice cell centre lies in the borehole", dx));
+    set_.resize(sys.particles.size());
+    force_.assign(sys.particles.size(), Vec3::Zero());
+    torque_.assign(sys.particles.size(), Vec3::Zero());
+    id_index_ = index_of_ids(sys.particles);
+  }
+
+  void fill_set(const dem::DemSystem& sys) {
+    const auto& p = sys.particles;
+    if (set_.size() != p.size()) set_.resize(p.size());
+    const double dx = s_.fluid.dx, dt = info_.scales.dt(), vf = dt / dx;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      set_.id[i] = std::uint64_t(p.id[i]);
+      set_.position[i] = (p.pos[i] - info_.origin) / dx;
+      set_.radius[i] = p.radius[i] / dx;
+      // Quasi-static walls unless fluid.moving_walls (the moving-wall term made the bounce-back
+      // runs diverge; docs/hydrofrac.md).
+      const double w = s_.moving_walls ? 1.0 : 0.0;
+      set_.velocity[i] = p.vel[i] * (vf * w);
+      set_.omega[i] = p.omega[i] * (dt * w);
+      if (L::D == 2) {
+        set_.position[i].z() = 0;
+        set_.velocity[i].z() = 0;
+        set_.omega[i].x() = set_.omega[i].y() = 0;
+      }
+    }
+  }
+
+  Real pressure_now(Real t) const { return s_.initial_pressure + s_.ramp_rate * (t - st_.t0); }
+
+  void lbm_step(const dem::DemSystem& sys) {
+    fill_set(sys);
+    fluid_->set_particles(set_);
+    fluid_->step(false);
+    ++st_.lbm_steps;
+    const double dt = info_.scales.dt();
+    const Real t_end = st_.t0 + double(st_.lbm_steps) * dt;
+    // Injection: the hole's fluid cells get the borehole density.
+    if (!s_.rate_mode) {
+      st_.pressure = pressure_now(t_end);
+      st_.injected += fluid_->impose_equilibrium(hole_cells_, info_.scales.lattice_density(st_.pressure), Vec3::Zero()) *
+                      cell_volume();
+    } else {
+      double mass = 0;
+      long nf = 0;
+      for (const auto& c : hole_cells_)
+        if (!fluid_->covered(c[0], c[1], c[2])) {
+          mass += fluid_->cell_density(c[0], c[1], c[2]);
+          ++nf;
+        }
+      if (nf > 0) {
+        const double rho_b = (mass + s_.flow_rate * dt / cell_volume()) / double(nf);
+        st_.injected += fluid_->impose_equilibrium(hole_cells_, rho_b, Vec3::Zero()) * cell_volume();
+        st_.pressure = info_.scales.pressure(rho_b);
+      }
+    }
+    // Loads: the momentum exchange minus that of the reference fluid at rest (p0) on the same links.
+    const auto& F = fluid_->particle_forces();
+    const auto& M = fluid_->particle_torques();
+    flood();
+    const auto& u = info_.scales.units;
+    const double dx = s_.fluid.dx;
+    for (std::size_t i = 0; i < force_.size(); ++i) {
+      // Dry rock: only particles that touch fluid connected to the hole carry a fluid load; the
+      // pore pockets between intact grains are sealed, and their trapped fluid (a stiff spring at
+      // K_eff) would only make the explicit coupling unstable.
+      if (!touches_wet(set_.position[i], sys.particles.radius[i] / dx)) {
+        force_[i] = torque_[i] = Vec3::Zero();
+        continue;
+      }
+      const Vec3 f = F[i], m = M[i];
+      Vec3 fs(u.to_si_force(f.x(), L::D), u.to_si_force(f.y(), L::D), u.to_si_force(f.z(), L::D));
+      Vec3 ms(u.to_si_torque(m.x(), L::D), u.to_si_torque(m.y(), L::D), u.to_si_torque(m.z(), L::D));
+      if (L::D == 2) {
+        fs.z() = 0;
+        ms.x() = ms.y() = 0;
+      }
+      force_[i] = fs;
+      torque_[i] = ms;
+    }
+    count_wetted(sys);  // O(cracks) per LBM step
+  }
+
+  // The fluid connected to the hole now: flood over uncovered cells (4 / 6 neighbours) from the
+  // hole's cells; cost proportional to the connected region.
+  void flood() {
+    const auto& g = fluid_->grid();
+    if (wet_.size() != std::size_t(g.nx) * g.ny * g.nz) wet_.assign(std::size_t(g.nx) * g.ny * g.nz, 0);
+    for (std::size_t k : wet_list_) wet_[k] = 0;
+    wet_list_.clear();
+    auto lin = [&](int x, int y, int z) { return std::size_t(x) + std::size_t(g.nx) * (std::size_t(y) + std::size_t(g.ny) * z); };
+    auto push = [&](int x, int y, int z) {
+      if (!g.is_interior(x, y, z)) return;
+      const std::size_t k = lin(x, y, z);
+      if (wet_[k] || fluid_->covered(x, y, z)) return;
+      wet_[k] = 1;
+      wet_list_.push_back(k);
+    };
+    for (const auto& c : hole_cells_) push(c[0], c[1], c[2]);
+    for (std::size_t h = 0; h < wet_list_.size(); ++h) {
+      const std::size_t k = wet_list_[h];
+      const int x = int(k % std::size_t(g.nx)), y = int((k / std::size_t(g.nx)) % std::size_t(g.ny)),
+                z = int(k / (std::size_t(g.nx) * g.ny));
+      push(x - 1, y, z);
+      push(x + 1, y, z);
+      push(x, y - 1, z);
+      push(x, y + 1, z);
+      if (L::D == 3) {
+        push(x, y, z - 1);
+        push(x, y, z + 1);
+      }
+    }
+  }
+  bool touches_wet(const Vec3& c, double r) const {
+    const auto& g = fluid_->grid();
+    const double reach = r + 1.0;
+    const int z0 = L::D == 3 ? std::max(0, int(std::floor(c.z() - reach))) : 0,
+              z1 = L::D == 3 ? std::min(g.nz - 1, int(std::ceil(c.z() + reach))) : 0;
+    for (int z = z0; z <= z1; ++z)
+      for (int y = std::max(0, int(std::floor(c.y() - reach))); y <= std::min(g.ny - 1, int(std::ceil(c.y() + reach))); ++y)
+        for (int x = std::max(0, int(std::floor(c.x() - reach))); x <= std::min(g.nx - 1, int(std::ceil(c.x() + reach))); ++x)
+          if (wet_[std::size_t(x) + std::size_t(g.nx) * (std::size_t(y) + std::size_t(g.ny) * z)]) return true;
+    return false;
+  }
+
+  // Wetted cracks: crack points (broken bonds and joints) whose lattice cell is fluid with p - p0
+  // above wet_fraction of the hole's.
+  void count_wetted(const dem::DemSystem& sys) {
+    const double dp = st_.pressure - info_.scales.background_pressure;
+    auto wet = [&](const Vec3& x) {
+      int c[3];
+      if (!cell_of(x, c) || fluid_->covered(c[0], c[1], c[2])) return false;
+      return info_.scales.pressure(fluid_->cell_density(c[0], c[1], c[2])) - info_.scales.background_pressure >
+             s_.wet_fraction * dp;
+    };
+    long n = 0;
+    for (const auto& e : sys.cracks.events)
+      if (!in_hole(hole_, e.position, 0) && wet(e.position)) ++n;
+    const auto& P = sys.particles;
+    for (const auto& j : joints_) {
+      const Index a = id_index_[std::size_t(j.a)], b = id_index_[std::size_t(j.b)];
+      if (a < 0 || b < 0) continue;
+      const Vec3 xc = P.pos[a] + (P.pos[b] - P.pos[a]) * (P.radius[a] / (P.radius[a] + P.radius[b]));
+      if (wet(xc)) ++n;
+    }
+    wetted_cracks_ = n;
+  }
+
+  LbmSettings s_;
+  LbmInfo info_;
+  BoreholeGeometry hole_;
+  std::vector<JointPair> joints_;
+  std::vector<Index> wall_, id_index_;
+  std::unique_ptr<Solver> fluid_;
+  std::vector<std::array<int, 3>> hole_cells_;
+  lbm::ParticleSet set_;
+  std::vector<Vec3> force_, torque_;
+  State st_;
+  long wetted_cracks_ = 0;
+  Real effective_radius_ = 0;
+  std::vector<std::uint8_t> wet_;
+  std::vector<std::size_t> wet_list_;
+};
+
+}  // namespace
+
+std::unique_ptr<LbmLoadBase> make_lbm_load(const LbmSettings& s, int dim) {
+  if (dim == 3) return std::make_unique<LbmLoad<lbm::D3Q19>>(s);
+  return std::make_unique<LbmLoad<lbm::D2Q9>>(s);
+}
+
+}  // namespace ff::drivers::hydrofrac
