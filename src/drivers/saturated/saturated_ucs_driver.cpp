@@ -18,6 +18,7 @@
 #include "dem/sample_builder.hpp"
 #include "drivers/dem_results.hpp"
 #include "drivers/dem_run_loop.hpp"
+#include "drivers/ucs/ucs_driver.hpp"
 #include "drivers/ucs/ucs_measure.hpp"
 #include "io/plot.hpp"
 
@@ -28,18 +29,7 @@ namespace ff::drivers {
 namespace {
 
 void declare(ParamTable& t) {
-  dem::declare_dem_params(t);
-  dem::declare_sample_params(t);
-  t.real("ucs.platen_velocity", 0.05, "m/s", "speed of each platen towards the sample").positive();
-  t.real("ucs.platen_friction", 0.1, "-", "friction between platens and particles (seed 000: 0.1)").non_negative();
-  t.real("ucs.stop_fraction", 0.6, "-", "stop when the axial stress has fallen below this fraction of its peak").open_range(0, 1);
-  t.real("ucs.max_strain", 0.05, "-", "stop at this axial strain in any case").positive();
-  t.integer("ucs.series_interval", 100, "steps", "steps between rows of series.csv").positive();
-  t.real("ucs.vtk_strain_interval", 1e-3, "-", "axial strain between VTK snapshots").positive();
-  t.integer("ucs.checkpoint_interval", 0, "steps",
-            "steps between extra checkpoints (0: none; checkpoints come every output.checkpoint_wall_interval seconds, at "
-            "the end and on interruption)")
-      .non_negative();
+  declare_ucs_params(t);
   t.real("fluid.saturation", 1.0, "-", "initial liquid saturation of the pores (0: dry, gas only; 1: liquid only)")
       .range(0, 1);
   t.real("fluid.liquid_viscosity", 1e-3, "Pa s", "dynamic viscosity of the liquid (water: 1e-3)").positive();

@@ -19,9 +19,9 @@ namespace fs = std::filesystem;
 
 namespace ff::drivers {
 
-namespace {
-
-void declare(ParamTable& t) {
+// The UCS keys (with the DEM and sample keys), shared with drivers that run the same test
+// (saturated_ucs).
+void declare_ucs_params(ParamTable& t) {
   dem::declare_dem_params(t);
   dem::declare_sample_params(t);
   t.real("ucs.platen_velocity", 0.05, "m/s", "speed of each platen towards the sample").positive();
@@ -35,6 +35,8 @@ void declare(ParamTable& t) {
             "the end and on interruption)")
       .non_negative();
 }
+
+namespace {
 
 // Column names end in their SI unit (_s, _Pa, _J); strains, counts and ratios have none.
 const std::vector<std::string> kColumns = {"step", "time_s", "axial_strain", "axial_stress_Pa", "lateral_strain",
@@ -151,7 +153,7 @@ RunStatus run(const Config& cfg, const RunOptions& opt) { return UcsRun(cfg, opt
 }  // namespace
 
 Driver ucs_driver() {
-  return Driver{"ucs", "uniaxial compression of a bonded-particle sample (UCS, E, nu, cracks)", declare, run,
+  return Driver{"ucs", "uniaxial compression of a bonded-particle sample (UCS, E, nu, cracks)", declare_ucs_params, run,
                 dem::validate_dem_sample};
 }
 

@@ -6,4 +6,6 @@
 
 namespace ff::drivers {
 Driver ucs_driver();
+// Declares the ucs.* keys and the DEM and sample keys they need.
+void declare_ucs_params(ParamTable& t);
 }
