@@ -93,7 +93,10 @@ std::string ParamSpec::allowed() const {
   std::string a = to_string(type);
   if (!choices.empty()) {
     a += " , one of:";
-    for (auto& c : choices) a += " " + quote(c);
+    for (auto& c : choices) {
+      a += ' ';  // appended in two steps: `" " + quote(c)` trips GCC 12's false -Wrestrict (PR 105329)
+      a += quote(c);
+    }
   }
   const bool lo = std::isfinite(min), hi = std::isfinite(max);
   if (type == ParamType::Float || type == ParamType::Int || type == ParamType::FloatList) {
@@ -204,7 +207,7 @@ std::string ParamTable::markdown() const {
       return r;
     };
     o += fmt::format("| `{}` | {} | {} | {} | {} | {} |\n", s.key, to_string(s.type), s.unit,
-                     s.default_value ? "`" + format_value(*s.default_value) + "`" : std::string("required"),
+                     s.default_value ? fmt::format("`{}`", format_value(*s.default_value)) : std::string("required"),
                      esc(allowed), esc(s.help));
   }
   return o;

@@ -185,7 +185,9 @@ TEST(RunResults, VeryLongRunPrintsItsEstimateFirst) {
   EXPECT_TRUE(has(r.output, "million steps")) << r.output;
   EXPECT_TRUE(has(r.output, "ucs.platen_velocity or ucs.max_strain shorten it")) << r.output;
   const auto step = r.output.find("step 300");  // the interruption message comes after the estimate
-  if (step != std::string::npos) EXPECT_LT(at, step);
+  if (step != std::string::npos) {
+    EXPECT_LT(at, step);
+  }
   fs::remove_all(out);
 }
 
