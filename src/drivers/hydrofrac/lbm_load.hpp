@@ -43,10 +43,19 @@ struct LbmSettings {
 // What the LBM side derived (for the log and summary.json).
 struct LbmInfo {
   coupling::FluidScales scales;
-  long stride = 1;  // DEM steps per LBM step
+  long stride = 1;  // DEM steps per LBM step (the sub-cycle count n)
+  Real dem_dt = 0;  // the DEM step [s]; dt_lbm = stride x dem_dt
   int n[3] = {1, 1, 1};
   Vec3 origin = Vec3::Zero();  // SI centre of cell (0, 0, 0)
   std::string describe() const;
+};
+
+// Where the injected fluid went (volumes at the reference density rho_f, m^3; 2D per metre):
+// lattice_change = injected + covering_refill + residual, the residual being what the walls'
+// bounce-back (interpolation, moving-wall term) created or destroyed; the box is closed.
+struct LbmBudget {
+  Real injected = 0, lattice_change = 0, covering_refill = 0, residual = 0;
+  long lbm_steps = 0;
 };
 
 // The fluid load; dim 2 or 3. `dem_dt` is the DEM step the driver uses.
@@ -61,10 +70,13 @@ class LbmLoadBase : public FluidLoad {
   virtual bool wet_at(const Vec3& x) const = 0;  // the cell containing x is fluid now
   // Hydrodynamic force of the last LBM step on particle i [N] (2D: per metre).
   virtual const std::vector<Vec3>& hydro_force() const = 0;
+  virtual LbmBudget budget() const = 0;  // sums the lattice: once per report, not per step
 };
 
 std::unique_ptr<LbmLoadBase> make_lbm_load(const LbmSettings& s, int dim);
 // The scales and stride without building a lattice (check / log).
 LbmInfo lbm_info(const LbmSettings& s, Real dem_dt);
+// The lattice over the particles (every particle plus one cell): sets info.n and info.origin.
+void size_lattice(const dem::ParticleStore& p, Real dx, int dim, LbmInfo& info);
 
 }  // namespace ff::drivers::hydrofrac
