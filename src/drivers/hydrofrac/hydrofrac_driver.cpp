@@ -886,6 +886,7 @@ void HydrofracRun::finish(const std::string& stop) {
                 {"dx_m", in.scales.units.dx()},
                 {"lattice", {in.n[0], in.n[1], in.n[2]}},
                 {"lbm_steps", b.lbm_steps},
+                {"particle_set_changes", b.set_changes},
                 {"mass_budget_m3",
                  {{"injected", b.injected},
                   {"lattice_change", b.lattice_change},
@@ -893,9 +894,9 @@ void HydrofracRun::finish(const std::string& stop) {
                   {"residual", b.residual},
                   {"definition", "volumes at the reference density: lattice_change = injected + covering_refill + residual; "
                                  "the residual is what the bounce-back walls created or destroyed (the box is closed)"}}}};
-    log::info("hydrofrac: LBM mass budget over {} LBM steps (m^3 at rho_f): injected {:.4g}, lattice change {:.4g}, covering "
-              "and refill {:.4g}, residual (walls) {:.4g}",
-              b.lbm_steps, b.injected, b.lattice_change, b.covering_refill, b.residual);
+    log::info("hydrofrac: LBM mass budget over {} LBM steps ({} new particle sets; m^3 at rho_f): injected {:.4g}, lattice "
+              "change {:.4g}, covering and refill {:.4g}, residual (walls) {:.4g}",
+              b.lbm_steps, b.set_changes, b.injected, b.lattice_change, b.covering_refill, b.residual);
   }
   j["cracks"] = cracks_json(sys);
   j["sample"] = sample_json(sys, info);

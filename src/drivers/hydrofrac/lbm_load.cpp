@@ -88,6 +88,7 @@ class LbmLoad final : public LbmLoadBase {
     // The hole's fluid at the initial pressure before the first step.
     fill_set(sys);
     fluid_->set_particles(set_);
+    find_loaded(sys);
     st_.mass0 = lattice_mass();
     const double rho_b = info_.scales.lattice_density(s_.initial_pressure);
     st_.injected += fluid_->impose_equilibrium(hole_cells_, rho_b, Vec3::Zero()) * cell_volume();
@@ -131,6 +132,7 @@ class LbmLoad final : public LbmLoadBase {
     b.covering_refill = st_.changes;
     b.residual = b.lattice_change - b.injected - b.covering_refill;
     b.lbm_steps = st_.lbm_steps;
+    b.set_changes = st_.set_changes;
     return b;
   }
 
@@ -237,6 +239,7 @@ class LbmLoad final : public LbmLoadBase {
     r.get("lbm.set.velocity", set_.velocity);
     r.get("lbm.set.omega", set_.omega);
     fluid_->restore_particles(set_);
+    find_loaded(sys);
     r.get("lbm.force", force_);
     r.get("lbm.torque", torque_);
     count_wetted(sys);
@@ -248,6 +251,7 @@ class LbmLoad final : public LbmLoadBase {
     Real mass0 = 0;    // lattice mass after the first set of particles, before the first imposition
     Real changes = 0;  // mass that covering and refill added (refill minus covered) [m^3 at rho_f]
     long dem_steps = 0, lbm_steps = 0;
+    long set_changes = 0;  // LBM steps that handed the solver a new particle set
   };
 
   double cell_volume() const { return std::pow(s_.fluid.dx, L::D); }  // 2D: per metre
@@ -307,11 +311,42 @@ class LbmLoad final : public LbmLoadBase {
 
   Real pressure_now(Real t) const { return s_.initial_pressure + s_.ramp_rate * (t - st_.t0); }
 
+  // With quasi-static walls the particle set changes only through the particles' positions: it is
+  // handed to the solver again once a particle has moved kRefresh cells since the last set (the
+  // rock creeps ~1e-4 cells per LBM step; rebuilding the solid cells and links of every grain each
+  // step cost several LBM steps). Moving walls refresh every step (their velocities change).
+  static constexpr double kRefresh = 0.02;
+  bool set_stale(const dem::DemSystem& sys) const {
+    const auto& p = sys.particles;
+    if (s_.moving_walls || set_.size() != p.size()) return true;
+    const double dx = s_.fluid.dx, lim = kRefresh * kRefresh;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      Vec3 d = (p.pos[i] - info_.origin) / dx - set_.position[i];
+      if (L::D == 2) d.z() = 0;
+      if (d.squaredNorm() > lim) return true;
+    }
+    return false;
+  }
+
+  // Particles that carry a fluid load (dry rock: only those touching fluid connected to the hole;
+  // the pore pockets between intact grains are sealed, and their trapped fluid, a stiff spring at
+  // K_eff, would only make the explicit coupling unstable). Depends on the set alone.
+  void find_loaded(const dem::DemSystem& sys) {
+    flood();
+    loaded_.assign(set_.size(), 0);
+    const double dx = s_.fluid.dx;
+    for (std::size_t i = 0; i < set_.size(); ++i) loaded_[i] = touches_wet(set_.position[i], sys.particles.radius[i] / dx);
+  }
+
   void lbm_step(const dem::DemSystem& sys) {
-    fill_set(sys);
-    fluid_->set_particles(set_);
-    if (const auto* mb = fluid_->moving_boundary())
-      st_.changes += (mb->stats().mass_added - mb->stats().mass_removed) * cell_volume();
+    if (set_stale(sys)) {
+      fill_set(sys);
+      fluid_->set_particles(set_);
+      if (const auto* mb = fluid_->moving_boundary())
+        st_.changes += (mb->stats().mass_added - mb->stats().mass_removed) * cell_volume();
+      find_loaded(sys);
+      ++st_.set_changes;
+    }
     fluid_->step(false);
     ++st_.lbm_steps;
     const double dt = info_.scales.dt();
@@ -338,14 +373,9 @@ class LbmLoad final : public LbmLoadBase {
     // Loads: the momentum exchange minus that of the reference fluid at rest (p0) on the same links.
     const auto& F = fluid_->particle_forces();
     const auto& M = fluid_->particle_torques();
-    flood();
     const auto& u = info_.scales.units;
-    const double dx = s_.fluid.dx;
     for (std::size_t i = 0; i < force_.size(); ++i) {
-      // Dry rock: only particles that touch fluid connected to the hole carry a fluid load; the
-      // pore pockets between intact grains are sealed, and their trapped fluid (a stiff spring at
-      // K_eff) would only make the explicit coupling unstable.
-      if (!touches_wet(set_.position[i], sys.particles.radius[i] / dx)) {
+      if (!loaded_[i]) {
         force_[i] = torque_[i] = Vec3::Zero();
         continue;
       }
@@ -429,6 +459,7 @@ class LbmLoad final : public LbmLoadBase {
   long wetted_cracks_ = 0;
   Real effective_radius_ = 0;
   std::vector<std::uint8_t> wet_;
+  std::vector<char> loaded_;  // per particle: touches the hole's fluid (find_loaded)
   std::vector<std::size_t> wet_list_;
 };
 

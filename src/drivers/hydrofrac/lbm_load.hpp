@@ -56,6 +56,7 @@ struct LbmInfo {
 struct LbmBudget {
   Real injected = 0, lattice_change = 0, covering_refill = 0, residual = 0;
   long lbm_steps = 0;
+  long set_changes = 0;  // LBM steps that rebuilt the particles' solid cells (quasi-static walls: after 0.02 dx of motion)
 };
 
 // The fluid load; dim 2 or 3. `dem_dt` is the DEM step the driver uses.
