@@ -117,7 +117,7 @@ class LbmLoad final : public LbmLoadBase {
     long nf = 0;
     for (const auto& c : hole_cells_) nf += fluid_->covered(c[0], c[1], c[2]) ? 0 : 1;
     f.borehole_volume = double(nf) * cell_volume();
-    f.wetted_particles = long(wall_.size());
+    f.wetted_particles = long(std::count(loaded_.begin(), loaded_.end(), char(1)));  // touching the hole's fluid
     f.wetted_cracks = wetted_cracks_;
     return f;
   }

@@ -4,7 +4,8 @@
 // p - p0 as K_eff (rho_lb - 1) with a reduced sound speed (docs/coupling.md).
 //
 // Per LBM step (every n DEM steps, n = floor(dt_lbm / dt_dem); the LBM step is then n dt_dem):
-//   1. the particles become the solver's ParticleSet (lattice units) and the fluid steps once;
+//   1. the particles become the solver's ParticleSet (coupling::fill_particle_set; with quasi-static
+//      walls, the default, only after one has moved 0.02 cells) and the fluid steps once;
 //      with the bounce-back schemes (default: interpolated, Bouzidi) the cells inside particles
 //      are solid, so intact rock holds the pressure and fluid enters only opened cracks; the PSM
 //      is allowed but its covered cells leak a static pressure (docs/coupling.md);
@@ -14,7 +15,10 @@
 //      the mass imposed, integrated, is the injected volume (at the reference density);
 //   3. each particle touching fluid connected to the hole gets the solver's load (relative to
 //      rho_lb = 1: p - p0), converted to SI and held over the next n DEM steps.
-// Status: experimental; the bounce-back schemes diverge on the test block (docs/hydrofrac.md).
+// Verified (test_hydrofrac_lbm_load): the wall's load is p times its wetted chord (total within
+// 0.2%), a pre-cut crack fills to the hole pressure, an isolated one stays dry, and the mass budget
+// (budget()) closes. fluid.moving_walls = true diverges (explicit coupling, added-mass instability:
+// docs/hydrofrac.md).
 // No allocation per step once the set has its size; the solver's loops are deterministic, so 1
 // and 2 threads give identical results; the checkpoint holds the populations, the LBM's step and
 // the last particle set, so a resumed run continues bit-for-bit.

@@ -139,3 +139,16 @@ TEST(HydrofracLbm, ResumeAndTwoThreadsAreBitIdenticalAndTheRockBreaks) {
   EXPECT_EQ(slurp(whole / "series.csv"), slurp(two / "series.csv"));
   EXPECT_EQ(slurp(whole / "cracks.csv"), slurp(two / "cracks.csv"));
 }
+
+// `fracflow check` on an LBM scenario prints what `run` logs at the start of injection: dt_lbm,
+// dt_dem, the sub-cycle count n, tau, the Mach number and K_eff (the DEM step needs the sample,
+// which check builds for this). The block's numbers: dt_dem 1.183e-07 s, n = 2, tau 0.5998.
+TEST(HydrofracLbm, CheckPrintsTheStepsAndTheFluid) {
+  Scratch s;
+  const fs::path file = s.write("block.toml", kBlock);
+  const auto r = fracflow("check " + file.string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  for (const char* want : {"dt_lbm = 2.366e-07 s", "dt_dem = 1.183e-07 s", "n = 2 DEM sub-steps", "tau = 0.5998", "Mach 0",
+                           "K_eff = 4.236e+08 Pa"})
+    EXPECT_NE(r.output.find(want), std::string::npos) << want << " not in:\n" << r.output;
+}
