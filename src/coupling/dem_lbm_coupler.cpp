@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "core/error.hpp"
+#include "coupling/particle_set.hpp"
 #include "dem/diagnostics.hpp"
 
 namespace ff::coupling {
@@ -119,20 +120,7 @@ bool DemLbmCoupler<L, T>::dry(const Vec3& xl) const {
 
 template <class L, class T>
 void DemLbmCoupler<L, T>::build_set() {
-  const auto& p = dem_.particles;
-  const double dt = scales_.dt(), vf = dt / dx_;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    set_.id[i] = std::uint64_t(p.id[i]);
-    set_.position[i] = to_lattice(p.pos[i]);
-    set_.radius[i] = p.radius[i] / dx_;
-    set_.velocity[i] = p.vel[i] * vf;
-    set_.omega[i] = p.omega[i] * dt;
-    if (L::D == 2) {
-      set_.position[i].z() = 0;
-      set_.velocity[i].z() = 0;
-      set_.omega[i].x() = set_.omega[i].y() = 0;
-    }
-  }
+  fill_particle_set(dem_.particles, cs_.origin, scales_.units, L::D, set_);
 }
 
 template <class L, class T>
@@ -200,12 +188,9 @@ void DemLbmCoupler<L, T>::step(bool sample_fluid) {
   const Vec3 g = dem_.settings.gravity;
   const double rho_f = u.rho();
   for (std::size_t i = 0; i < p.size(); ++i) {
-    Vec3 f(u.to_si_force(F[i].x(), L::D), u.to_si_force(F[i].y(), L::D), u.to_si_force(F[i].z(), L::D));
-    Vec3 m(u.to_si_torque(M[i].x(), L::D), u.to_si_torque(M[i].y(), L::D), u.to_si_torque(M[i].z(), L::D));
-    if (L::D == 2) {
-      f.z() = 0;
-      m.x() = m.y() = 0;
-    }
+    const SiLoad si = to_si_load(u, L::D, F[i], M[i]);
+    Vec3 f = si.force;
+    const Vec3 m = si.torque;
     if (cs_.pressure_load) f += dry_force_[i];
     if (cs_.buoyancy) {
       const double r = p.radius[i];

@@ -3,7 +3,7 @@
 // code that sees both modules. docs/coupling.md describes the scheme, the units and the tests.
 //
 // One coupled step (time t -> t + dt_lbm):
-//   1. the DEM particles (SI) become an lbm::ParticleSet (lattice units: positions relative to
+//   1. the DEM particles (SI) become an lbm::ParticleSet (coupling/particle_set.hpp; lattice units: positions relative to
 //      the centre of cell (0, 0, 0), radii / dx, v dt / dx, omega dt; ids carried along);
 //      disks on D2Q9, spheres on D3Q19;
 //   2. the fluid steps once with them (Solver::set_particles, step) and returns each

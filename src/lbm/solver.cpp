@@ -501,7 +501,7 @@ template <class L, class T>
 double Solver<L, T>::cell_density(int x, int y, int z) const {
   const bool odd = (time_ & 1) != 0;
   const CellIndex N = n_(), c = grid_.index(x, y, z);
-  double rho = double(f_[c]);
+  double rho = 1.0 + double(f_[c]);  // populations are stored shifted by their weights (collision.hpp)
   for (int q = 1; q < Q; ++q)
     rho += odd ? double(f_[L::opp[q] * N + grid_.neighbour(x, y, z, -L::c[q][0], -L::c[q][1], -L::c[q][2])])
                : double(f_[q * N + c]);

@@ -158,7 +158,7 @@ class Solver {
   // for sources that a coupled driver imposes after a step (e.g. a pressurised borehole).
   // Static solid or covered by a moving particle (bounce-back schemes) now.
   bool covered(int x, int y, int z) const;
-  double cell_density(int x, int y, int z) const;  // sum_q g_q of an interior cell
+  double cell_density(int x, int y, int z) const;  // rho = 1 + sum_q g_q of an interior cell
   // f = f^eq(rho, u) on each listed interior cell that is not covered(); returns the mass added,
   // sum (rho - rho_before) over those cells (lattice units).
   double impose_equilibrium(const std::vector<std::array<int, 3>>& cells, double rho, const Vec3& u);

@@ -139,6 +139,7 @@ FlowCheckReport::~FlowCheckReport() { g_check_report = nullptr; }
 void FlowCheckReport::append(const std::string& s) {
   if (g_check_report) g_check_report->text_ += s;
 }
+bool FlowCheckReport::active() { return g_check_report != nullptr; }
 
 namespace {
 

@@ -54,6 +54,7 @@ class FlowCheckReport {
   FlowCheckReport& operator=(const FlowCheckReport&) = delete;
   const std::string& text() const { return text_; }
   static void append(const std::string& s);  // no-op when none lives
+  static bool active();                       // one lives (`fracflow check`): worth deriving a report
 
  private:
   std::string text_;

@@ -34,6 +34,7 @@
 #include "drivers/hydrofrac/kirsch.hpp"
 #include "drivers/hydrofrac/sleeve_load.hpp"
 #include "drivers/hydrofrac/lbm_load.hpp"
+#include "drivers/flow/flow_runner.hpp"
 #include "io/pvd.hpp"
 #include "coupling/fluid_spec.hpp"
 #include "drivers/run_control.hpp"
@@ -180,7 +181,27 @@ void validate(const Config& cfg) {
   if (cfg.string("sample.shape") != "box")
     cfg.fail("sample.shape", "the hydrofrac block is a box: shape = \"box\" (2D rectangle in x-y; 3D box with the borehole along z)");
   // The fluid's own checks (tau, Mach, density variation; the DEM step rounds dt_lbm later).
-  if (cfg.string("injection.fluid") == "lbm") (void)coupling::derive_scales(lbm_fluid_spec(cfg));
+  if (cfg.string("injection.fluid") == "lbm") {
+    (void)coupling::derive_scales(lbm_fluid_spec(cfg));
+    // `fracflow check`: the LBM and DEM steps as `run` logs them (the DEM step needs the sample).
+    if (FlowCheckReport::active()) {
+      const bool q = log::quiet();
+      log::quiet() = true;
+      dem::DemSystem sys;
+      sys.settings = dem::build_settings(cfg);
+      sys.materials = dem::build_materials(cfg);
+      (void)dem::build_sample(cfg, sys);
+      dem::choose_time_step(cfg, sys);
+      log::quiet() = q;
+      hydrofrac::LbmSettings l;
+      l.fluid = lbm_fluid_spec(cfg);
+      hydrofrac::LbmInfo in = hydrofrac::lbm_info(l, sys.settings.dt);
+      hydrofrac::size_lattice(sys.particles, l.fluid.dx, sys.settings.dim, in);
+      FlowCheckReport::append(fmt::format("hydrofrac: lattice Boltzmann fluid ({}): {}\n(lattice from the packing before the "
+                                          "hole is carved and the walls servo: the run's may differ by a cell)\n",
+                                          cfg.string("fluid.scheme"), in.describe()));
+    }
+  }
   const Block b = block_of(cfg);
   const Real R = cfg.real("borehole.radius"), rmax = cfg.real("sample.radius_max");
   const Real lmin = std::min(b.lx, b.ly);
@@ -852,6 +873,31 @@ void HydrofracRun::finish(const std::string& stop) {
                  "the same region (a = effective hole radius, far field = the in-situ targets, compression positive)"},
       {"insitu", circles_json(insitu_)}};
   if (!probe_.empty()) j["elastic_state"]["pressurised"] = circles_json(probe_);
+  if (lbm_) {
+    const auto& in = lbm_->info();
+    const hydrofrac::LbmBudget b = lbm_->budget();
+    j["lbm"] = {{"scheme", cfg.string("fluid.scheme")},
+                {"dt_lbm_s", in.scales.dt()},
+                {"dt_dem_s", in.dem_dt},
+                {"sub_steps", in.stride},
+                {"tau", in.scales.units.tau()},
+                {"mach", in.scales.mach},
+                {"bulk_modulus_eff_Pa", in.scales.bulk_modulus},
+                {"dx_m", in.scales.units.dx()},
+                {"lattice", {in.n[0], in.n[1], in.n[2]}},
+                {"lbm_steps", b.lbm_steps},
+                {"particle_set_changes", b.set_changes},
+                {"mass_budget_m3",
+                 {{"injected", b.injected},
+                  {"lattice_change", b.lattice_change},
+                  {"covering_refill", b.covering_refill},
+                  {"residual", b.residual},
+                  {"definition", "volumes at the reference density: lattice_change = injected + covering_refill + residual; "
+                                 "the residual is what the bounce-back walls created or destroyed (the box is closed)"}}}};
+    log::info("hydrofrac: LBM mass budget over {} LBM steps ({} new particle sets; m^3 at rho_f): injected {:.4g}, lattice "
+              "change {:.4g}, covering and refill {:.4g}, residual (walls) {:.4g}",
+              b.lbm_steps, b.set_changes, b.injected, b.lattice_change, b.covering_refill, b.residual);
+  }
   j["cracks"] = cracks_json(sys);
   j["sample"] = sample_json(sys, info);
   j["time_step_s"] = sys.settings.dt;

@@ -7,6 +7,8 @@
 #include <cmath>
 
 #include "core/error.hpp"
+#include "core/log.hpp"
+#include "coupling/particle_set.hpp"
 #include "drivers/hydrofrac/borehole.hpp"
 #include "io/vtk.hpp"
 #include "lbm/solver.hpp"
@@ -14,8 +16,10 @@
 namespace ff::drivers::hydrofrac {
 
 std::string LbmInfo::describe() const {
-  return fmt::format("{}\nLBM lattice {} x {} x {} cells, one LBM step every {} DEM steps (dt_lbm = {:.4g} s)",
-                     scales.describe(), n[0], n[1], n[2], stride, scales.dt());
+  return fmt::format("{}\nLBM lattice {} x {} x {} cells; dt_lbm = {:.4g} s = n dt_dem with dt_dem = {:.4g} s and n = {} DEM "
+                     "sub-steps per LBM step; tau = {:.4g}, Mach {:.3g}, K_eff = {:.4g} Pa",
+                     scales.describe(), n[0], n[1], n[2], scales.dt(), dem_dt, stride, scales.units.tau(), scales.mach,
+                     scales.bulk_modulus);
 }
 
 LbmInfo lbm_info(const LbmSettings& s, Real dem_dt) {
@@ -34,7 +38,24 @@ LbmInfo lbm_info(const LbmSettings& s, Real dem_dt) {
                                  in.stride, dem_dt, first.fixed_by, first.dt()));
   }
   in.scales.fixed_by = first.fixed_by + " and the DEM step";
+  in.dem_dt = dem_dt;
   return in;
+}
+
+void size_lattice(const dem::ParticleStore& P, Real dx, int dim, LbmInfo& info) {
+  Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+  for (std::size_t i = 0; i < P.size(); ++i)
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], P.pos[i][a] - P.radius[i]);
+      hi[a] = std::max(hi[a], P.pos[i][a] + P.radius[i]);
+    }
+  info.n[0] = info.n[1] = info.n[2] = 1;
+  for (int a = 0; a < dim; ++a) {
+    lo[a] -= dx;
+    info.n[a] = int(std::ceil((hi[a] + dx - lo[a]) / dx));
+  }
+  if (dim == 2) lo.z() = -0.5 * dx;
+  info.origin = lo + Vec3::Constant(0.5 * dx);
 }
 
 namespace {
@@ -52,19 +73,7 @@ class LbmLoad final : public LbmLoadBase {
     const auto& P = sys.particles;
     info_ = lbm_info(s_, sys.settings.dt);
     const double dx = s_.fluid.dx;
-    // The lattice covers every particle plus one cell.
-    Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
-    for (std::size_t i = 0; i < P.size(); ++i)
-      for (int a = 0; a < 3; ++a) {
-        lo[a] = std::min(lo[a], P.pos[i][a] - P.radius[i]);
-        hi[a] = std::max(hi[a], P.pos[i][a] + P.radius[i]);
-      }
-    for (int a = 0; a < L::D; ++a) {
-      lo[a] -= dx;
-      info_.n[a] = int(std::ceil((hi[a] + dx - lo[a]) / dx));
-    }
-    if (L::D == 2) lo.z() = -0.5 * dx;
-    info_.origin = lo + Vec3::Constant(0.5 * dx);
+    size_lattice(P, dx, L::D, info_);  // every particle plus one cell
     const double cells = double(info_.n[0]) * info_.n[1] * info_.n[2];
     if (cells > 2e8)
       throw InputError(fmt::format("fluid.dx: {} m gives {:.3g} lattice cells over the block (at most 2e8); raise it", dx, cells));
@@ -79,8 +88,13 @@ class LbmLoad final : public LbmLoadBase {
     // The hole's fluid at the initial pressure before the first step.
     fill_set(sys);
     fluid_->set_particles(set_);
+    find_loaded(sys);
+    st_.mass0 = lattice_mass();
     const double rho_b = info_.scales.lattice_density(s_.initial_pressure);
     st_.injected += fluid_->impose_equilibrium(hole_cells_, rho_b, Vec3::Zero()) * cell_volume();
+    if (s_.moving_walls)
+      log::warn("fluid.moving_walls = true: the particles' velocities enter the bounce-back walls; with explicit coupling "
+                "this diverges for grains of a few cells in tight pores (added-mass instability, docs/hydrofrac.md)");
     const HoleSurface hs = hole_surface(sys, hole, s_.cell, s_.inflate, s_.reach);
     wall_ = hs.particle;
     effective_radius_ = hs.effective_radius;
@@ -103,7 +117,7 @@ class LbmLoad final : public LbmLoadBase {
     long nf = 0;
     for (const auto& c : hole_cells_) nf += fluid_->covered(c[0], c[1], c[2]) ? 0 : 1;
     f.borehole_volume = double(nf) * cell_volume();
-    f.wetted_particles = long(wall_.size());
+    f.wetted_particles = long(std::count(loaded_.begin(), loaded_.end(), char(1)));  // touching the hole's fluid
     f.wetted_cracks = wetted_cracks_;
     return f;
   }
@@ -111,6 +125,16 @@ class LbmLoad final : public LbmLoadBase {
   const LbmInfo& info() const override { return info_; }
   Real effective_radius() const override { return effective_radius_; }
   const std::vector<Vec3>& hydro_force() const override { return force_; }
+  LbmBudget budget() const override {
+    LbmBudget b;
+    b.injected = st_.injected;
+    b.lattice_change = (lattice_mass() - st_.mass0) * cell_volume();
+    b.covering_refill = st_.changes;
+    b.residual = b.lattice_change - b.injected - b.covering_refill;
+    b.lbm_steps = st_.lbm_steps;
+    b.set_changes = st_.set_changes;
+    return b;
+  }
 
   Real pressure_at(const Vec3& x) const override {
     int c[3];
@@ -142,7 +166,7 @@ class LbmLoad final : public LbmLoadBase {
             continue;
           }
           // Moments of the populations the next step reads (AA slots as in Solver::cell_density).
-          double rho = 0, j[3] = {0, 0, 0};
+          double rho = 1, j[3] = {0, 0, 0};  // populations shifted by their weights (collision.hpp)
           const lbm::CellIndex c = g.index(x, y, z);
           for (int q = 0; q < L::Q; ++q) {
             const double v = q == 0 ? f[c]
@@ -215,6 +239,7 @@ class LbmLoad final : public LbmLoadBase {
     r.get("lbm.set.velocity", set_.velocity);
     r.get("lbm.set.omega", set_.omega);
     fluid_->restore_particles(set_);
+    find_loaded(sys);
     r.get("lbm.force", force_);
     r.get("lbm.torque", torque_);
     count_wetted(sys);
@@ -223,10 +248,24 @@ class LbmLoad final : public LbmLoadBase {
  private:
   struct State {  // trivially copyable (a checkpoint section)
     Real t0 = 0, pressure = 0, injected = 0;
+    Real mass0 = 0;    // lattice mass after the first set of particles, before the first imposition
+    Real changes = 0;  // mass that covering and refill added (refill minus covered) [m^3 at rho_f]
     long dem_steps = 0, lbm_steps = 0;
+    long set_changes = 0;  // LBM steps that handed the solver a new particle set
   };
 
   double cell_volume() const { return std::pow(s_.fluid.dx, L::D); }  // 2D: per metre
+
+  // Sum of rho over the fluid cells (lattice units), the state the next step reads.
+  double lattice_mass() const {
+    const auto& g = fluid_->grid();
+    double m = 0;
+    for (int z = 0; z < g.nz; ++z)
+      for (int y = 0; y < g.ny; ++y)
+        for (int x = 0; x < g.nx; ++x)
+          if (!fluid_->covered(x, y, z)) m += fluid_->cell_density(x, y, z);
+    return m;
+  }
 
   bool cell_of(const Vec3& x, int* c) const {
     const Vec3 xl = (x - info_.origin) / s_.fluid.dx;
@@ -264,32 +303,50 @@ class LbmLoad final : public LbmLoadBase {
     id_index_ = index_of_ids(sys.particles);
   }
 
+  // Quasi-static walls unless fluid.moving_walls (motion factor 0: the moving-wall term of explicit
+  // coupling is unstable for these light, confined grains; docs/hydrofrac.md).
   void fill_set(const dem::DemSystem& sys) {
-    const auto& p = sys.particles;
-    if (set_.size() != p.size()) set_.resize(p.size());
-    const double dx = s_.fluid.dx, dt = info_.scales.dt(), vf = dt / dx;
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      set_.id[i] = std::uint64_t(p.id[i]);
-      set_.position[i] = (p.pos[i] - info_.origin) / dx;
-      set_.radius[i] = p.radius[i] / dx;
-      // Quasi-static walls unless fluid.moving_walls (the moving-wall term made the bounce-back
-      // runs diverge; docs/hydrofrac.md).
-      const double w = s_.moving_walls ? 1.0 : 0.0;
-      set_.velocity[i] = p.vel[i] * (vf * w);
-      set_.omega[i] = p.omega[i] * (dt * w);
-      if (L::D == 2) {
-        set_.position[i].z() = 0;
-        set_.velocity[i].z() = 0;
-        set_.omega[i].x() = set_.omega[i].y() = 0;
-      }
-    }
+    coupling::fill_particle_set(sys.particles, info_.origin, info_.scales.units, L::D, set_, s_.moving_walls ? 1.0 : 0.0);
   }
 
   Real pressure_now(Real t) const { return s_.initial_pressure + s_.ramp_rate * (t - st_.t0); }
 
+  // With quasi-static walls the particle set changes only through the particles' positions: it is
+  // handed to the solver again once a particle has moved kRefresh cells since the last set (the
+  // rock creeps ~1e-4 cells per LBM step; rebuilding the solid cells and links of every grain each
+  // step cost several LBM steps). Moving walls refresh every step (their velocities change).
+  static constexpr double kRefresh = 0.02;
+  bool set_stale(const dem::DemSystem& sys) const {
+    const auto& p = sys.particles;
+    if (s_.moving_walls || set_.size() != p.size()) return true;
+    const double dx = s_.fluid.dx, lim = kRefresh * kRefresh;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      Vec3 d = (p.pos[i] - info_.origin) / dx - set_.position[i];
+      if (L::D == 2) d.z() = 0;
+      if (d.squaredNorm() > lim) return true;
+    }
+    return false;
+  }
+
+  // Particles that carry a fluid load (dry rock: only those touching fluid connected to the hole;
+  // the pore pockets between intact grains are sealed, and their trapped fluid, a stiff spring at
+  // K_eff, would only make the explicit coupling unstable). Depends on the set alone.
+  void find_loaded(const dem::DemSystem& sys) {
+    flood();
+    loaded_.assign(set_.size(), 0);
+    const double dx = s_.fluid.dx;
+    for (std::size_t i = 0; i < set_.size(); ++i) loaded_[i] = touches_wet(set_.position[i], sys.particles.radius[i] / dx);
+  }
+
   void lbm_step(const dem::DemSystem& sys) {
-    fill_set(sys);
-    fluid_->set_particles(set_);
+    if (set_stale(sys)) {
+      fill_set(sys);
+      fluid_->set_particles(set_);
+      if (const auto* mb = fluid_->moving_boundary())
+        st_.changes += (mb->stats().mass_added - mb->stats().mass_removed) * cell_volume();
+      find_loaded(sys);
+      ++st_.set_changes;
+    }
     fluid_->step(false);
     ++st_.lbm_steps;
     const double dt = info_.scales.dt();
@@ -316,32 +373,23 @@ class LbmLoad final : public LbmLoadBase {
     // Loads: the momentum exchange minus that of the reference fluid at rest (p0) on the same links.
     const auto& F = fluid_->particle_forces();
     const auto& M = fluid_->particle_torques();
-    flood();
     const auto& u = info_.scales.units;
-    const double dx = s_.fluid.dx;
     for (std::size_t i = 0; i < force_.size(); ++i) {
-      // Dry rock: only particles that touch fluid connected to the hole carry a fluid load; the
-      // pore pockets between intact grains are sealed, and their trapped fluid (a stiff spring at
-      // K_eff) would only make the explicit coupling unstable.
-      if (!touches_wet(set_.position[i], sys.particles.radius[i] / dx)) {
+      if (!loaded_[i]) {
         force_[i] = torque_[i] = Vec3::Zero();
         continue;
       }
-      const Vec3 f = F[i], m = M[i];
-      Vec3 fs(u.to_si_force(f.x(), L::D), u.to_si_force(f.y(), L::D), u.to_si_force(f.z(), L::D));
-      Vec3 ms(u.to_si_torque(m.x(), L::D), u.to_si_torque(m.y(), L::D), u.to_si_torque(m.z(), L::D));
-      if (L::D == 2) {
-        fs.z() = 0;
-        ms.x() = ms.y() = 0;
-      }
-      force_[i] = fs;
-      torque_[i] = ms;
+      const coupling::SiLoad si = coupling::to_si_load(u, L::D, F[i], M[i]);
+      force_[i] = si.force;
+      torque_[i] = si.torque;
     }
     count_wetted(sys);  // O(cracks) per LBM step
   }
 
-  // The fluid connected to the hole now: flood over uncovered cells (4 / 6 neighbours) from the
-  // hole's cells; cost proportional to the connected region.
+  // The fluid connected to the hole now: flood over uncovered cells from the hole's cells along
+  // the lattice's directions (8 / 18 neighbours: the populations stream diagonally too, so a
+  // pocket that touches the hole's fluid only at a corner is connected); cost proportional to
+  // the connected region.
   void flood() {
     const auto& g = fluid_->grid();
     if (wet_.size() != std::size_t(g.nx) * g.ny * g.nz) wet_.assign(std::size_t(g.nx) * g.ny * g.nz, 0);
@@ -360,14 +408,7 @@ class LbmLoad final : public LbmLoadBase {
       const std::size_t k = wet_list_[h];
       const int x = int(k % std::size_t(g.nx)), y = int((k / std::size_t(g.nx)) % std::size_t(g.ny)),
                 z = int(k / (std::size_t(g.nx) * g.ny));
-      push(x - 1, y, z);
-      push(x + 1, y, z);
-      push(x, y - 1, z);
-      push(x, y + 1, z);
-      if (L::D == 3) {
-        push(x, y, z - 1);
-        push(x, y, z + 1);
-      }
+      for (int q = 1; q < L::Q; ++q) push(x + L::c[q][0], y + L::c[q][1], z + L::c[q][2]);
     }
   }
   bool touches_wet(const Vec3& c, double r) const {
@@ -418,6 +459,7 @@ class LbmLoad final : public LbmLoadBase {
   long wetted_cracks_ = 0;
   Real effective_radius_ = 0;
   std::vector<std::uint8_t> wet_;
+  std::vector<char> loaded_;  // per particle: touches the hole's fluid (find_loaded)
   std::vector<std::size_t> wet_list_;
 };
 

@@ -4,7 +4,8 @@
 // p - p0 as K_eff (rho_lb - 1) with a reduced sound speed (docs/coupling.md).
 //
 // Per LBM step (every n DEM steps, n = floor(dt_lbm / dt_dem); the LBM step is then n dt_dem):
-//   1. the particles become the solver's ParticleSet (lattice units) and the fluid steps once;
+//   1. the particles become the solver's ParticleSet (coupling::fill_particle_set; with quasi-static
+//      walls, the default, only after one has moved 0.02 cells) and the fluid steps once;
 //      with the bounce-back schemes (default: interpolated, Bouzidi) the cells inside particles
 //      are solid, so intact rock holds the pressure and fluid enters only opened cracks; the PSM
 //      is allowed but its covered cells leak a static pressure (docs/coupling.md);
@@ -14,7 +15,10 @@
 //      the mass imposed, integrated, is the injected volume (at the reference density);
 //   3. each particle touching fluid connected to the hole gets the solver's load (relative to
 //      rho_lb = 1: p - p0), converted to SI and held over the next n DEM steps.
-// Status: experimental; the bounce-back schemes diverge on the test block (docs/hydrofrac.md).
+// Verified (test_hydrofrac_lbm_load): the wall's load is p times its wetted chord (total within
+// 0.2%), a pre-cut crack fills to the hole pressure, an isolated one stays dry, and the mass budget
+// (budget()) closes. fluid.moving_walls = true diverges (explicit coupling, added-mass instability:
+// docs/hydrofrac.md).
 // No allocation per step once the set has its size; the solver's loops are deterministic, so 1
 // and 2 threads give identical results; the checkpoint holds the populations, the LBM's step and
 // the last particle set, so a resumed run continues bit-for-bit.
@@ -43,10 +47,20 @@ struct LbmSettings {
 // What the LBM side derived (for the log and summary.json).
 struct LbmInfo {
   coupling::FluidScales scales;
-  long stride = 1;  // DEM steps per LBM step
+  long stride = 1;  // DEM steps per LBM step (the sub-cycle count n)
+  Real dem_dt = 0;  // the DEM step [s]; dt_lbm = stride x dem_dt
   int n[3] = {1, 1, 1};
   Vec3 origin = Vec3::Zero();  // SI centre of cell (0, 0, 0)
   std::string describe() const;
+};
+
+// Where the injected fluid went (volumes at the reference density rho_f, m^3; 2D per metre):
+// lattice_change = injected + covering_refill + residual, the residual being what the walls'
+// bounce-back (interpolation, moving-wall term) created or destroyed; the box is closed.
+struct LbmBudget {
+  Real injected = 0, lattice_change = 0, covering_refill = 0, residual = 0;
+  long lbm_steps = 0;
+  long set_changes = 0;  // LBM steps that rebuilt the particles' solid cells (quasi-static walls: after 0.02 dx of motion)
 };
 
 // The fluid load; dim 2 or 3. `dem_dt` is the DEM step the driver uses.
@@ -61,10 +75,13 @@ class LbmLoadBase : public FluidLoad {
   virtual bool wet_at(const Vec3& x) const = 0;  // the cell containing x is fluid now
   // Hydrodynamic force of the last LBM step on particle i [N] (2D: per metre).
   virtual const std::vector<Vec3>& hydro_force() const = 0;
+  virtual LbmBudget budget() const = 0;  // sums the lattice: once per report, not per step
 };
 
 std::unique_ptr<LbmLoadBase> make_lbm_load(const LbmSettings& s, int dim);
 // The scales and stride without building a lattice (check / log).
 LbmInfo lbm_info(const LbmSettings& s, Real dem_dt);
+// The lattice over the particles (every particle plus one cell): sets info.n and info.origin.
+void size_lattice(const dem::ParticleStore& p, Real dx, int dim, LbmInfo& info);
 
 }  // namespace ff::drivers::hydrofrac
