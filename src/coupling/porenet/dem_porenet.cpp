@@ -218,12 +218,16 @@ void DemPorenetCoupling::cavitate() {
   const auto p = flow_->pressure();
   const auto mq = flow_->liquid_mass();
   const auto mp = flow_->gas_mass();
-  const Real rho_q = prm_.fluid.liquid.density(pc, true);
+  const Real rho_q = prm_.fluid.liquid.density(pc, true), rho_v = prm_.fluid.gas.density(pc, false);
   for (Index i = 0; i < net_->n_pores(); ++i) {
     if (!(p[i] < pc)) continue;
-    // Same liquid mass at the vapour pressure; the rest of the void is vapour at pc.
-    const Real S = std::min(1.0, mq[i] / (net_->pore_void[i] * rho_q));
+    // Same liquid mass at the vapour pressure; the rest of the void is vapour at pc. Vapour is only
+    // added: a pore whose gas would fill that space already is left alone (gas mass never falls).
+    const Real V = net_->pore_void[i];
+    const Real S = std::min(1.0, mq[i] / (V * rho_q));
+    const Real needed = (1 - S) * V * rho_v;
     const Real mp_old = mp[i];
+    if (needed < mp_old) continue;
     flow_->set_pore_state(i, pc, S);
     stats_.vapour_mass += flow_->gas_mass()[i] - mp_old;
     ++stats_.cavitations;
