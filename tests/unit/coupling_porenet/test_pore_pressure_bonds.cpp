@@ -89,3 +89,40 @@ TEST(PorePressureBonds, SeedDiameterHeightGivesTwoROverTOfIt) {
 
 }  // namespace
 }  // namespace ff::coupling
+
+namespace ff::coupling {
+namespace {
+
+// Cavitation (DemPorenetCoupling, fluid.cavitation_pressure): a liquid-filled pore pulled below the
+// vapour pressure p_v keeps its liquid mass (to round-off, 1e-12) and holds vapour at p_v in the rest
+// of its void: S = m_q / (V rho_q(p_v)), vapour mass (1 - S) V rho_v(p_v). Without the floor the
+// barotropic liquid stays below p_v (and would go on into tension).
+TEST(PorePressureBonds, CavitationHoldsTheVapourPressureAndKeepsTheLiquid) {
+  for (const Real pv : {2.34e3, 0.0}) {
+    dem::DemSystem s = triangle();
+    DemPorenetCoupling c;
+    auto prm = gas(ForceHeight::Thickness);
+    prm.saturation = 1;
+    prm.cavitation_pressure = pv;
+    c.init(s, prm);
+    c.set_uniform_state(1e3, 1.0);  // liquid below the vapour pressure
+    const Real mq0 = c.flow().liquid_mass()[0];
+    c.step(s);
+    const Real p = c.flow().pressure()[0];
+    std::printf("floor %.4g Pa: p %.6g Pa, liquid mass change %.3g, vapour %.3g kg, cavitations %ld\n", pv, p,
+                c.flow().liquid_mass()[0] / mq0 - 1, c.flow().gas_mass()[0], c.stats().cavitations);
+    EXPECT_NEAR(c.flow().liquid_mass()[0] / mq0, 1.0, 1e-12);
+    if (pv > 0) {
+      EXPECT_EQ(p, pv);
+      EXPECT_EQ(c.stats().cavitations, 1);
+      EXPECT_GT(c.flow().gas_mass()[0], 0);
+      EXPECT_LT(c.flow().liquid_fraction()[0], 1);
+    } else {
+      EXPECT_LT(p, 1.5e3);
+      EXPECT_EQ(c.stats().cavitations, 0);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace ff::coupling
