@@ -28,6 +28,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "dem/bond/cohesive_bond.hpp"
 #include "dem/bond/no_bond.hpp"
 #include "dem/bond/parallel_bond.hpp"
 #include "dem/bond/rotational_bond.hpp"
@@ -43,11 +44,13 @@ template <class... L> struct LawList {
 // ---- The registered laws: one line each. ----------------------------------------------------
 using ContactLaws = LawList<
     LinearContact,
-    HertzMindlinContact>;
+    HertzMindlinContact,
+    CohesiveContact>;
 using BondLaws = LawList<
     ParallelBond,
     RotationalBond,
-    NoBond>;
+    NoBond,
+    CohesiveBond>;
 // ---------------------------------------------------------------------------------------------
 
 // Calls f(std::type_identity<Law>{}) for every law of the list, in order.

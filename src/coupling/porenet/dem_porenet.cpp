@@ -63,7 +63,7 @@ void DemPorenetCoupling::fill_pair_state(const dem::DemSystem& sys) {
   const auto& pl = sys.pair_loads();
   const Real t = prm_.network.thickness;
   const auto n = static_cast<Index>(pairs_.size());
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (static_cast<std::size_t>(n) > sys.settings.parallel_min)
   for (Index q = 0; q < n; ++q) {
     const Index a = pairs_.i[q], b = pairs_.j[q];
     const Vec3 d = P.pos[b] - P.pos[a];
@@ -161,6 +161,13 @@ void DemPorenetCoupling::add_forces(dem::DemSystem& sys) {
   const porenet::Particles2D parts{x_, y_, r_, {}};
   porenet::add_pressure_forces(*net_, parts, pg_, fx_, fy_);
   if (prm_.shear_forces) porenet::add_shear_forces(*net_, parts, pg_, fx_, fy_);
+  // porenet applies both over the seed's height 2 r_j; every term of particle k carries it once.
+  if (prm_.force_height == ForceHeight::Thickness)
+    for (std::size_t k = 0; k < fx_.size(); ++k) {
+      const Real scale = prm_.network.thickness / (2 * r_[k]);
+      fx_[k] *= scale;
+      fy_[k] *= scale;
+    }
   for (std::size_t k = 0; k < fx_.size(); ++k) {
     sys.particles.ext_force[k].x() += fx_[k];
     sys.particles.ext_force[k].y() += fy_[k];
@@ -194,12 +201,37 @@ void DemPorenetCoupling::step(dem::DemSystem& sys) {
         "reduce the liquid bulk modulus or the DEM step, or raise the apertures",
         nsub, limit, dt, prm_.max_substeps));
   const Real h = dt / static_cast<Real>(nsub);
-  for (long s = 0; s < nsub; ++s) flow_->step_explicit(h);
+  for (long s = 0; s < nsub; ++s) {
+    flow_->step_explicit(h);
+    cavitate();
+  }
   stats_.last_substeps = nsub;
   stats_.last_flow_dt = h;
   sys.add_external_loads();
   add_forces(sys);
   sys.integrate();
+}
+
+void DemPorenetCoupling::cavitate() {
+  const Real pc = prm_.cavitation_pressure;
+  if (!(pc > 0)) return;
+  const auto p = flow_->pressure();
+  const auto mq = flow_->liquid_mass();
+  const auto mp = flow_->gas_mass();
+  const Real rho_q = prm_.fluid.liquid.density(pc, true), rho_v = prm_.fluid.gas.density(pc, false);
+  for (Index i = 0; i < net_->n_pores(); ++i) {
+    if (!(p[i] < pc)) continue;
+    // Same liquid mass at the vapour pressure; the rest of the void is vapour at pc. Vapour is only
+    // added: a pore whose gas would fill that space already is left alone (gas mass never falls).
+    const Real V = net_->pore_void[i];
+    const Real S = std::min(1.0, mq[i] / (V * rho_q));
+    const Real needed = (1 - S) * V * rho_v;
+    const Real mp_old = mp[i];
+    if (needed < mp_old) continue;
+    flow_->set_pore_state(i, pc, S);
+    stats_.vapour_mass += flow_->gas_mass()[i] - mp_old;
+    ++stats_.cavitations;
+  }
 }
 
 Real DemPorenetCoupling::max_pressure() const {

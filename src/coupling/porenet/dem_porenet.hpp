@@ -12,7 +12,8 @@
 //   n explicit flow sub-steps of dt_dem / n, n = ceil(dt_dem / (safety dt_flow)), dt_flow the
 //     two-phase stable step (docs/porenet.md §3, §5); when dt_flow > dt_dem one flow step per DEM step;
 //   add_external_loads(); grain forces from the gauge pressure p - p_ambient (pressure B26-B27,
-//     channel shear B25, B28) into particles.ext_force; integrate().
+//     channel shear B25, B28; wetted height t or 2 r_j, ForceHeight) into particles.ext_force;
+//     integrate().
 // Contacts and bonds that form between triangulations get their S2S channel at the next one.
 // Results are bit-identical on any thread count (porenet's fixed-order sums; per-particle loops).
 #pragma once
@@ -31,6 +32,16 @@ namespace ff::coupling {
 // max radii of the sample's lateral sides (x extremes), held at the ambient pressure.
 enum class Drainage : std::uint8_t { Closed = 0, Sides = 1 };
 
+// Height of the wetted grain surface in B27 (A_k = height x arc) and B28 (height x L_k); it must
+// be the height over which the grain's contacts and bonds carry their forces (the pressures do not
+// depend on it: pore volumes and channel conductances both scale with the network's depth t).
+// Thickness: fracflow's 2D discs are t = 1 m thick and the linear contact and parallel bond carry
+// forces over t. Diameter: the seed's 2 r_j, for its law A1-A7, whose forces are those of spheres
+// (a layer of spheres 2 r thick). Parallel bonds with the diameter height feel 2 r / t of the
+// pressure's force (1e-3 for r = 0.5 mm): why 20 MPa of pore pressure left the UCS of the first
+// sweep unchanged (docs/saturated.md).
+enum class ForceHeight : std::uint8_t { Thickness = 0, Diameter = 1 };
+
 struct PorenetCouplingParams {
   porenet::NetworkParams network;
   porenet::TwoPhaseParams fluid;
@@ -41,6 +52,12 @@ struct PorenetCouplingParams {
   Real dt_safety = 0.9;                   // flow sub-step <= safety x stable step
   long max_substeps = 200000;             // a flow step this small is an error, not a slow run
   bool shear_forces = true;
+  // Cavitation: a pore's liquid cannot be pulled below this absolute pressure (water's vapour
+  // pressure, 2.34 kPa at 20 C); below it the pore keeps its liquid mass and fills the rest of its
+  // void with vapour (modelled as the gas phase) at this pressure. 0 = off (the barotropic liquid
+  // then takes any tension: a dilating saturated sample is held together by suction).
+  Real cavitation_pressure = 2.34e3;  // [Pa]
+  ForceHeight force_height = ForceHeight::Thickness;
   Drainage drainage = Drainage::Closed;
 };
 
@@ -50,6 +67,8 @@ struct CouplingStats {
   Real last_flow_dt = 0;    // sub-step used [s]
   Real last_stable_dt = 0;  // two-phase stable step [s]
   Real max_displacement = 0;  // since the last triangulation [m]
+  long cavitations = 0;       // pore-steps that cavitated
+  Real vapour_mass = 0;       // gas-phase mass created by cavitation [kg per m of depth]
 };
 
 class DemPorenetCoupling {
@@ -87,6 +106,7 @@ class DemPorenetCoupling {
   void set_boundaries(porenet::TwoPhaseFlow& flow, const porenet::Network2D& net);
   void retriangulate(const dem::DemSystem& sys);
   void add_forces(dem::DemSystem& sys);
+  void cavitate();
 
   PorenetCouplingParams prm_;
   std::unique_ptr<porenet::Network2D> net_;

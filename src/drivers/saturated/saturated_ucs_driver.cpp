@@ -56,6 +56,15 @@ void declare(ParamTable& t) {
          "retriangulate when a particle has moved this fraction of the mean radius since the last triangulation")
       .positive();
   t.boolean("fluid.shear_forces", true, "add the channel shear forces (B25, B28) to the pressure forces (B26-B27)");
+  t.real("fluid.cavitation_pressure", 2.34e3, "Pa",
+         "absolute pressure below which a pore's liquid cavitates (vapour fills the rest of its void at this pressure; "
+         "water at 20 C: 2.34e3); 0 = the liquid takes any tension")
+      .non_negative();
+  t.string("fluid.force_height", "auto",
+           "wetted height of a grain in B27/B28, to match the height its contacts and bonds act over: thickness (1 m "
+           "discs: linear/parallel laws), diameter (the seed's 2 r_j: spheres in one layer, its cohesive law A1-A7), "
+           "auto (diameter with dem.contact_law = cohesive, else thickness)")
+      .one_of({"auto", "thickness", "diameter"});
 }
 
 const std::vector<std::string> kColumns = {
@@ -91,6 +100,10 @@ coupling::PorenetCouplingParams coupling_params(const Config& cfg) {
   p.network.min_void_relative = cfg.real("fluid.min_void_relative");
   p.retriangulation_tolerance = cfg.real("fluid.retriangulation_tolerance");
   p.shear_forces = cfg.boolean("fluid.shear_forces");
+  p.cavitation_pressure = cfg.real("fluid.cavitation_pressure");
+  const std::string& h = cfg.string("fluid.force_height");
+  const bool diameter = h == "diameter" || (h == "auto" && cfg.string("dem.contact_law") == dem::CohesiveContact::name);
+  p.force_height = diameter ? coupling::ForceHeight::Diameter : coupling::ForceHeight::Thickness;
   return p;
 }
 
@@ -214,6 +227,19 @@ class SaturatedUcsRun final : public DemRun {
     j["fluid"]["flow_stable_dt_s"] = fluid_.stats().last_stable_dt;
     j["fluid"]["flow_substeps"] = fluid_.stats().last_substeps;
     j["fluid"]["pores"] = fluid_.network().n_pores();
+    j["fluid"]["cavitations"] = fluid_.stats().cavitations;
+    j["fluid"]["vapour_mass_kg_per_m"] = fluid_.stats().vapour_mass;
+    // With sphere forces (force_height = diameter) the sample is a layer of spheres ~2 r thick,
+    // while the axial stress divides by the discs' 1 m: the same peak per mean diameter.
+    const bool layer = fluid_.params().force_height == coupling::ForceHeight::Diameter;
+    Real rm = 0;
+    for (Real r : sys.particles.radius) rm += r;
+    rm /= static_cast<Real>(sys.particles.size());
+    j["fluid"]["force_height"] = layer ? "diameter" : "thickness";
+    if (layer && out.no_peak.empty()) {
+      j["layer"]["thickness_m"] = 2 * rm;
+      j["layer"]["ucs_Pa"] = st_.peak_stress / (2 * rm);
+    }
     write_pores("pores_final.csv");
   }
   void plots() override { make_plots(opt.out_dir, cfg); }
