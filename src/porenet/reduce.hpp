@@ -16,7 +16,8 @@ inline Index reduce_blocks(Index n) { return (n + kReduceBlock - 1) / kReduceBlo
 template <class F>
 Real fixed_order_sum(Index n, F&& term, std::vector<Real>& scratch) {
   const Index nb = reduce_blocks(n);
-#pragma omp parallel for schedule(static)
+  // One block: no parallel region (an idle, spinning worker slows a busy machine down).
+#pragma omp parallel for schedule(static) if (nb > 1)
   for (Index b = 0; b < nb; ++b) {
     const Index end = std::min(n, (b + 1) * kReduceBlock);
     Real s = 0;
