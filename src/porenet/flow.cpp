@@ -100,7 +100,7 @@ Real SinglePhaseFlow::pressure_from_mass(Index i, Real m, Real p_guess) const {
 }
 
 void SinglePhaseFlow::compute_fluxes(std::span<const Real> p) {
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nc_ > kParallelMin)
   for (Index c = 0; c < nc_; ++c) {
     const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
     flux_[c] = g_[c] * (p[a] - p[b]);
@@ -110,7 +110,7 @@ void SinglePhaseFlow::compute_fluxes(std::span<const Real> p) {
 // Mass update (B8) with the fluxes in flux_, then pressure from the EOS (B20 analogue).
 void SinglePhaseFlow::update_masses(Real dt) {
   Index bad = -1;  // no exception may leave an OpenMP region
-#pragma omp parallel for schedule(static) reduction(max : bad)
+#pragma omp parallel for schedule(static) reduction(max : bad) if (np_ > kParallelMin)
   for (Index i = 0; i < np_; ++i) {
     Real out = 0;
     for (Index e = net_.pc_start[i]; e < net_.pc_start[i + 1]; ++e) {
@@ -147,7 +147,7 @@ void SinglePhaseFlow::update_masses(Real dt) {
 Real SinglePhaseFlow::stable_dt() const {
   Real dt = std::numeric_limits<Real>::infinity();
   const Real inv_mu = 1.0 / prm_.mu;
-#pragma omp parallel for schedule(static) reduction(min : dt)
+#pragma omp parallel for schedule(static) reduction(min : dt) if (np_ > kParallelMin)
   for (Index i = 0; i < np_; ++i) {
     if (bc_[i] == PoreBc::Pressure) continue;
     Real gsum = 0;
@@ -163,7 +163,7 @@ Real SinglePhaseFlow::stable_dt() const {
 
 void SinglePhaseFlow::step_explicit(Real dt) {
   const Real inv_mu = 1.0 / prm_.mu;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nc_ > kParallelMin)
   for (Index c = 0; c < nc_; ++c) {
     const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
     g_[c] = (p_[a] >= p_[b] ? rho_[a] : rho_[b]) * net_.ch_cond[c] * inv_mu;  // upwind density
@@ -174,7 +174,7 @@ void SinglePhaseFlow::step_explicit(Real dt) {
 
 void SinglePhaseFlow::step_implicit(Real dt) {
   const Real inv_mu = 1.0 / prm_.mu;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nc_ > kParallelMin)
   for (Index c = 0; c < nc_; ++c) {
     const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
     g_[c] = (p_[a] >= p_[b] ? rho_[a] : rho_[b]) * net_.ch_cond[c] * inv_mu;
@@ -185,7 +185,7 @@ void SinglePhaseFlow::step_implicit(Real dt) {
   const auto* outer = A.outerIndexPtr();
   const auto* inner = A.innerIndexPtr();
   // Rows (= columns: symmetric). Pressure pores: identity rows, their columns moved to the rhs.
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (np_ > kParallelMin)
   for (Index i = 0; i < np_; ++i) {
     const bool fixed_i = bc_[i] == PoreBc::Pressure;
     Real diag = 0, rhs = 0;
@@ -230,7 +230,7 @@ void SinglePhaseFlow::step_implicit(Real dt) {
     if (!prm_.warm_start) std::fill(x_.begin(), x_.end(), 0.0);
     cg_iters_ = sys_.solve(rhs_, x_, prm_.preconditioner, prm_.cg_tolerance, prm_.cg_max_iterations);
   }
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (np_ > kParallelMin)
   for (Index i = 0; i < np_; ++i) pnew_[i] = p_[i] + x_[i];
   compute_fluxes(pnew_);
   update_masses(dt);

@@ -35,6 +35,18 @@ PressureSystem::PressureSystem(const Network2D& net) : n_(net.n_pores()) {
         if (net.ch_pore[2 * c] == row || net.ch_pore[2 * c + 1] == row) entry_channel_[k] = c;
       }
     }
+  // Per row, the stored entries inside its DIC block: [lo_begin_, diag) and (diag, hi_end_).
+  lo_begin_.assign(n, 0);
+  hi_end_.assign(n, 0);
+  for (Index i = 0; i < n_; ++i) {
+    const Index lo = i / kDicBlock * kDicBlock, hi = std::min(n_, lo + kDicBlock);
+    Index k = A_.outerIndexPtr()[i];
+    while (k < diag_pos_[i] && A_.innerIndexPtr()[k] < lo) ++k;
+    lo_begin_[i] = k;
+    k = A_.outerIndexPtr()[i + 1];
+    while (k > diag_pos_[i] + 1 && A_.innerIndexPtr()[k - 1] >= hi) --k;
+    hi_end_[i] = k;
+  }
   pivot_.assign(n, 1);
   r_ = z_ = d_ = ad_ = pivot_;
   scratch_.assign(static_cast<std::size_t>(std::max<Index>(reduce_blocks(n_), 1)), 0);
@@ -45,7 +57,7 @@ void PressureSystem::setup_preconditioner(Preconditioner pc) {
   const auto* outer = A_.outerIndexPtr();
   const auto* inner = A_.innerIndexPtr();
   if (pc == Preconditioner::Jacobi) {
-    for (Index i = 0; i < n_; ++i) pivot_[i] = val[diag_pos_[i]];
+    for (Index i = 0; i < n_; ++i) pivot_[i] = 1 / val[diag_pos_[i]];
     return;
   }
   const Index nb = (n_ + kDicBlock - 1) / kDicBlock;
@@ -54,9 +66,8 @@ void PressureSystem::setup_preconditioner(Preconditioner pc) {
     const Index lo = b * kDicBlock, hi = std::min(n_, lo + kDicBlock);
     for (Index i = lo; i < hi; ++i) {  // entries of row i left of the diagonal (inner sorted)
       Real d = val[diag_pos_[i]];
-      for (Index k = outer[i]; k < diag_pos_[i]; ++k)
-        if (inner[k] >= lo) d -= val[k] * val[k] / pivot_[inner[k]];
-      pivot_[i] = d;
+      for (Index k = lo_begin_[i]; k < diag_pos_[i]; ++k) d -= val[k] * val[k] * pivot_[inner[k]];
+      pivot_[i] = 1 / d;  // stored inverted
     }
   }
 }
@@ -64,7 +75,7 @@ void PressureSystem::setup_preconditioner(Preconditioner pc) {
 void PressureSystem::apply_preconditioner(Preconditioner pc, const std::vector<Real>& r, std::vector<Real>& z) {
   if (pc == Preconditioner::Jacobi) {
 #pragma omp parallel for schedule(static) if (n_ > kDicBlock)
-    for (Index i = 0; i < n_; ++i) z[i] = r[i] / pivot_[i];
+    for (Index i = 0; i < n_; ++i) z[i] = r[i] * pivot_[i];
     return;
   }
   const Real* val = A_.valuePtr();
@@ -76,15 +87,13 @@ void PressureSystem::apply_preconditioner(Preconditioner pc, const std::vector<R
     const Index lo = b * kDicBlock, hi = std::min(n_, lo + kDicBlock);
     for (Index i = lo; i < hi; ++i) {  // (D + L) y = r
       Real s = r[i];
-      for (Index k = outer[i]; k < diag_pos_[i]; ++k)
-        if (inner[k] >= lo) s -= val[k] * z[inner[k]];
-      z[i] = s / pivot_[i];
+      for (Index k = lo_begin_[i]; k < diag_pos_[i]; ++k) s -= val[k] * z[inner[k]];
+      z[i] = s * pivot_[i];
     }
     for (Index i = hi - 1; i >= lo; --i) {  // (D + L^T) z = D y
       Real s = 0;
-      for (Index k = diag_pos_[i] + 1; k < outer[i + 1]; ++k)
-        if (inner[k] < hi) s += val[k] * z[inner[k]];
-      z[i] -= s / pivot_[i];
+      for (Index k = diag_pos_[i] + 1; k < hi_end_[i]; ++k) s += val[k] * z[inner[k]];
+      z[i] -= s * pivot_[i];
     }
   }
 }

@@ -41,8 +41,9 @@ class PressureSystem {
 
   Index n_;
   Eigen::SparseMatrix<Real> A_;
-  std::vector<Index> entry_channel_, diag_pos_;
-  std::vector<Real> pivot_, r_, z_, d_, ad_, scratch_;
+  std::vector<Index> entry_channel_, diag_pos_, lo_begin_, hi_end_;
+  std::vector<Real> pivot_;  // inverse pivots (DIC) or inverse diagonal (Jacobi)
+  std::vector<Real> r_, z_, d_, ad_, scratch_;
 };
 
 }  // namespace ff::porenet

@@ -9,6 +9,9 @@
 namespace ff::porenet {
 
 inline constexpr Index kReduceBlock = 2048;
+// Loops over fewer items run on one thread: on a busy machine an OpenMP fork/join (and its spinning
+// workers) costs more than a few thousand pores' work.
+inline constexpr Index kParallelMin = 4096;
 
 inline Index reduce_blocks(Index n) { return (n + kReduceBlock - 1) / kReduceBlock; }
 

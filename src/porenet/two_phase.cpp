@@ -148,7 +148,7 @@ void TwoPhaseFlow::channel_mobilities(Index c, Index u, Real& lq, Real& lp) cons
 void TwoPhaseFlow::compute_rates() {
   const Real t = net_.params.thickness;
   if (net_.dim != 2) {
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nc_ > kParallelMin)
     for (Index c = 0; c < nc_; ++c) {
       const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
       const Index u = p_[a] >= p_[b] ? a : b;
@@ -159,7 +159,7 @@ void TwoPhaseFlow::compute_rates() {
     }
     return;
   }
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nc_ > kParallelMin)
   for (Index c = 0; c < nc_; ++c) {
     const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
     const Index u = p_[a] >= p_[b] ? a : b;  // upstream pore: face values (B8)
@@ -176,7 +176,7 @@ Real TwoPhaseFlow::stable_dt() {
   compute_rates();
   const Real t = net_.params.thickness;
   Real dt = std::numeric_limits<Real>::infinity();
-#pragma omp parallel for schedule(static) reduction(min : dt)
+#pragma omp parallel for schedule(static) reduction(min : dt) if (np_ > kParallelMin)
   for (Index i = 0; i < np_; ++i) {
     if (bc_[i] == PoreBc::Pressure) continue;
     Real mob = 0, outq = 0, outp = 0;
@@ -217,7 +217,7 @@ void TwoPhaseFlow::step_explicit(Real dt) {
 // volume (B19) and the phase densities (B20).
 void TwoPhaseFlow::update_pore_states(Real dt, const char* scheme) {
   Index bad = -1;
-#pragma omp parallel for schedule(static) reduction(max : bad)
+#pragma omp parallel for schedule(static) reduction(max : bad) if (np_ > kParallelMin)
   for (Index i = 0; i < np_; ++i) {
     if (bc_[i] == PoreBc::Pressure) {
       // Fixed state at the new void volume.
@@ -284,7 +284,7 @@ void TwoPhaseFlow::implicit_substep(Real dt, int depth) {
   const auto* outer = A.outerIndexPtr();
   const auto* inner = A.innerIndexPtr();
   // Mass mobilities at t^n (upstream pore of p^n): tq_, tp_ [kg/(Pa s)]; volumetric ones in the matrix.
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nc_ > kParallelMin)
   for (Index c = 0; c < nc_; ++c) {
     const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
     const Index u = p_[a] >= p_[b] ? a : b;
@@ -293,7 +293,7 @@ void TwoPhaseFlow::implicit_substep(Real dt, int depth) {
     tq_[c] = lq;  // volumetric for now; densities applied below
     tp_[c] = lp;
   }
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (np_ > kParallelMin)
   for (Index i = 0; i < np_; ++i) {
     const bool fixed_i = bc_[i] == PoreBc::Pressure;
     Real diag = 0, rhs = 0;
@@ -325,10 +325,10 @@ void TwoPhaseFlow::implicit_substep(Real dt, int depth) {
     rhs_[i] = fixed_i ? bc_value_[i] - p_[i] : rhs;
   }
   cg_iters_ = sys_->solve(rhs_, dp_, prm_.preconditioner, prm_.cg_tolerance, prm_.cg_max_iterations);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (np_ > kParallelMin)
   for (Index i = 0; i < np_; ++i) pnew_[i] = p_[i] + dp_[i];
   // Mass rates with p^{n+1} and the t^n upstream densities.
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nc_ > kParallelMin)
   for (Index c = 0; c < nc_; ++c) {
     const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
     const Index u = p_[a] >= p_[b] ? a : b;
@@ -337,7 +337,7 @@ void TwoPhaseFlow::implicit_substep(Real dt, int depth) {
   }
   // Outflow limiter: a pore gives away at most the mass of each phase it holds.
   Index limited = 0;
-#pragma omp parallel for schedule(static) reduction(+ : limited)
+#pragma omp parallel for schedule(static) reduction(+ : limited) if (np_ > kParallelMin)
   for (Index i = 0; i < np_; ++i) {
     lim_q_[i] = lim_p_[i] = 1;
     if (bc_[i] == PoreBc::Pressure) continue;
@@ -362,7 +362,7 @@ void TwoPhaseFlow::implicit_substep(Real dt, int depth) {
   limited_ = limited;
   ++substeps_;
   if (limited > 0) {
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nc_ > kParallelMin)
     for (Index c = 0; c < nc_; ++c) {
       const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
       fq_[c] *= fq_[c] > 0 ? lim_q_[a] : lim_q_[b];

@@ -88,6 +88,13 @@ class TwoPhaseFlow {
   int last_cg_iterations() const { return cg_iters_; }
   Index last_limited_pores() const { return limited_; }
   int last_substeps() const { return substeps_; }
+  // The CG start of the next implicit step (the last pressure change): part of a checkpoint.
+  std::span<const Real> implicit_guess() const { return dp_; }
+  void restore_implicit_guess(std::span<const Real> g) {
+    prepare_implicit();
+    if (g.size() != dp_.size()) throw InputError("porenet: restore_implicit_guess needs one value per pore");
+    dp_.assign(g.begin(), g.end());
+  }
   // Checkpoint resume (src/coupling/porenet): the full per-pore state as it was, so a resumed run
   // continues bit-for-bit (load_masses would re-solve B23 from another guess: last-bit differences).
   void restore_state(std::span<const Real> p, std::span<const Real> alpha, std::span<const Real> mq,
