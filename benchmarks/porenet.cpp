@@ -210,14 +210,15 @@ int main(int argc, char** argv) {
   const double t_dem3 = median_ms(11, [&] { d3->sys.step(); });
   std::printf("DEM 3D: %zu spheres, %zu bonds, dt %.3e s: DEM step %9.3f ms\n", d3->sys.particles.size(),
               d3->sys.bonds.size(), d3->sys.settings.dt, t_dem3);
+  for (const Real S : {1.0, 0.5}) {
   coupling::Porenet3DParams cp;
-  cp.saturation = 0.5;
+  cp.saturation = S;
   // Masses are conserved whatever the CG residual, and the volume residual enters the next step's
   // right-hand side: a looser tolerance costs pressure accuracy only (1e-8 of the source term).
   cp.fluid.cg_tolerance = 1e-8;
   coupling::DemPorenet3D cpl;
   cpl.init(d3->sys, cp);
-  const int nc = 10;
+  const int nc = S == 1.0 ? 10 : 3;
   const auto tc = std::chrono::steady_clock::now();
   cpl.run(d3->sys, nc);
   const double t_run = std::chrono::duration<double>(std::chrono::steady_clock::now() - tc).count();
@@ -227,14 +228,15 @@ int main(int argc, char** argv) {
   // 0.25 x 0.5 mm / (v dt) steps (the platen moves fastest of all particles).
   const double steps_between = cp.retriangulation_tolerance * 0.5e-3 / (v * d3->sys.settings.dt);
   const double t_tri = st.t_triangulation;  // the initial build (+ any retriangulation)
-  std::printf("coupled 3D (%d pores, implicit two-phase, S 0.5): %d steps in %.2f s: %.1f ms per step = DEM + "
+  std::printf("coupled 3D (%d pores, implicit, S %.1f): %d steps in %.2f s: %.1f ms per step = DEM + "
               "update %.1f ms + flow %.1f ms + forces %.1f ms; triangulation + remap %.0f ms (%ld retriangulations)\n",
-              cpl.network().n_pores(), nc, t_run, 1e3 * per_step, 1e3 * st.t_update / nc, 1e3 * st.t_flow / nc,
+              cpl.network().n_pores(), S, nc, t_run, 1e3 * per_step, 1e3 * st.t_update / nc, 1e3 * st.t_flow / nc,
               1e3 * st.t_forces / nc, 1e3 * t_tri, st.retriangulations);
   std::printf("  last step: %d CG iterations, %ld flow sub-steps; max pore pressure %.4e Pa\n",
               cpl.flow().last_cg_iterations(), st.last_substeps, cpl.max_pressure());
   std::printf("  flow step / DEM step = %.2f; retriangulation every %.0f steps at %.2f m/s: share of the run %.3f%%\n",
               st.t_flow / nc / (t_dem3 * 1e-3), steps_between, v,
               100 * t_tri / (t_tri + steps_between * per_step));
+  }
   return 0;
 }

@@ -13,14 +13,15 @@ inline constexpr Index kReduceBlock = 2048;
 // workers) costs more than a few thousand pores' work.
 inline constexpr Index kParallelMin = 4096;
 
+
 inline Index reduce_blocks(Index n) { return (n + kReduceBlock - 1) / kReduceBlock; }
 
 // scratch must hold reduce_blocks(n) values (sized once, outside the time loop).
 template <class F>
 Real fixed_order_sum(Index n, F&& term, std::vector<Real>& scratch) {
   const Index nb = reduce_blocks(n);
-  // One block: no parallel region (an idle, spinning worker slows a busy machine down).
-#pragma omp parallel for schedule(static) if (nb > 1)
+  // Few blocks: no parallel region (idle, spinning workers slow a busy machine down).
+#pragma omp parallel for schedule(static) if (n > kParallelMin)
   for (Index b = 0; b < nb; ++b) {
     const Index end = std::min(n, (b + 1) * kReduceBlock);
     Real s = 0;
