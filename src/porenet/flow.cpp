@@ -11,7 +11,7 @@
 namespace ff::porenet {
 
 SinglePhaseFlow::SinglePhaseFlow(const Network2D& net, const SinglePhaseParams& params)
-    : net_(net), prm_(params), np_(net.n_pores()), nc_(net.n_channels()) {
+    : net_(net), prm_(params), np_(net.n_pores()), nc_(net.n_channels()), sys_(net) {
   if (!(params.mu > 0)) throw InputError(fmt::format("porenet: viscosity mu = {} Pa s; must be > 0", params.mu));
   if (params.matrix_modulus < 0)
     throw InputError(fmt::format("porenet: matrix_modulus = {} Pa; must be >= 0 (0: rigid/DEM-driven)",
@@ -28,29 +28,8 @@ SinglePhaseFlow::SinglePhaseFlow(const Network2D& net, const SinglePhaseParams& 
   flux_.assign(static_cast<std::size_t>(nc_), 0);
   g_.assign(static_cast<std::size_t>(nc_), 0);
   rhs_.assign(n, 0);
-  x_ = r_ = z_ = d_ = q_ = pnew_ = rhs_;
+  x_ = pnew_ = rhs_;
   scratch_.assign(static_cast<std::size_t>(std::max<Index>(reduce_blocks(np_), 1)), 0);
-  // Pattern of the implicit system: one row per pore, diagonal + one entry per channel.
-  std::vector<Eigen::Triplet<Real>> trip;
-  trip.reserve(n + 2 * static_cast<std::size_t>(nc_));
-  for (Index i = 0; i < np_; ++i) trip.emplace_back(i, i, 1.0);
-  for (Index c = 0; c < nc_; ++c) {
-    trip.emplace_back(net.ch_pore[2 * c], net.ch_pore[2 * c + 1], 0.0);
-    trip.emplace_back(net.ch_pore[2 * c + 1], net.ch_pore[2 * c], 0.0);
-  }
-  A_.resize(np_, np_);
-  A_.setFromTriplets(trip.begin(), trip.end());
-  A_.makeCompressed();
-  entry_channel_.assign(static_cast<std::size_t>(A_.nonZeros()), -1);
-  for (Index col = 0; col < np_; ++col)
-    for (Index k = A_.outerIndexPtr()[col]; k < A_.outerIndexPtr()[col + 1]; ++k) {
-      const Index row = A_.innerIndexPtr()[k];
-      if (row == col) continue;
-      for (Index e = net.pc_start[col]; e < net.pc_start[col + 1]; ++e) {
-        const Index c = net.pc_ch[e];
-        if (net.ch_pore[2 * c] == row || net.ch_pore[2 * c + 1] == row) entry_channel_[k] = c;
-      }
-    }
 }
 
 void SinglePhaseFlow::init(Real p) {
@@ -121,7 +100,7 @@ Real SinglePhaseFlow::pressure_from_mass(Index i, Real m, Real p_guess) const {
 }
 
 void SinglePhaseFlow::compute_fluxes(std::span<const Real> p) {
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nc_ > kParallelMin)
   for (Index c = 0; c < nc_; ++c) {
     const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
     flux_[c] = g_[c] * (p[a] - p[b]);
@@ -131,7 +110,7 @@ void SinglePhaseFlow::compute_fluxes(std::span<const Real> p) {
 // Mass update (B8) with the fluxes in flux_, then pressure from the EOS (B20 analogue).
 void SinglePhaseFlow::update_masses(Real dt) {
   Index bad = -1;  // no exception may leave an OpenMP region
-#pragma omp parallel for schedule(static) reduction(max : bad)
+#pragma omp parallel for schedule(static) reduction(max : bad) if (np_ > kParallelMin)
   for (Index i = 0; i < np_; ++i) {
     Real out = 0;
     for (Index e = net_.pc_start[i]; e < net_.pc_start[i + 1]; ++e) {
@@ -168,7 +147,7 @@ void SinglePhaseFlow::update_masses(Real dt) {
 Real SinglePhaseFlow::stable_dt() const {
   Real dt = std::numeric_limits<Real>::infinity();
   const Real inv_mu = 1.0 / prm_.mu;
-#pragma omp parallel for schedule(static) reduction(min : dt)
+#pragma omp parallel for schedule(static) reduction(min : dt) if (np_ > kParallelMin)
   for (Index i = 0; i < np_; ++i) {
     if (bc_[i] == PoreBc::Pressure) continue;
     Real gsum = 0;
@@ -184,7 +163,7 @@ Real SinglePhaseFlow::stable_dt() const {
 
 void SinglePhaseFlow::step_explicit(Real dt) {
   const Real inv_mu = 1.0 / prm_.mu;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nc_ > kParallelMin)
   for (Index c = 0; c < nc_; ++c) {
     const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
     g_[c] = (p_[a] >= p_[b] ? rho_[a] : rho_[b]) * net_.ch_cond[c] * inv_mu;  // upwind density
@@ -195,16 +174,18 @@ void SinglePhaseFlow::step_explicit(Real dt) {
 
 void SinglePhaseFlow::step_implicit(Real dt) {
   const Real inv_mu = 1.0 / prm_.mu;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nc_ > kParallelMin)
   for (Index c = 0; c < nc_; ++c) {
     const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
     g_[c] = (p_[a] >= p_[b] ? rho_[a] : rho_[b]) * net_.ch_cond[c] * inv_mu;
   }
-  Real* val = A_.valuePtr();
-  const auto* outer = A_.outerIndexPtr();
-  const auto* inner = A_.innerIndexPtr();
+  auto& A = sys_.matrix();
+  const auto& entry_channel = sys_.entry_channel();
+  Real* val = A.valuePtr();
+  const auto* outer = A.outerIndexPtr();
+  const auto* inner = A.innerIndexPtr();
   // Rows (= columns: symmetric). Pressure pores: identity rows, their columns moved to the rhs.
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (np_ > kParallelMin)
   for (Index i = 0; i < np_; ++i) {
     const bool fixed_i = bc_[i] == PoreBc::Pressure;
     Real diag = 0, rhs = 0;
@@ -215,7 +196,7 @@ void SinglePhaseFlow::step_implicit(Real dt) {
     }
     for (Index k = outer[i]; k < outer[i + 1]; ++k) {
       const Index j = inner[k];
-      const Index c = entry_channel_[k];
+      const Index c = entry_channel[k];
       if (c < 0) continue;
       const Real G = dt * g_[c];
       const bool fixed_j = bc_[j] == PoreBc::Pressure;
@@ -238,74 +219,21 @@ void SinglePhaseFlow::step_implicit(Real dt) {
   }
   if (prm_.solver == LinearSolver::LDLT) {
     if (!ldlt_analysed_) {
-      ldlt_.analyzePattern(A_);
+      ldlt_.analyzePattern(A);
       ldlt_analysed_ = true;
     }
-    ldlt_.factorize(A_);
+    ldlt_.factorize(A);
     if (ldlt_.info() != Eigen::Success) throw NumericalError("porenet: LDLT factorisation of the pressure system failed");
     Eigen::Map<Eigen::VectorXd> b(rhs_.data(), np_), x(x_.data(), np_);
     x = ldlt_.solve(b);
   } else {
-    solve_cg();
+    if (!prm_.warm_start) std::fill(x_.begin(), x_.end(), 0.0);
+    cg_iters_ = sys_.solve(rhs_, x_, prm_.preconditioner, prm_.cg_tolerance, prm_.cg_max_iterations);
   }
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (np_ > kParallelMin)
   for (Index i = 0; i < np_; ++i) pnew_[i] = p_[i] + x_[i];
   compute_fluxes(pnew_);
   update_masses(dt);
-}
-
-// Jacobi-preconditioned conjugate gradients on A x = rhs, x0 = 0; fixed-order dot products.
-void SinglePhaseFlow::solve_cg() {
-  const Real* val = A_.valuePtr();
-  const auto* outer = A_.outerIndexPtr();
-  const auto* inner = A_.innerIndexPtr();
-  auto matvec = [&](const std::vector<Real>& in, std::vector<Real>& out) {
-#pragma omp parallel for schedule(static)
-    for (Index i = 0; i < np_; ++i) {
-      Real s = 0;
-      for (Index k = outer[i]; k < outer[i + 1]; ++k) s += val[k] * in[inner[k]];
-      out[i] = s;
-    }
-  };
-  // Diagonal (stored in d_ temporarily as its inverse, then reused as the search direction).
-  std::vector<Real>& inv_diag = q_;
-  for (Index i = 0; i < np_; ++i)
-    for (Index k = outer[i]; k < outer[i + 1]; ++k)
-      if (inner[k] == i) inv_diag[i] = 1.0 / val[k];
-  const Real bnorm2 = fixed_order_sum(np_, [&](Index i) { return rhs_[i] * rhs_[i]; }, scratch_);
-  std::fill(x_.begin(), x_.end(), 0.0);
-  cg_iters_ = 0;
-  if (bnorm2 == 0) return;
-  for (Index i = 0; i < np_; ++i) {
-    r_[i] = rhs_[i];
-    z_[i] = inv_diag[i] * r_[i];
-  }
-  // q_ holds the inverse diagonal; keep it and use pnew_ as A d.
-  std::vector<Real>& Ad = pnew_;
-  d_ = z_;
-  Real rz = fixed_order_sum(np_, [&](Index i) { return r_[i] * z_[i]; }, scratch_);
-  const Real tol2 = prm_.cg_tolerance * prm_.cg_tolerance * bnorm2;
-  for (int it = 0; it < prm_.cg_max_iterations; ++it) {
-    matvec(d_, Ad);
-    const Real dAd = fixed_order_sum(np_, [&](Index i) { return d_[i] * Ad[i]; }, scratch_);
-    const Real alpha = rz / dAd;
-#pragma omp parallel for schedule(static)
-    for (Index i = 0; i < np_; ++i) {
-      x_[i] += alpha * d_[i];
-      r_[i] -= alpha * Ad[i];
-      z_[i] = inv_diag[i] * r_[i];
-    }
-    cg_iters_ = it + 1;
-    const Real rr = fixed_order_sum(np_, [&](Index i) { return r_[i] * r_[i]; }, scratch_);
-    if (rr <= tol2) return;
-    const Real rz_new = fixed_order_sum(np_, [&](Index i) { return r_[i] * z_[i]; }, scratch_);
-    const Real beta = rz_new / rz;
-    rz = rz_new;
-#pragma omp parallel for schedule(static)
-    for (Index i = 0; i < np_; ++i) d_[i] = z_[i] + beta * d_[i];
-  }
-  throw NumericalError(fmt::format("porenet: conjugate gradients did not converge in {} iterations; raise "
-                                   "cg_max_iterations or use the LDLT solver", prm_.cg_max_iterations));
 }
 
 Real SinglePhaseFlow::pressure_pores_inflow_rate(bool positive_part) const {

@@ -12,9 +12,10 @@
 //    of the neighbours' pressures; above 2 dt_s it diverges.
 //  - implicit (backward Euler, for stiff liquids): F from p^{n+1}, linearised about p^n:
 //      S_i dp_i + dt sum_j G_ij (dp_i - dp_j) = m_i^n - rho_i^n V_i^{n+1} - dt sum_j G_ij (p_i^n - p_j^n) + dt Q_i
-//    with G_ij = rho_up^n g_ij (a symmetric positive definite system), solved by Jacobi-
-//    preconditioned conjugate gradients (no allocation, fixed-order sums) or Eigen's
-//    SimplicialLDLT (allocates per factorisation). Masses are then updated with the same
+//    with G_ij = rho_up^n g_ij (a symmetric positive definite system), solved by conjugate
+//    gradients (porenet/pcg.hpp: DIC or Jacobi preconditioner, warm start from the last step's
+//    pressure change; no allocation, fixed-order sums) or Eigen's SimplicialLDLT (allocates per
+//    factorisation). Masses are then updated with the same
 //    fluxes, so mass stays conserved to round-off and p follows from the EOS.
 // Boundary pores: Pressure (Dirichlet p, the fluid crossing it is counted in boundary_mass_in),
 // Flux (prescribed mass inflow Q [kg/s]: injection; Q < 0 withdraws), None (no flow: default,
@@ -31,6 +32,7 @@
 
 #include "porenet/eos.hpp"
 #include "porenet/network.hpp"
+#include "porenet/pcg.hpp"
 
 namespace ff::porenet {
 
@@ -44,6 +46,8 @@ struct SinglePhaseParams {
   LinearSolver solver = LinearSolver::ConjugateGradient;
   Real cg_tolerance = 1e-13;  // relative residual
   int cg_max_iterations = 20000;
+  Preconditioner preconditioner = Preconditioner::DIC;
+  bool warm_start = true;  // CG starts from the last step's pressure change
 };
 
 class SinglePhaseFlow {
@@ -83,7 +87,6 @@ class SinglePhaseFlow {
   Real pressure_from_mass(Index i, Real m, Real p_guess) const;
   void compute_fluxes(std::span<const Real> p);
   void update_masses(Real dt);
-  void solve_cg();
 
   const Network2D& net_;
   SinglePhaseParams prm_;
@@ -93,11 +96,10 @@ class SinglePhaseFlow {
   std::vector<Index> bc_pressure_pores_;
   Real sigma_ = 0, sigma_eff0_ = 0, bc_mass_in_ = 0, injected_ = 0;
   // implicit system (symmetric; ColMajor storage read as rows)
-  Eigen::SparseMatrix<Real> A_;
-  std::vector<Index> entry_channel_;  // per stored entry: channel id, -1 on the diagonal
+  PressureSystem sys_;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<Real>> ldlt_;
   bool ldlt_analysed_ = false;
-  std::vector<Real> rhs_, x_, r_, z_, d_, q_, pnew_, scratch_;
+  std::vector<Real> rhs_, x_, pnew_, scratch_;
   int cg_iters_ = 0;
 };
 

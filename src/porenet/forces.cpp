@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include "core/error.hpp"
+#include "porenet/reduce.hpp"
 
 namespace ff::porenet {
 namespace {
@@ -21,7 +22,7 @@ void check(const Network2D& net, const Particles2D& p, std::span<const Real> pp,
 void add_pressure_forces(const Network2D& net, const Particles2D& p, std::span<const Real> P, std::span<Real> fx,
                          std::span<Real> fy) {
   check(net, p, P, fx, fy);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (net.n_particles > kParallelMin)
   for (Index j = 0; j < net.n_particles; ++j) {
     Real sx = 0, sy = 0;
     for (Index e = net.pp_start[j]; e < net.pp_start[j + 1]; ++e) {
@@ -45,7 +46,7 @@ void add_pressure_forces(const Network2D& net, const Particles2D& p, std::span<c
 void add_shear_forces(const Network2D& net, const Particles2D& p, std::span<const Real> P, std::span<Real> fx,
                       std::span<Real> fy) {
   check(net, p, P, fx, fy);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (net.n_particles > kParallelMin)
   for (Index j = 0; j < net.n_particles; ++j) {
     Real sx = 0, sy = 0;
     for (Index e = net.pw_start[j]; e < net.pw_start[j + 1]; ++e) {
@@ -62,6 +63,59 @@ void add_shear_forces(const Network2D& net, const Particles2D& p, std::span<cons
     }
     fx[j] += sx;
     fy[j] += sy;
+  }
+}
+
+}  // namespace ff::porenet
+
+namespace ff::porenet {
+
+// Sphere j at a corner of tetrahedron k: the pressure on the spherical patch inside the tetrahedron.
+// The patch and the three plane sectors of the tetrahedron's faces through j (angle theta at j,
+// area theta R^2 / 2) close a cone, so int_patch n dA = -sum_f n_f theta_f R^2 / 2 (n_f the face's
+// outward normal) and the force -p int_patch n dA = p sum_f n_f theta_f R^2 / 2. A face between two
+// pores gets opposite normals from them: an interior sphere at uniform pressure feels no net force.
+void add_pressure_forces_3d(const Network2D& net, const Particles3D& p, std::span<const Real> P, std::span<Real> fx,
+                            std::span<Real> fy, std::span<Real> fz) {
+  const auto n = static_cast<std::size_t>(net.n_particles);
+  if (net.dim != 3) throw InputError("porenet: add_pressure_forces_3d needs a 3D network");
+  if (p.x.size() != n || fx.size() != n || fy.size() != n || fz.size() != n ||
+      P.size() != static_cast<std::size_t>(net.n_pores()))
+    throw InputError(fmt::format("porenet: 3D force arrays sized {} / {} particles and {} pressures; the network has "
+                                 "{} particles and {} pores", p.x.size(), fx.size(), P.size(), n, net.n_pores()));
+#pragma omp parallel for schedule(static) if (net.n_particles > kParallelMin)
+  for (Index j = 0; j < net.n_particles; ++j) {
+    Real s[3] = {0, 0, 0};
+    const Real R = p.radius[j];
+    for (Index e = net.pp_start[j]; e < net.pp_start[j + 1]; ++e) {
+      const Index k = net.pp_pore[e];
+      const int c = net.pp_corner[e];
+      const Index* v = &net.pore_v[4 * static_cast<std::size_t>(k)];
+      const Real o[3] = {p.x[j], p.y[j], p.z[j]};
+      Real u[3][3];  // edges from j to the other three corners
+      for (int q = 0; q < 3; ++q) {
+        const Index w = v[(c + 1 + q) % 4];
+        u[q][0] = p.x[w] - o[0];
+        u[q][1] = p.y[w] - o[1];
+        u[q][2] = p.z[w] - o[2];
+      }
+      for (int f = 0; f < 3; ++f) {  // face (j, a, b); the third edge d points to the opposite corner
+        const Real* a = u[f];
+        const Real* b = u[(f + 1) % 3];
+        const Real* d = u[(f + 2) % 3];
+        Real nn[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+        const Real len = std::sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
+        if (!(len > 0)) continue;
+        const Real sgn = (nn[0] * d[0] + nn[1] * d[1] + nn[2] * d[2]) > 0 ? -1.0 : 1.0;  // away from d
+        const Real ab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        const Real th = std::atan2(len, ab);
+        const Real w = sgn * P[k] * 0.5 * th * R * R / len;
+        for (int q = 0; q < 3; ++q) s[q] += w * nn[q];
+      }
+    }
+    fx[j] += s[0];
+    fy[j] += s[1];
+    fz[j] += s[2];
   }
 }
 

@@ -20,4 +20,9 @@ void add_pressure_forces(const Network2D& net, const Particles2D& particles, std
 void add_shear_forces(const Network2D& net, const Particles2D& particles, std::span<const Real> pore_pressure,
                       std::span<Real> fx, std::span<Real> fy);
 
+// 3D (PFV-style integration over the sphere surface; forces.cpp): pressure on the spherical patches of
+// each sphere inside its tetrahedra, added to fx, fy, fz [N].
+void add_pressure_forces_3d(const Network2D& net, const Particles3D& particles, std::span<const Real> pore_pressure,
+                            std::span<Real> fx, std::span<Real> fy, std::span<Real> fz);
+
 }  // namespace ff::porenet

@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "core/error.hpp"
+#include "porenet/reduce.hpp"
 
 namespace ff::porenet {
 namespace {
@@ -278,14 +279,14 @@ void update_network_2d(Network2D& net, const Particles2D& p, const PairList& pai
     throw InputError(fmt::format("porenet: update with {} pairs, network built with {}; pass the same pair list "
                                  "(same order) with updated states", pairs.size(), net.n_pairs));
   const Index np = net.n_pores(), nc = net.n_channels();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (np > kParallelMin)
   for (Index k = 0; k < np; ++k) pore_geometry(net, p, k);
   Real mean_cell = 0;  // serial: a fixed-order sum
   for (Index k = 0; k < np; ++k) mean_cell += net.pore_cell[k];
   mean_cell /= static_cast<Real>(np);
   const Real floor_v = net.params.min_void_relative * mean_cell;
   for (Index k = 0; k < np; ++k) net.pore_void[k] = std::max(net.pore_void[k], floor_v);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nc > kParallelMin)
   for (Index c = 0; c < nc; ++c) channel_geometry(net, p, pairs, c);
 }
 

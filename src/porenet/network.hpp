@@ -79,7 +79,8 @@ struct NetworkParams {
 // The network. In 2D pore k has corners pore_v[3k..3k+2] (particle indices, counter-clockwise) and
 // channel c joins pores ch_pore[2c] < ch_pore[2c+1] across the edge of particles ch_part[2c],
 // ch_part[2c+1]. In 3D (build_network_3d) pores are tetrahedra with corners pore_v[4k..4k+3], channels
-// are the throats through shared facets and ch_part, ch_edge, ch_sin_omega, pw_* and pp_* are empty.
+// are the throats through shared facets (corners ch_part[3c..3c+2]); ch_edge, ch_sin_omega and pw_*
+// are empty.
 struct Network2D {
   int dim = 2;
   NetworkParams params;
@@ -111,6 +112,8 @@ struct Network2D {
   Index unmatched_pairs = 0;  // pairs of the list that are not Delaunay edges (no channel)
 
   Index hidden_particles = 0;  // 3D regular triangulation: spheres with an empty power cell (no pore)
+  // 3D: kept from the build for update_network_3d
+  Real void_floor = 0, ch_cond_cap = 0, pfv_factor = 1;
 
   Index n_pores() const { return static_cast<Index>(pore_area.size()); }
   Index n_channels() const { return static_cast<Index>(ch_length.size()); }
@@ -140,6 +143,9 @@ struct Particles3D {
 // volume/surface ratio) and conductance g = pfv_factor A_f R_h^2 / (2 mu L) (ch_cond = g mu),
 // L the centroid distance. Contacts/bonds do not form extra channels in 3D (not yet).
 Network2D build_network_3d(const Particles3D& particles, const NetworkParams& params = {}, Real pfv_factor = 1.0);
+
+// Pore volumes, centroids and throat conductances for moved spheres, keeping the topology (3D).
+void update_network_3d(Network2D& net, const Particles3D& particles);
 
 // Eq. B1 aperture for a contact/bond channel (+ opening for a broken bond).
 Real aperture_b1(const NetworkParams& p, PairState state, Real sigma_n, Real opening);

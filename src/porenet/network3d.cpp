@@ -9,8 +9,10 @@
 #include <array>
 #include <cmath>
 #include <fmt/format.h>
+#include <limits>
 
 #include "core/error.hpp"
+#include "porenet/reduce.hpp"
 #include "porenet/network.hpp"
 
 namespace ff::porenet {
@@ -41,6 +43,63 @@ Real solid_angle(V3 u, V3 v, V3 w) {
 }
 
 Real angle(V3 u, V3 v) { return std::atan2(norm(cross(u, v)), dot(u, v)); }
+
+// Volume, void (METHODS §5.2) and centroid of pore k from its corners.
+void pore_geometry_3d(Network2D& net, const Particles3D& p, Index k) {
+  auto pos = [&](Index i) { return V3{p.x[i], p.y[i], p.z[i]}; };
+  const Index* v = &net.pore_v[4 * static_cast<std::size_t>(k)];
+  const V3 a = pos(v[0]);
+  const V3 u = sub(pos(v[1]), a), w = sub(pos(v[2]), a), s = sub(pos(v[3]), a);
+  const Real vol = std::abs(dot(u, cross(w, s))) / 6;
+  Real solid = 0;
+  for (int i = 0; i < 4; ++i) {
+    const V3 o = pos(v[i]);
+    const Real om = solid_angle(sub(pos(v[(i + 1) % 4]), o), sub(pos(v[(i + 2) % 4]), o), sub(pos(v[(i + 3) % 4]), o));
+    const Real R = p.radius[v[i]];
+    solid += om * R * R * R / 3;  // sphere sector inside the tetrahedron (METHODS §5.2)
+  }
+  net.pore_cell[k] = vol;
+  net.pore_void[k] = std::max(vol - solid, net.params.min_void_fraction * vol);
+  net.pore_cx[k] = 0.25 * (p.x[v[0]] + p.x[v[1]] + p.x[v[2]] + p.x[v[3]]);
+  net.pore_cy[k] = 0.25 * (p.y[v[0]] + p.y[v[1]] + p.y[v[2]] + p.y[v[3]]);
+  net.pore_cz[k] = 0.25 * (p.z[v[0]] + p.z[v[1]] + p.z[v[2]] + p.z[v[3]]);
+}
+
+// Throat c (facet corners ch_part[3c..3c+2]): length, hydraulic aperture and unclamped conductance.
+void throat_geometry_3d(Network2D& net, const Particles3D& p, Index c, Real pfv_factor) {
+  auto pos = [&](Index i) { return V3{p.x[i], p.y[i], p.z[i]}; };
+  const Index* v = &net.ch_part[3 * static_cast<std::size_t>(c)];
+  const Index pa = net.ch_pore[2 * c], pb = net.ch_pore[2 * c + 1];
+  const V3 A = pos(v[0]), B = pos(v[1]), C = pos(v[2]);
+  const Real area = 0.5 * norm(cross(sub(B, A), sub(C, A)));
+  Real solid = 0, perim = 0;
+  for (int j = 0; j < 3; ++j) {
+    const V3 o = pos(v[j]);
+    const Real th = angle(sub(pos(v[(j + 1) % 3]), o), sub(pos(v[(j + 2) % 3]), o));
+    const Real R = p.radius[v[j]];
+    solid += 0.5 * th * R * R;
+    perim += th * R;
+  }
+  const Real af = std::max(area - solid, net.params.min_void_fraction * area);
+  const Real rh = af / perim;
+  const V3 d{net.pore_cx[pb] - net.pore_cx[pa], net.pore_cy[pb] - net.pore_cy[pa], net.pore_cz[pb] - net.pore_cz[pa]};
+  // Adjacent slivers have almost coincident centroids: L at least a tenth of the mean radius.
+  const Real L = std::max(norm(d), 0.1 * (p.radius[v[0]] + p.radius[v[1]] + p.radius[v[2]]) / 3);
+  net.ch_length[c] = L;
+  net.ch_aperture[c] = 2 * rh;
+  net.ch_cond[c] = pfv_factor * af * rh * rh / (2 * L);  // Chareyre et al. 2012
+}
+
+// Clamp local conductances relative to the median (YADE clamps to maxKdivKmean x the mean,
+// METHODS §5.3a; here the median: the wide flat facets near the hull reach 1e5 x the typical
+// conductance and would dominate a mean). The median is the one of the build (kept in ch_cond_cap).
+void clamp_conductances(Network2D& net) {
+  for (Index c = 0; c < net.n_channels(); ++c) net.ch_cond[c] = std::min(net.ch_cond[c], net.ch_cond_cap);
+}
+
+void min_void_floor(Network2D& net) {
+  for (Index k = 0; k < net.n_pores(); ++k) net.pore_void[k] = std::max(net.pore_void[k], net.void_floor);
+}
 
 }  // namespace
 
@@ -92,28 +151,14 @@ Network2D build_network_3d(const Particles3D& p, const NetworkParams& params, Re
   net.pore_cz.resize(np);
   net.pore_hull.assign(np, 0);
   for (Index k = 0; k < np; ++k) {
-    const auto& v = cells[k].v;
-    for (int i = 0; i < 4; ++i) net.pore_v[4 * k + i] = v[i];
-    const V3 a = pos(v[0]);
-    const V3 u = sub(pos(v[1]), a), w = sub(pos(v[2]), a), s = sub(pos(v[3]), a);
-    const Real vol = std::abs(dot(u, cross(w, s))) / 6;
-    Real solid = 0;
-    for (int i = 0; i < 4; ++i) {
-      const V3 o = pos(v[i]);
-      const Real om = solid_angle(sub(pos(v[(i + 1) % 4]), o), sub(pos(v[(i + 2) % 4]), o), sub(pos(v[(i + 3) % 4]), o));
-      const Real R = p.radius[v[i]];
-      solid += om * R * R * R / 3;  // sphere sector inside the tetrahedron (METHODS §5.2)
-    }
-    net.pore_cell[k] = vol;
-    net.pore_void[k] = std::max(vol - solid, params.min_void_fraction * vol);
-    net.pore_cx[k] = 0.25 * (p.x[v[0]] + p.x[v[1]] + p.x[v[2]] + p.x[v[3]]);
-    net.pore_cy[k] = 0.25 * (p.y[v[0]] + p.y[v[1]] + p.y[v[2]] + p.y[v[3]]);
-    net.pore_cz[k] = 0.25 * (p.z[v[0]] + p.z[v[1]] + p.z[v[2]] + p.z[v[3]]);
+    for (int i = 0; i < 4; ++i) net.pore_v[4 * k + i] = cells[k].v[i];
+    pore_geometry_3d(net, p, k);
   }
   Real mean_cell = 0;
   for (Index k = 0; k < np; ++k) mean_cell += net.pore_cell[k];
   mean_cell /= static_cast<Real>(np);
-  for (Index k = 0; k < np; ++k) net.pore_void[k] = std::max(net.pore_void[k], params.min_void_relative * mean_cell);
+  net.void_floor = params.min_void_relative * mean_cell;
+  min_void_floor(net);
   // Facets: sorted gid triple -> pores; shared = throat, single = hull.
   struct Facet {
     std::array<std::int64_t, 3> key;
@@ -136,29 +181,15 @@ Network2D build_network_3d(const Particles3D& p, const NetworkParams& params, Re
   for (std::size_t e = 0; e < facets.size();) {
     if (e + 1 < facets.size() && facets[e + 1].key == facets[e].key) {
       const Index pa = facets[e].pore, pb = facets[e + 1].pore;
-      const auto& v = facets[e].v;
-      const V3 A = pos(v[0]), B = pos(v[1]), C = pos(v[2]);
-      const Real area = 0.5 * norm(cross(sub(B, A), sub(C, A)));
-      Real solid = 0, perim = 0;
-      for (int j = 0; j < 3; ++j) {
-        const V3 o = pos(v[j]);
-        const Real th = angle(sub(pos(v[(j + 1) % 3]), o), sub(pos(v[(j + 2) % 3]), o));
-        const Real R = p.radius[v[j]];
-        solid += 0.5 * th * R * R;
-        perim += th * R;
-      }
-      const Real af = std::max(area - solid, params.min_void_fraction * area);
-      const Real rh = af / perim;
-      const V3 d{net.pore_cx[pb] - net.pore_cx[pa], net.pore_cy[pb] - net.pore_cy[pa], net.pore_cz[pb] - net.pore_cz[pa]};
-      // Adjacent slivers have almost coincident centroids: L at least a tenth of the mean radius.
-      const Real L = std::max(norm(d), 0.1 * (p.radius[v[0]] + p.radius[v[1]] + p.radius[v[2]]) / 3);
       net.ch_pore.push_back(pa);
       net.ch_pore.push_back(pb);
+      for (int j = 0; j < 3; ++j) net.ch_part.push_back(facets[e].v[j]);
       net.ch_kind.push_back(ChannelKind::T2T);
       net.ch_pair.push_back(-1);
-      net.ch_length.push_back(L);
-      net.ch_aperture.push_back(2 * rh);
-      net.ch_cond.push_back(pfv_factor * af * rh * rh / (2 * L));  // Chareyre et al. 2012
+      net.ch_length.push_back(0);
+      net.ch_aperture.push_back(0);
+      net.ch_cond.push_back(0);
+      throat_geometry_3d(net, p, net.n_channels() - 1, pfv_factor);
       e += 2;
     } else {
       net.pore_hull[facets[e].pore] = 1;
@@ -166,14 +197,13 @@ Network2D build_network_3d(const Particles3D& p, const NetworkParams& params, Re
     }
   }
   const Index nc = net.n_channels();
-  // Clamp local conductances relative to the median (YADE clamps to maxKdivKmean x the mean,
-  // METHODS §5.3a; here the median: the wide flat facets near the hull reach 1e5 x the typical
-  // conductance and would dominate a mean).
+  net.pfv_factor = pfv_factor;
+  net.ch_cond_cap = std::numeric_limits<Real>::infinity();
   if (nc > 0) {
     std::vector<Real> sorted(net.ch_cond);
     std::nth_element(sorted.begin(), sorted.begin() + nc / 2, sorted.end());
-    const Real med = sorted[nc / 2];
-    for (Index c = 0; c < nc; ++c) net.ch_cond[c] = std::min(net.ch_cond[c], params.max_cond_ratio * med);
+    net.ch_cond_cap = params.max_cond_ratio * sorted[nc / 2];
+    clamp_conductances(net);
   }
   net.pc_start.assign(np + 1, 0);
   for (Index c = 0; c < nc; ++c) {
@@ -187,7 +217,37 @@ Network2D build_network_3d(const Particles3D& p, const NetworkParams& params, Re
     net.pc_ch[fill[net.ch_pore[2 * c]]++] = c;
     net.pc_ch[fill[net.ch_pore[2 * c + 1]]++] = c;
   }
+  // Particle -> pore corners (pores in ascending order per particle).
+  net.pp_start.assign(n + 1, 0);
+  for (Index k = 0; k < np; ++k)
+    for (int i = 0; i < 4; ++i) ++net.pp_start[net.pore_v[4 * k + i] + 1];
+  for (std::size_t q = 0; q < n; ++q) net.pp_start[q + 1] += net.pp_start[q];
+  net.pp_pore.resize(net.pp_start[n]);
+  net.pp_corner.resize(net.pp_start[n]);
+  std::vector<Index> pfill(net.pp_start.begin(), net.pp_start.end() - 1);
+  for (Index k = 0; k < np; ++k)
+    for (int i = 0; i < 4; ++i) {
+      const Index q = pfill[net.pore_v[4 * k + i]]++;
+      net.pp_pore[q] = k;
+      net.pp_corner[q] = static_cast<std::uint8_t>(i);
+    }
   return net;
+}
+
+void update_network_3d(Network2D& net, const Particles3D& p) {
+  if (net.dim != 3) throw InputError("porenet: update_network_3d needs a network from build_network_3d");
+  if (p.x.size() != static_cast<std::size_t>(net.n_particles))
+    throw InputError(fmt::format("porenet: {} particles for a network built on {}", p.x.size(), net.n_particles));
+#pragma omp parallel for schedule(static) if (net.n_pores() > kParallelMin)
+  for (Index k = 0; k < net.n_pores(); ++k) {
+    pore_geometry_3d(net, p, k);
+    net.pore_void[k] = std::max(net.pore_void[k], net.void_floor);
+  }
+#pragma omp parallel for schedule(static) if (net.n_channels() > kParallelMin)
+  for (Index c = 0; c < net.n_channels(); ++c) {
+    throat_geometry_3d(net, p, c, net.pfv_factor);
+    net.ch_cond[c] = std::min(net.ch_cond[c], net.ch_cond_cap);
+  }
 }
 
 }  // namespace ff::porenet

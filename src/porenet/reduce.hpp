@@ -9,6 +9,10 @@
 namespace ff::porenet {
 
 inline constexpr Index kReduceBlock = 2048;
+// Loops over fewer items run on one thread: on a busy machine an OpenMP fork/join (and its spinning
+// workers) costs more than a few thousand pores' work.
+inline constexpr Index kParallelMin = 4096;
+
 
 inline Index reduce_blocks(Index n) { return (n + kReduceBlock - 1) / kReduceBlock; }
 
@@ -16,7 +20,8 @@ inline Index reduce_blocks(Index n) { return (n + kReduceBlock - 1) / kReduceBlo
 template <class F>
 Real fixed_order_sum(Index n, F&& term, std::vector<Real>& scratch) {
   const Index nb = reduce_blocks(n);
-#pragma omp parallel for schedule(static)
+  // Few blocks: no parallel region (idle, spinning workers slow a busy machine down).
+#pragma omp parallel for schedule(static) if (n > kParallelMin)
   for (Index b = 0; b < nb; ++b) {
     const Index end = std::min(n, (b + 1) * kReduceBlock);
     Real s = 0;

@@ -32,7 +32,6 @@ StratifiedRates stratified_channel_flow(Real G, Real hq, Real hp, Real muq, Real
 
 TwoPhaseFlow::TwoPhaseFlow(const Network2D& net, const TwoPhaseParams& params)
     : net_(net), prm_(params), np_(net.n_pores()), nc_(net.n_channels()) {
-  if (net.dim != 2) throw InputError("porenet: two-phase flow (stratified slit channels, B3-B7) needs a 2D network");
   if (!(params.mu_liquid > 0 && params.mu_gas > 0))
     throw InputError(fmt::format("porenet: viscosities must be > 0 (liquid {}, gas {} Pa s)", params.mu_liquid,
                                  params.mu_gas));
@@ -133,9 +132,34 @@ Real TwoPhaseFlow::solve_shared_pressure(Real mq, Real mp, Real V, Real a0, Real
   return a;
 }
 
+void TwoPhaseFlow::channel_mobilities(Index c, Index u, Real& lq, Real& lp) const {
+  if (net_.dim == 2) {
+    const Real h = net_.ch_aperture[c], w = net_.params.thickness / net_.ch_length[c];
+    const StratifiedRates r = stratified_channel_flow(1.0, alpha_[u] * h, (1 - alpha_[u]) * h, prm_.mu_liquid, prm_.mu_gas);
+    lq = r.q_liquid * w;
+    lp = r.q_gas * w;
+  } else {
+    const StratifiedRates r = stratified_channel_flow(1.0, alpha_[u], 1 - alpha_[u], prm_.mu_liquid, prm_.mu_gas);
+    lq = 12 * net_.ch_cond[c] * r.q_liquid;
+    lp = 12 * net_.ch_cond[c] * r.q_gas;
+  }
+}
+
 void TwoPhaseFlow::compute_rates() {
   const Real t = net_.params.thickness;
-#pragma omp parallel for schedule(static)
+  if (net_.dim != 2) {
+#pragma omp parallel for schedule(static) if (nc_ > kParallelMin)
+    for (Index c = 0; c < nc_; ++c) {
+      const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
+      const Index u = p_[a] >= p_[b] ? a : b;
+      Real lq, lp;
+      channel_mobilities(c, u, lq, lp);
+      fq_[c] = rq_[u] * lq * (p_[a] - p_[b]);
+      fp_[c] = rp_[u] * lp * (p_[a] - p_[b]);
+    }
+    return;
+  }
+#pragma omp parallel for schedule(static) if (nc_ > kParallelMin)
   for (Index c = 0; c < nc_; ++c) {
     const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
     const Index u = p_[a] >= p_[b] ? a : b;  // upstream pore: face values (B8)
@@ -152,7 +176,7 @@ Real TwoPhaseFlow::stable_dt() {
   compute_rates();
   const Real t = net_.params.thickness;
   Real dt = std::numeric_limits<Real>::infinity();
-#pragma omp parallel for schedule(static) reduction(min : dt)
+#pragma omp parallel for schedule(static) reduction(min : dt) if (np_ > kParallelMin)
   for (Index i = 0; i < np_; ++i) {
     if (bc_[i] == PoreBc::Pressure) continue;
     Real mob = 0, outq = 0, outp = 0;
@@ -160,10 +184,16 @@ Real TwoPhaseFlow::stable_dt() {
       const Index c = net_.pc_ch[e];
       const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
       const Index u = p_[a] >= p_[b] ? a : b;
-      const Real h = net_.ch_aperture[c];
-      const StratifiedRates r =
-          stratified_channel_flow(1.0, alpha_[u] * h, (1 - alpha_[u]) * h, prm_.mu_liquid, prm_.mu_gas);
-      mob += (r.q_liquid + r.q_gas) * t / net_.ch_length[c];
+      if (net_.dim == 2) {
+        const Real h = net_.ch_aperture[c];
+        const StratifiedRates r =
+            stratified_channel_flow(1.0, alpha_[u] * h, (1 - alpha_[u]) * h, prm_.mu_liquid, prm_.mu_gas);
+        mob += (r.q_liquid + r.q_gas) * t / net_.ch_length[c];
+      } else {
+        Real lq, lp;
+        channel_mobilities(c, u, lq, lp);
+        mob += lq + lp;
+      }
       const Real sgn = a == i ? 1 : -1;
       outq += std::max(sgn * fq_[c], 0.0);
       outp += std::max(sgn * fp_[c], 0.0);
@@ -180,8 +210,14 @@ Real TwoPhaseFlow::stable_dt() {
 
 void TwoPhaseFlow::step_explicit(Real dt) {
   compute_rates();
+  update_pore_states(dt, "explicit");
+}
+
+// Phase masses from the channel rates fq_, fp_ (B18), then the shared pressure (B23) at the new void
+// volume (B19) and the phase densities (B20).
+void TwoPhaseFlow::update_pore_states(Real dt, const char* scheme) {
   Index bad = -1;
-#pragma omp parallel for schedule(static) reduction(max : bad)
+#pragma omp parallel for schedule(static) reduction(max : bad) if (np_ > kParallelMin)
   for (Index i = 0; i < np_; ++i) {
     if (bc_[i] == PoreBc::Pressure) {
       // Fixed state at the new void volume.
@@ -215,10 +251,125 @@ void TwoPhaseFlow::step_explicit(Real dt) {
     rp_[i] = a < 1 ? mp_[i] / ((1 - a) * V) : prm_.gas.density(p > 0 ? p : 1.0, false);
   }
   if (bad >= 0)
-    throw NumericalError(fmt::format("porenet: pore {} phase masses ({}, {}) kg after a step of {} s; reduce dt "
-                                     "below stable_dt()", bad, mq_[bad], mp_[bad], dt));
+    throw NumericalError(fmt::format("porenet: pore {} phase masses ({}, {}) kg after an {} step of {} s; reduce dt "
+                                     "below stable_dt()", bad, mq_[bad], mp_[bad], scheme, dt));
   for (Index i = 0; i < np_; ++i)
     if (bc_[i] == PoreBc::Flux) injected_ += dt * bc_value_[i];
+}
+
+void TwoPhaseFlow::prepare_implicit() {
+  if (sys_) return;
+  sys_ = std::make_unique<PressureSystem>(net_);
+  const auto n = static_cast<std::size_t>(np_), m = static_cast<std::size_t>(nc_);
+  tq_.assign(m, 0);
+  tp_ = tq_;
+  rhs_.assign(n, 0);
+  dp_ = pnew_ = lim_q_ = lim_p_ = rhs_;
+}
+
+void TwoPhaseFlow::step_implicit(Real dt) {
+  prepare_implicit();
+  substeps_ = 0;
+  implicit_substep(dt, 0);
+}
+
+// One backward-Euler step; if a pore would give away more of a phase than it holds (the explicit
+// transport limit, far above the pressure-diffusion limit for liquids), two half steps instead
+// (nothing has been changed yet); past kMaxHalvings the outflow limiter below applies.
+void TwoPhaseFlow::implicit_substep(Real dt, int depth) {
+  constexpr int kMaxHalvings = 12;
+  auto& A = sys_->matrix();
+  const auto& entry_channel = sys_->entry_channel();
+  Real* val = A.valuePtr();
+  const auto* outer = A.outerIndexPtr();
+  const auto* inner = A.innerIndexPtr();
+  // Mass mobilities at t^n (upstream pore of p^n): tq_, tp_ [kg/(Pa s)]; volumetric ones in the matrix.
+#pragma omp parallel for schedule(static) if (nc_ > kParallelMin)
+  for (Index c = 0; c < nc_; ++c) {
+    const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
+    const Index u = p_[a] >= p_[b] ? a : b;
+    Real lq, lp;
+    channel_mobilities(c, u, lq, lp);
+    tq_[c] = lq;  // volumetric for now; densities applied below
+    tp_[c] = lp;
+  }
+#pragma omp parallel for schedule(static) if (np_ > kParallelMin)
+  for (Index i = 0; i < np_; ++i) {
+    const bool fixed_i = bc_[i] == PoreBc::Pressure;
+    Real diag = 0, rhs = 0;
+    if (!fixed_i) {
+      const Real vq = mq_[i] / rq_[i], vp = mp_[i] / rp_[i];  // phase volumes at t^n
+      diag = (vq > 0 ? vq / prm_.liquid.bulk_modulus(rq_[i]) : 0) + (vp > 0 ? vp / prm_.gas.bulk_modulus(rp_[i]) : 0);
+      rhs = vq + vp - net_.pore_void[i] + (bc_[i] == PoreBc::Flux ? dt * bc_value_[i] / rq_[i] : 0);
+    }
+    for (Index k = outer[i]; k < outer[i + 1]; ++k) {
+      const Index c = entry_channel[k];
+      if (c < 0) continue;
+      const Index j = inner[k];
+      if (fixed_i) {
+        val[k] = 0;
+        continue;
+      }
+      const Real W = dt * (tq_[c] + tp_[c]);
+      diag += W;
+      rhs -= W * (p_[i] - p_[j]);
+      if (bc_[j] == PoreBc::Pressure) {
+        rhs += W * (bc_value_[j] - p_[j]);
+        val[k] = 0;
+      } else {
+        val[k] = -W;
+      }
+    }
+    for (Index k = outer[i]; k < outer[i + 1]; ++k)
+      if (inner[k] == i) val[k] = fixed_i ? 1.0 : diag;
+    rhs_[i] = fixed_i ? bc_value_[i] - p_[i] : rhs;
+  }
+  cg_iters_ = sys_->solve(rhs_, dp_, prm_.preconditioner, prm_.cg_tolerance, prm_.cg_max_iterations);
+#pragma omp parallel for schedule(static) if (np_ > kParallelMin)
+  for (Index i = 0; i < np_; ++i) pnew_[i] = p_[i] + dp_[i];
+  // Mass rates with p^{n+1} and the t^n upstream densities.
+#pragma omp parallel for schedule(static) if (nc_ > kParallelMin)
+  for (Index c = 0; c < nc_; ++c) {
+    const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
+    const Index u = p_[a] >= p_[b] ? a : b;
+    fq_[c] = rq_[u] * tq_[c] * (pnew_[a] - pnew_[b]);
+    fp_[c] = rp_[u] * tp_[c] * (pnew_[a] - pnew_[b]);
+  }
+  // Outflow limiter: a pore gives away at most the mass of each phase it holds.
+  Index limited = 0;
+#pragma omp parallel for schedule(static) reduction(+ : limited) if (np_ > kParallelMin)
+  for (Index i = 0; i < np_; ++i) {
+    lim_q_[i] = lim_p_[i] = 1;
+    if (bc_[i] == PoreBc::Pressure) continue;
+    Real oq = 0, op = 0;
+    for (Index e = net_.pc_start[i]; e < net_.pc_start[i + 1]; ++e) {
+      const Index c = net_.pc_ch[e];
+      const Real sg = net_.ch_pore[2 * c] == i ? 1.0 : -1.0;
+      oq += std::max(sg * fq_[c], 0.0);
+      op += std::max(sg * fp_[c], 0.0);
+    }
+    oq *= dt;
+    op *= dt;
+    if (oq > mq_[i]) lim_q_[i] = (1 - 1e-12) * mq_[i] / oq;
+    if (op > mp_[i]) lim_p_[i] = (1 - 1e-12) * mp_[i] / op;
+    limited += (oq > mq_[i] || op > mp_[i]) ? 1 : 0;
+  }
+  if (limited > 0 && depth < kMaxHalvings) {
+    implicit_substep(0.5 * dt, depth + 1);
+    implicit_substep(0.5 * dt, depth + 1);
+    return;
+  }
+  limited_ = limited;
+  ++substeps_;
+  if (limited > 0) {
+#pragma omp parallel for schedule(static) if (nc_ > kParallelMin)
+    for (Index c = 0; c < nc_; ++c) {
+      const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
+      fq_[c] *= fq_[c] > 0 ? lim_q_[a] : lim_q_[b];
+      fp_[c] *= fp_[c] > 0 ? lim_p_[a] : lim_p_[b];
+    }
+  }
+  update_pore_states(dt, "implicit");
 }
 
 Real TwoPhaseFlow::total_liquid_mass() { return fixed_order_sum(np_, [&](Index i) { return mq_[i]; }, scratch_); }

@@ -14,8 +14,26 @@
 //    with the phases' EOS (Peng–Robinson + Peneloux for water, B10–B22; or ideal gas), by
 //    safeguarded Newton on the liquid branch (the PR liquid density is kept above its spinodal).
 // Both phase masses are conserved to round-off: each channel's two mass rates are computed once.
+// 3D networks (throats, no slit aperture): the throat's single-phase conductance ch_cond shared by
+// the phases in the proportions of the same two-layer slit, lambda_k = 12 ch_cond q_k(G = 1, alpha,
+// 1 - alpha) [m^3/(Pa s)] (q_k scales with h^3: in 2D this is exactly B3–B7 with t / L).
+// Implicit step (step_implicit; IMPES, for stiff liquids): pressure backward Euler with the EOS
+// linearised per pore and the phase mobilities, upstream directions and densities frozen at t^n.
+// Dividing each phase's balance by its density and summing (sum_k m_k / rho_k = V) gives
+//   C_i dp_i + dt sum_j W_ij (dp_i - dp_j) = sum_k m_k^n / rho_k^n - V_i^{n+1} - dt sum_j W_ij (p_i^n - p_j^n)
+//                                            + dt Q_i / rho_q,i,
+//   C_i = V_i^n (alpha_i / K_q + (1 - alpha_i) / K_p),  W_ij = lambda_q,ij + lambda_p,ij
+// (the density ratios rho_k,up / rho_k,i of the exact volume balance set to 1: a symmetric M-matrix,
+// solved by porenet/pcg.hpp). The phase masses are then updated with the mass rates
+// rho_k,up lambda_k (p_i^{n+1} - p_j^{n+1}), each computed once (conservative to round-off), and B23
+// gives p and alpha. Volume errors of the linearisation are corrected at the next step (the
+// sum m/rho - V term). A pore cannot give away more of a phase than it holds (the transport limit of
+// the frozen mobilities): such a step is split in two halves, recursively (last_substeps()); after 12
+// halvings the pore's outgoing rates of that phase are scaled down to its mass instead (still
+// conservative; counted in last_limited_pores()).
 // Isothermal (T of the EOS); no capillarity, no phase change (seed 004: mass transfer ignored).
 #pragma once
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -23,6 +41,7 @@
 #include "porenet/eos.hpp"
 #include "porenet/flow.hpp"
 #include "porenet/network.hpp"
+#include "porenet/pcg.hpp"
 
 namespace ff::porenet {
 
@@ -38,6 +57,10 @@ struct TwoPhaseParams {
   Eos gas = Eos::air_pr(293.15);
   Real mu_liquid = 1.0e-3;  // [Pa s]
   Real mu_gas = 1.8e-5;     // [Pa s]
+  // implicit step
+  Preconditioner preconditioner = Preconditioner::DIC;
+  Real cg_tolerance = 1e-12;  // relative residual
+  int cg_max_iterations = 20000;
 };
 
 class TwoPhaseFlow {
@@ -58,6 +81,20 @@ class TwoPhaseFlow {
 
   Real stable_dt();
   void step_explicit(Real dt);
+  // Backward-Euler pressure, conservative phase update (see above). The first call allocates the
+  // pressure system (call prepare_implicit() beforehand to keep the time loop allocation free).
+  void step_implicit(Real dt);
+  void prepare_implicit();
+  int last_cg_iterations() const { return cg_iters_; }
+  Index last_limited_pores() const { return limited_; }
+  int last_substeps() const { return substeps_; }
+  // The CG start of the next implicit step (the last pressure change): part of a checkpoint.
+  std::span<const Real> implicit_guess() const { return dp_; }
+  void restore_implicit_guess(std::span<const Real> g) {
+    prepare_implicit();
+    if (g.size() != dp_.size()) throw InputError("porenet: restore_implicit_guess needs one value per pore");
+    dp_.assign(g.begin(), g.end());
+  }
   // Checkpoint resume (src/coupling/porenet): the full per-pore state as it was, so a resumed run
   // continues bit-for-bit (load_masses would re-solve B23 from another guess: last-bit differences).
   void restore_state(std::span<const Real> p, std::span<const Real> alpha, std::span<const Real> mq,
@@ -89,6 +126,9 @@ class TwoPhaseFlow {
 
  private:
   void compute_rates();
+  void channel_mobilities(Index c, Index u, Real& lq, Real& lp) const;
+  void update_pore_states(Real dt, const char* scheme);
+  void implicit_substep(Real dt, int depth);
 
   const Network2D& net_;
   TwoPhaseParams prm_;
@@ -96,6 +136,11 @@ class TwoPhaseFlow {
   std::vector<Real> p_, alpha_, mq_, mp_, rq_, rp_, fq_, fp_, bc_value_, bc_alpha_, scratch_;
   std::vector<PoreBc> bc_;
   Real injected_ = 0;
+  // implicit
+  std::unique_ptr<PressureSystem> sys_;
+  std::vector<Real> tq_, tp_, rhs_, dp_, pnew_, lim_q_, lim_p_;
+  int cg_iters_ = 0, substeps_ = 0;
+  Index limited_ = 0;
 };
 
 }  // namespace ff::porenet

@@ -1,0 +1,212 @@
+#include "coupling/porenet/dem_porenet3d.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include "core/error.hpp"
+#include "porenet/forces.hpp"
+#include "porenet/remap.hpp"
+
+namespace ff::coupling {
+
+namespace {
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+}  // namespace
+
+void DemPorenet3D::gather(const dem::DemSystem& sys) {
+  const auto n = sys.particles.size();
+  for (std::size_t k = 0; k < n; ++k) {
+    x_[k] = sys.particles.pos[k].x();
+    y_[k] = sys.particles.pos[k].y();
+    z_[k] = sys.particles.pos[k].z();
+    r_[k] = sys.particles.radius[k];
+  }
+}
+
+void DemPorenet3D::set_boundaries(porenet::TwoPhaseFlow& flow, const porenet::Network2D& net) {
+  if (prm_.drained)
+    for (Index i = 0; i < net.n_pores(); ++i)
+      if (net.pore_hull[i]) flow.set_bc(i, porenet::PoreBc::Pressure, prm_.ambient_pressure, prm_.saturation);
+  if (on_network) on_network(flow, net);
+  if (prm_.implicit) flow.prepare_implicit();
+}
+
+void DemPorenet3D::make_network_and_flow(std::unique_ptr<porenet::Network2D>& net,
+                                         std::unique_ptr<porenet::TwoPhaseFlow>& flow) {
+  const auto t0 = std::chrono::steady_clock::now();
+  net = std::make_unique<porenet::Network2D>(porenet::build_network_3d(view(), prm_.network, prm_.pfv_factor));
+  flow = std::make_unique<porenet::TwoPhaseFlow>(*net, prm_.fluid);
+  ref_x_ = x_;
+  ref_y_ = y_;
+  ref_z_ = z_;
+  pg_.assign(static_cast<std::size_t>(net->n_pores()), 0);
+  stats_.t_triangulation += seconds_since(t0);
+}
+
+void DemPorenet3D::init(dem::DemSystem& sys, const Porenet3DParams& params) {
+  if (sys.settings.dim != 3)
+    throw InputError("coupling.porenet3d: the 3D pore-network coupling needs a sphere sample (dem.dim = 3)");
+  if (!(params.saturation >= 0 && params.saturation <= 1))
+    throw InputError(fmt::format("coupling.porenet3d: saturation {} outside [0, 1]", params.saturation));
+  if (!(params.retriangulation_tolerance > 0))
+    throw InputError("coupling.porenet3d: retriangulation_tolerance must be > 0");
+  prm_ = params;
+  const auto n = sys.particles.size();
+  x_.assign(n, 0);
+  y_ = z_ = r_ = fx_ = fy_ = fz_ = x_;
+  gather(sys);
+  mean_radius_ = 0;
+  for (Real r : r_) mean_radius_ += r;
+  mean_radius_ /= static_cast<Real>(n);
+  stats_ = {};
+  make_network_and_flow(net_, flow_);
+  flow_->init(prm_.initial_pressure, prm_.saturation);
+  set_boundaries(*flow_, *net_);
+}
+
+void DemPorenet3D::set_uniform_state(Real p, Real s) {
+  for (Index i = 0; i < net_->n_pores(); ++i) flow_->set_pore_state(i, p, s);
+}
+
+std::vector<Index> DemPorenet3D::pores_near(const Vec3& c, Real radius) const {
+  std::vector<Index> out;
+  for (Index i = 0; i < net_->n_pores(); ++i) {
+    const Real dx = net_->pore_cx[i] - c.x(), dy = net_->pore_cy[i] - c.y(), dz = net_->pore_cz[i] - c.z();
+    if (dx * dx + dy * dy + dz * dz <= radius * radius) out.push_back(i);
+  }
+  return out;
+}
+
+void DemPorenet3D::retriangulate() {
+  porenet::update_network_3d(*net_, view());  // old pores at the current positions: the remap's centroids
+  auto old_net = std::move(net_);
+  auto old_flow = std::move(flow_);
+  make_network_and_flow(net_, flow_);
+  const auto t0 = std::chrono::steady_clock::now();
+  flow_->init(prm_.initial_pressure, prm_.saturation);
+  set_boundaries(*flow_, *net_);
+  porenet::remap_two_phase(*old_net, *old_flow, *net_, *flow_);
+  stats_.t_triangulation += seconds_since(t0);
+  ++stats_.retriangulations;
+}
+
+void DemPorenet3D::flow_step(Real dt) {
+  if (prm_.implicit) {
+    flow_->step_implicit(dt);
+    stats_.last_substeps = flow_->last_substeps();
+    return;
+  }
+  const Real limit = prm_.dt_safety * flow_->stable_dt();
+  long nsub = 1;
+  if (limit < dt) nsub = static_cast<long>(std::ceil(dt / limit));
+  if (nsub > prm_.max_substeps)
+    throw NumericalError(fmt::format("coupling.porenet3d: the explicit flow needs {} sub-steps per DEM step of {:.3g} s "
+                                     "(more than {}); use the implicit step", nsub, dt, prm_.max_substeps));
+  const Real h = dt / static_cast<Real>(nsub);
+  for (long s = 0; s < nsub; ++s) flow_->step_explicit(h);
+  stats_.last_substeps = nsub;
+}
+
+void DemPorenet3D::add_forces(dem::DemSystem& sys) {
+  const auto p = flow_->pressure();
+  for (std::size_t i = 0; i < pg_.size(); ++i) pg_[i] = p[i] - prm_.ambient_pressure;
+  std::fill(fx_.begin(), fx_.end(), 0.0);
+  std::fill(fy_.begin(), fy_.end(), 0.0);
+  std::fill(fz_.begin(), fz_.end(), 0.0);
+  porenet::add_pressure_forces_3d(*net_, view(), pg_, fx_, fy_, fz_);
+  for (std::size_t k = 0; k < fx_.size(); ++k) sys.particles.ext_force[k] += Vec3(fx_[k], fy_[k], fz_[k]);
+}
+
+void DemPorenet3D::step(dem::DemSystem& sys) {
+  sys.update_neighbors();
+  sys.compute_forces();
+  gather(sys);
+  Real dmax2 = 0;
+  for (std::size_t k = 0; k < x_.size(); ++k) {
+    const Real dx = x_[k] - ref_x_[k], dy = y_[k] - ref_y_[k], dz = z_[k] - ref_z_[k];
+    dmax2 = std::max(dmax2, dx * dx + dy * dy + dz * dz);
+  }
+  stats_.max_displacement = std::sqrt(dmax2);
+  if (stats_.max_displacement > prm_.retriangulation_tolerance * mean_radius_) {
+    retriangulate();
+    stats_.max_displacement = 0;
+  } else {
+    const auto t0 = std::chrono::steady_clock::now();
+    porenet::update_network_3d(*net_, view());
+    stats_.t_update += seconds_since(t0);
+  }
+  auto t1 = std::chrono::steady_clock::now();
+  flow_step(sys.settings.dt);
+  stats_.t_flow += seconds_since(t1);
+  sys.add_external_loads();
+  t1 = std::chrono::steady_clock::now();
+  add_forces(sys);
+  stats_.t_forces += seconds_since(t1);
+  sys.integrate();
+}
+
+Real DemPorenet3D::max_pressure() const {
+  Real m = -std::numeric_limits<Real>::infinity();
+  for (Real p : flow_->pressure()) m = std::max(m, p);
+  return m;
+}
+
+void DemPorenet3D::save(CheckpointWriter& w) const {
+  w.put("porenet3d.ref_x", ref_x_);
+  w.put("porenet3d.ref_y", ref_y_);
+  w.put("porenet3d.ref_z", ref_z_);
+  const auto vec = [](std::span<const Real> s) { return std::vector<Real>(s.begin(), s.end()); };
+  w.put("porenet3d.p", vec(flow_->pressure()));
+  w.put("porenet3d.alpha", vec(flow_->liquid_fraction()));
+  w.put("porenet3d.mq", vec(flow_->liquid_mass()));
+  w.put("porenet3d.mp", vec(flow_->gas_mass()));
+  w.put("porenet3d.rq", vec(flow_->liquid_density()));
+  w.put("porenet3d.rp", vec(flow_->gas_density()));
+  w.put("porenet3d.guess", prm_.implicit ? vec(flow_->implicit_guess()) : std::vector<Real>{});
+  w.put_value("porenet3d.stats", stats_);
+}
+
+void DemPorenet3D::load(CheckpointReader& r, dem::DemSystem& sys, const Porenet3DParams& params) {
+  prm_ = params;
+  const auto n = sys.particles.size();
+  x_.assign(n, 0);
+  y_ = z_ = r_ = fx_ = fy_ = fz_ = x_;
+  gather(sys);
+  mean_radius_ = 0;
+  for (Real rr : r_) mean_radius_ += rr;
+  mean_radius_ /= static_cast<Real>(n);
+  // The network as built at the last triangulation (same positions: same numbering); the next step
+  // recomputes its geometry from the current positions.
+  std::vector<Real> cx = x_, cy = y_, cz = z_;
+  r.get("porenet3d.ref_x", x_);
+  r.get("porenet3d.ref_y", y_);
+  r.get("porenet3d.ref_z", z_);
+  if (x_.size() != n) throw InputError(fmt::format("checkpoint: porenet3d positions for {} spheres; the sample has {}", x_.size(), n));
+  make_network_and_flow(net_, flow_);
+  flow_->init(prm_.initial_pressure, prm_.saturation);
+  set_boundaries(*flow_, *net_);
+  x_ = cx;
+  y_ = cy;
+  z_ = cz;
+  std::vector<Real> p, a, mq, mp, rq, rp, g;
+  r.get("porenet3d.p", p);
+  r.get("porenet3d.alpha", a);
+  r.get("porenet3d.mq", mq);
+  r.get("porenet3d.mp", mp);
+  r.get("porenet3d.rq", rq);
+  r.get("porenet3d.rp", rp);
+  r.get("porenet3d.guess", g);
+  if (p.size() != static_cast<std::size_t>(net_->n_pores()))
+    throw InputError(fmt::format("checkpoint: {} pore states for a rebuilt network of {} pores", p.size(), net_->n_pores()));
+  flow_->restore_state(p, a, mq, mp, rq, rp);
+  if (prm_.implicit) flow_->restore_implicit_guess(g);
+  stats_ = r.get_value<Porenet3DStats>("porenet3d.stats");
+}
+
+}  // namespace ff::coupling

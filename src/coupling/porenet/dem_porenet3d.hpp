@@ -1,0 +1,94 @@
+// Two-way coupling of the 3D bonded-sphere DEM with the PFV-style pore network (issue 16, item 7;
+// porenet/network3d.cpp: regular triangulation, tetrahedral pores, facet throats).
+//
+// One coupled step (DemPorenet3D::step), with the DemSystem's public stages:
+//   update_neighbors(); compute_forces();
+//   retriangulate when the largest displacement since the last triangulation exceeds
+//     `retriangulation_tolerance` x the mean radius (phase masses carried over by porenet's remap,
+//     conserving each phase), else update the pore volumes and throats for the moved spheres: the new
+//     void volumes drive the pressure (undrained compaction);
+//   flow over the DEM step: implicit two-phase (one backward-Euler step of dt_dem; default: stiff
+//     liquids need no sub-steps) or explicit with n = ceil(dt_dem / (safety dt_stable)) sub-steps;
+//   add_external_loads(); grain forces from the gauge pressure p - p_ambient (pressure integrated over
+//     each sphere's patches inside its tetrahedra, porenet::add_pressure_forces_3d); integrate().
+// Channel shear (B25) is not applied in 3D. Results are bit-identical on any thread count.
+#pragma once
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "dem/dem_system.hpp"
+#include "io/checkpoint.hpp"
+#include "porenet/network.hpp"
+#include "porenet/two_phase.hpp"
+
+namespace ff::coupling {
+
+struct Porenet3DParams {
+  porenet::NetworkParams network;
+  porenet::TwoPhaseParams fluid;
+  Real pfv_factor = 1.0;        // throat conductance factor (Chareyre et al. 2012)
+  Real initial_pressure = 1e5;  // [Pa]
+  Real ambient_pressure = 1e5;  // outside the sample [Pa]; forces use p - ambient
+  Real saturation = 1.0;        // initial liquid saturation, 0..1
+  Real retriangulation_tolerance = 0.25;  // x mean radius (cf. YADE defTolerance)
+  bool implicit = true;
+  Real dt_safety = 0.9;       // explicit: flow sub-step <= safety x stable step
+  long max_substeps = 100000;
+  bool drained = false;       // true: hull pores held at the ambient pressure (saturation kept)
+};
+
+struct Porenet3DStats {
+  long retriangulations = 0;
+  long last_substeps = 0;
+  Real max_displacement = 0;  // since the last triangulation [m]
+  double t_triangulation = 0, t_update = 0, t_flow = 0, t_forces = 0;  // cumulative wall seconds
+};
+
+class DemPorenet3D {
+ public:
+  // Builds network and flow from the system's current state (3D, after sys.initialise()).
+  void init(dem::DemSystem& sys, const Porenet3DParams& params);
+  void step(dem::DemSystem& sys);
+  void run(dem::DemSystem& sys, long steps) {
+    for (long s = 0; s < steps; ++s) step(sys);
+  }
+
+  const porenet::Network2D& network() const { return *net_; }
+  porenet::TwoPhaseFlow& flow() { return *flow_; }
+  const Porenet3DStats& stats() const { return stats_; }
+  const Porenet3DParams& params() const { return prm_; }
+  Real max_pressure() const;
+  // Fluid force of the last step on particle k [N].
+  Vec3 fluid_force(Index k) const { return {fx_[k], fy_[k], fz_[k]}; }
+  // Sets every pore's pressure and saturation.
+  void set_uniform_state(Real p, Real saturation);
+  // Pressure (and saturation) at the pores whose centroid is within `radius` of `centre` (injection).
+  std::vector<Index> pores_near(const Vec3& centre, Real radius) const;
+
+  // Checkpoint sections (prefix "porenet3d."): triangulation positions, per-pore state, CG start.
+  void save(CheckpointWriter& w) const;
+  void load(CheckpointReader& r, dem::DemSystem& sys, const Porenet3DParams& params);
+
+  // Called after every (re)build of the network, before the state is carried over: boundary conditions.
+  std::function<void(porenet::TwoPhaseFlow&, const porenet::Network2D&)> on_network;
+
+ private:
+  void gather(const dem::DemSystem& sys);
+  void make_network_and_flow(std::unique_ptr<porenet::Network2D>& net, std::unique_ptr<porenet::TwoPhaseFlow>& flow);
+  void set_boundaries(porenet::TwoPhaseFlow& flow, const porenet::Network2D& net);
+  void retriangulate();
+  void flow_step(Real dt);
+  void add_forces(dem::DemSystem& sys);
+  porenet::Particles3D view() const { return {x_, y_, z_, r_, {}}; }
+
+  Porenet3DParams prm_;
+  std::unique_ptr<porenet::Network2D> net_;
+  std::unique_ptr<porenet::TwoPhaseFlow> flow_;
+  std::vector<Real> x_, y_, z_, r_, ref_x_, ref_y_, ref_z_, fx_, fy_, fz_, pg_;
+  Real mean_radius_ = 0;
+  Porenet3DStats stats_;
+};
+
+}  // namespace ff::coupling

@@ -1,0 +1,149 @@
+#include "porenet/pcg.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+#include "porenet/reduce.hpp"
+
+namespace ff::porenet {
+
+PressureSystem::PressureSystem(const Network2D& net) : n_(net.n_pores()) {
+  const auto n = static_cast<std::size_t>(n_);
+  std::vector<Eigen::Triplet<Real>> trip;
+  trip.reserve(n + 2 * static_cast<std::size_t>(net.n_channels()));
+  for (Index i = 0; i < n_; ++i) trip.emplace_back(i, i, 1.0);
+  for (Index c = 0; c < net.n_channels(); ++c) {
+    trip.emplace_back(net.ch_pore[2 * c], net.ch_pore[2 * c + 1], 0.0);
+    trip.emplace_back(net.ch_pore[2 * c + 1], net.ch_pore[2 * c], 0.0);
+  }
+  A_.resize(n_, n_);
+  A_.setFromTriplets(trip.begin(), trip.end());
+  A_.makeCompressed();
+  entry_channel_.assign(static_cast<std::size_t>(A_.nonZeros()), -1);
+  diag_pos_.assign(n, -1);
+  for (Index col = 0; col < n_; ++col)
+    for (Index k = A_.outerIndexPtr()[col]; k < A_.outerIndexPtr()[col + 1]; ++k) {
+      const Index row = A_.innerIndexPtr()[k];
+      if (row == col) {
+        diag_pos_[col] = k;
+        continue;
+      }
+      for (Index e = net.pc_start[col]; e < net.pc_start[col + 1]; ++e) {
+        const Index c = net.pc_ch[e];
+        if (net.ch_pore[2 * c] == row || net.ch_pore[2 * c + 1] == row) entry_channel_[k] = c;
+      }
+    }
+  // Per row, the stored entries inside its DIC block: [lo_begin_, diag) and (diag, hi_end_).
+  lo_begin_.assign(n, 0);
+  hi_end_.assign(n, 0);
+  for (Index i = 0; i < n_; ++i) {
+    const Index lo = i / kDicBlock * kDicBlock, hi = std::min(n_, lo + kDicBlock);
+    Index k = A_.outerIndexPtr()[i];
+    while (k < diag_pos_[i] && A_.innerIndexPtr()[k] < lo) ++k;
+    lo_begin_[i] = k;
+    k = A_.outerIndexPtr()[i + 1];
+    while (k > diag_pos_[i] + 1 && A_.innerIndexPtr()[k - 1] >= hi) --k;
+    hi_end_[i] = k;
+  }
+  pivot_.assign(n, 1);
+  r_ = z_ = d_ = ad_ = pivot_;
+  scratch_.assign(static_cast<std::size_t>(std::max<Index>(reduce_blocks(n_), 1)), 0);
+}
+
+void PressureSystem::setup_preconditioner(Preconditioner pc) {
+  const Real* val = A_.valuePtr();
+  const auto* outer = A_.outerIndexPtr();
+  const auto* inner = A_.innerIndexPtr();
+  if (pc == Preconditioner::Jacobi) {
+    for (Index i = 0; i < n_; ++i) pivot_[i] = 1 / val[diag_pos_[i]];
+    return;
+  }
+  const Index nb = (n_ + kDicBlock - 1) / kDicBlock;
+#pragma omp parallel for schedule(static) if (nb > 1)
+  for (Index b = 0; b < nb; ++b) {
+    const Index lo = b * kDicBlock, hi = std::min(n_, lo + kDicBlock);
+    for (Index i = lo; i < hi; ++i) {  // entries of row i left of the diagonal (inner sorted)
+      Real d = val[diag_pos_[i]];
+      for (Index k = lo_begin_[i]; k < diag_pos_[i]; ++k) d -= val[k] * val[k] * pivot_[inner[k]];
+      pivot_[i] = 1 / d;  // stored inverted
+    }
+  }
+}
+
+void PressureSystem::apply_preconditioner(Preconditioner pc, const std::vector<Real>& r, std::vector<Real>& z) {
+  if (pc == Preconditioner::Jacobi) {
+#pragma omp parallel for schedule(static) if (n_ > kDicBlock)
+    for (Index i = 0; i < n_; ++i) z[i] = r[i] * pivot_[i];
+    return;
+  }
+  const Real* val = A_.valuePtr();
+  const auto* outer = A_.outerIndexPtr();
+  const auto* inner = A_.innerIndexPtr();
+  const Index nb = (n_ + kDicBlock - 1) / kDicBlock;
+#pragma omp parallel for schedule(static) if (nb > 1)
+  for (Index b = 0; b < nb; ++b) {
+    const Index lo = b * kDicBlock, hi = std::min(n_, lo + kDicBlock);
+    for (Index i = lo; i < hi; ++i) {  // (D + L) y = r
+      Real s = r[i];
+      for (Index k = lo_begin_[i]; k < diag_pos_[i]; ++k) s -= val[k] * z[inner[k]];
+      z[i] = s * pivot_[i];
+    }
+    for (Index i = hi - 1; i >= lo; --i) {  // (D + L^T) z = D y
+      Real s = 0;
+      for (Index k = diag_pos_[i] + 1; k < hi_end_[i]; ++k) s += val[k] * z[inner[k]];
+      z[i] -= s * pivot_[i];
+    }
+  }
+}
+
+int PressureSystem::solve(std::span<const Real> b, std::span<Real> x, Preconditioner pc, Real tol, int max_it) {
+  const Real* val = A_.valuePtr();
+  const auto* outer = A_.outerIndexPtr();
+  const auto* inner = A_.innerIndexPtr();
+  auto matvec = [&](const Real* in, std::vector<Real>& out) {
+#pragma omp parallel for schedule(static) if (n_ > kDicBlock)
+    for (Index i = 0; i < n_; ++i) {
+      Real s = 0;
+      for (Index k = outer[i]; k < outer[i + 1]; ++k) s += val[k] * in[inner[k]];
+      out[i] = s;
+    }
+  };
+  const Real bnorm2 = fixed_order_sum(n_, [&](Index i) { return b[i] * b[i]; }, scratch_);
+  if (bnorm2 == 0) {
+    std::fill(x.begin(), x.end(), 0.0);
+    return 0;
+  }
+  const Real tol2 = tol * tol * bnorm2;
+  matvec(x.data(), ad_);
+#pragma omp parallel for schedule(static) if (n_ > kDicBlock)
+  for (Index i = 0; i < n_; ++i) r_[i] = b[i] - ad_[i];
+  if (fixed_order_sum(n_, [&](Index i) { return r_[i] * r_[i]; }, scratch_) <= tol2) return 0;
+  setup_preconditioner(pc);
+  apply_preconditioner(pc, r_, z_);
+  d_ = z_;
+  Real rz = fixed_order_sum(n_, [&](Index i) { return r_[i] * z_[i]; }, scratch_);
+  for (int it = 0; it < max_it; ++it) {
+    matvec(d_.data(), ad_);
+    const Real dad = fixed_order_sum(n_, [&](Index i) { return d_[i] * ad_[i]; }, scratch_);
+    const Real alpha = rz / dad;
+#pragma omp parallel for schedule(static) if (n_ > kDicBlock)
+    for (Index i = 0; i < n_; ++i) {
+      x[i] += alpha * d_[i];
+      r_[i] -= alpha * ad_[i];
+    }
+    const Real rr = fixed_order_sum(n_, [&](Index i) { return r_[i] * r_[i]; }, scratch_);
+    if (rr <= tol2) return it + 1;
+    apply_preconditioner(pc, r_, z_);
+    const Real rz_new = fixed_order_sum(n_, [&](Index i) { return r_[i] * z_[i]; }, scratch_);
+    const Real beta = rz_new / rz;
+    rz = rz_new;
+#pragma omp parallel for schedule(static) if (n_ > kDicBlock)
+    for (Index i = 0; i < n_; ++i) d_[i] = z_[i] + beta * d_[i];
+  }
+  throw NumericalError(fmt::format("porenet: conjugate gradients did not converge in {} iterations; raise "
+                                   "cg_max_iterations or use the LDLT solver", max_it));
+}
+
+}  // namespace ff::porenet

@@ -1,0 +1,214 @@
+// 3D DEM <-> pore network coupling (src/coupling/porenet/dem_porenet3d.*): a small bonded sphere
+// specimen (the UCS driver's sample builder and parallel-bond law) with the PFV-style network and the
+// implicit two-phase flow.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "coupling/porenet/dem_porenet3d.hpp"
+#include "dem/dem_checkpoint.hpp"
+#include "dem/dem_params.hpp"
+#include "dem/sample_builder.hpp"
+#include "io/scenario.hpp"
+#include "porenet/eos.hpp"
+
+namespace ff::coupling {
+namespace {
+
+ParamTable sample_table() {
+  ParamTable t;
+  dem::declare_dem_params(t);
+  dem::declare_sample_params(t);
+  return t;
+}
+
+const std::string kScenario =
+    "[dem]\ndim = 3\nbond_law = \"parallel\"\n[dem.group.matrix]\ndensity = 2400\n"
+    "[dem.contact.matrix-matrix]\nemod = 2.0e9\nkratio = 2.5\nfriction = 0.4\n"
+    "[dem.bond.matrix-matrix]\nemod = 2.0e9\nkratio = 2.5\ntensile_strength = 17.4e6\ncohesion = 4.35e6\n"
+    "[sample]\nshape = \"box\"\nwidth = 6e-3\ndepth = 6e-3\nheight = 6e-3\nradius_min = 0.4e-3\nradius_max = 0.6e-3\n"
+    "porosity = 0.45\nseed = 5\n";
+
+struct Specimen {
+  ParamTable table = sample_table();
+  Config cfg;
+  dem::DemSystem sys;
+  dem::SampleInfo info;
+};
+
+std::unique_ptr<Specimen> specimen(Real platen_v, std::size_t parallel_min = 2048) {
+  auto s = std::make_unique<Specimen>();
+  s->cfg = load_scenario(s->table, "", kScenario, {});
+  s->sys.settings = dem::build_settings(s->cfg);
+  s->sys.settings.parallel_min = parallel_min;
+  s->sys.materials = dem::build_materials(s->cfg);
+  s->info = dem::build_sample(s->cfg, s->sys);
+  dem::add_platens(s->sys, s->info, 0.1);
+  dem::choose_time_step(s->cfg, s->sys);
+  s->sys.walls[0].velocity[s->info.axis] = platen_v;
+  s->sys.walls[1].velocity[s->info.axis] = -platen_v;
+  return s;
+}
+
+Porenet3DParams fluid(Real saturation, Real K = 5e7) {
+  Porenet3DParams p;
+  p.fluid.liquid = porenet::Eos::barotropic(1000, 1e5, K);
+  p.fluid.gas = porenet::Eos::ideal_gas(293.15, 28.9586);
+  p.saturation = saturation;
+  p.pfv_factor = 1e-4;  // tight (concrete-like) throats: the pressure equalises over ~100 DEM steps
+  return p;
+}
+
+Real sum_void(const porenet::Network2D& n) {
+  Real v = 0;
+  for (Real x : n.pore_void) v += x;
+  return v;
+}
+
+// Uniform gauge pressure: the surface integral of p n over each interior sphere is zero (the
+// sphere's patches close), so the fluid force on every sphere not on the hull vanishes.
+TEST(CouplingPorenet3D, UniformPressureZeroForceOnInteriorSpheres) {
+  auto s = specimen(0);
+  DemPorenet3D c;
+  auto prm = fluid(1.0);
+  prm.ambient_pressure = 0;
+  c.init(s->sys, prm);
+  const Real P = 1e6;
+  c.set_uniform_state(P, 1.0);
+  const auto& net = c.network();
+  std::vector<char> hull(s->sys.particles.size(), 0);
+  for (Index i = 0; i < net.n_pores(); ++i)
+    if (net.pore_hull[i])
+      for (int k = 0; k < 4; ++k) hull[static_cast<std::size_t>(net.pore_v[4 * i + k])] = 1;
+  c.step(s->sys);
+  int interior = 0;
+  Real worst = 0, hull_max = 0;
+  for (std::size_t k = 0; k < hull.size(); ++k) {
+    const Real r = s->sys.particles.radius[k];
+    const Real rel = c.fluid_force(static_cast<Index>(k)).norm() / (P * 4 * M_PI * r * r);
+    if (hull[k]) {
+      hull_max = std::max(hull_max, rel);
+      continue;
+    }
+    ++interior;
+    worst = std::max(worst, rel);
+  }
+  std::printf("uniform pressure (3D): %zu spheres, %d pores, %d interior spheres, max |F|/(P 4 pi r^2) = %.3g "
+              "(hull %.3g)\n", hull.size(), net.n_pores(), interior, worst, hull_max);
+  EXPECT_GT(interior, 10);
+  EXPECT_LT(worst, 1e-9);
+  EXPECT_GT(hull_max, 1e-3);
+}
+
+// Undrained compression of a saturated closed sample: p - p0 = K ln(V0/V) once the pressure has
+// equalised (barotropic liquid, mass conserved; Wang 2000, Theory of Linear Poroelasticity, with B = 1).
+TEST(CouplingPorenet3D, UndrainedCompressionPressureJump) {
+  auto s = specimen(0.02);
+  DemPorenet3D c;
+  const Real K = 5e7;
+  c.init(s->sys, fluid(1.0, K));
+  const Real V0 = sum_void(c.network());
+  for (int k = 0; k < 600; ++k) c.step(s->sys);
+  s->sys.walls[0].velocity.setZero();
+  s->sys.walls[1].velocity.setZero();
+  for (int k = 0; k < 300; ++k) c.step(s->sys);
+  const auto& net = c.network();
+  const Real V = sum_void(net);
+  Real pv = 0;
+  const auto p = c.flow().pressure();
+  for (Index i = 0; i < net.n_pores(); ++i) pv += p[i] * net.pore_void[i];
+  const Real dp = pv / V - 1e5, dp_pred = K * std::log(V0 / V);
+  std::printf("undrained (3D): dV/V0 = %.4g, mean dp = %.5g Pa, K ln(V0/V) = %.5g Pa, rel err %.3g; %ld "
+              "retriangulations; DEM dt %.3g s\n", (V0 - V) / V0, dp, dp_pred, std::abs(dp / dp_pred - 1),
+              c.stats().retriangulations, s->sys.settings.dt);
+  EXPECT_GT((V0 - V) / V0, 5e-5);  // the sample did compact
+  EXPECT_GT(dp, 0);
+  EXPECT_NEAR(dp / dp_pred, 1.0, 0.02);
+}
+
+// Single- and two-phase coupled runs with retriangulations: each phase's mass is conserved.
+TEST(CouplingPorenet3D, SingleAndTwoPhaseMassConserved) {
+  for (const Real S : {1.0, 0.5}) {
+    auto s = specimen(0.05);
+    DemPorenet3D c;
+    auto prm = fluid(S, 2.2e9);
+    prm.retriangulation_tolerance = 0.003;
+    c.init(s->sys, prm);
+    const Real mq0 = c.flow().total_liquid_mass(), mp0 = c.flow().total_gas_mass();
+    for (int k = 0; k < 300; ++k) c.step(s->sys);
+    const Real eq = std::abs(c.flow().total_liquid_mass() / mq0 - 1);
+    const Real ep = mp0 > 0 ? std::abs(c.flow().total_gas_mass() / mp0 - 1) : c.flow().total_gas_mass();
+    std::printf("3D S = %.1f (water K = 2.2 GPa, implicit, one flow step per DEM step of %.3g s): %ld "
+                "retriangulations, liquid mass error %.3g, gas %.3g, max p %.5g Pa\n", S, s->sys.settings.dt,
+                c.stats().retriangulations, eq, ep, c.max_pressure());
+    EXPECT_GE(c.stats().retriangulations, 1);
+    EXPECT_LT(eq, 1e-12);
+    EXPECT_LT(ep, 1e-12);
+    EXPECT_GT(c.max_pressure(), 1e5);
+  }
+}
+
+std::vector<Real> state_of(const dem::DemSystem& sys, DemPorenet3D& c) {
+  std::vector<Real> v;
+  for (const auto& p : sys.particles.pos) v.insert(v.end(), {p.x(), p.y(), p.z()});
+  for (Real p : c.flow().pressure()) v.push_back(p);
+  for (Real p : c.flow().liquid_mass()) v.push_back(p);
+  return v;
+}
+
+// Resume from a checkpoint (DEM + network + fluid) continues bit-for-bit; 1 and 2 threads agree.
+TEST(CouplingPorenet3D, CheckpointResumeAndThreadsBitIdentical) {
+  auto prm = fluid(0.5, 2.2e9);
+  prm.retriangulation_tolerance = 0.0015;
+  const int n1 = 120, n2 = 120;
+  omp_set_num_threads(2);
+  auto ref = specimen(0.05, 1);
+  DemPorenet3D cref;
+  cref.init(ref->sys, prm);
+  cref.run(ref->sys, n1 + n2);
+  const auto a = state_of(ref->sys, cref);
+  EXPECT_GE(cref.stats().retriangulations, 1);
+
+  omp_set_num_threads(1);
+  auto one = specimen(0.05, 1);
+  DemPorenet3D c1;
+  c1.init(one->sys, prm);
+  c1.run(one->sys, n1);
+  const auto path = std::filesystem::temp_directory_path() / "ff_coupling_porenet3d_test.ckpt";
+  {
+    CheckpointWriter w(path);
+    dem::save_dem(w, one->sys);
+    c1.save(w);
+    w.commit();
+  }
+  auto resumed = specimen(0, 1);
+  {
+    CheckpointReader r(path);
+    dem::load_dem(r, resumed->sys);
+    DemPorenet3D c2;
+    c2.load(r, resumed->sys, prm);
+    c2.run(resumed->sys, n2);
+    c1.run(one->sys, n2);
+    const auto b = state_of(resumed->sys, c2), d = state_of(one->sys, c1);
+    ASSERT_EQ(a.size(), d.size());
+    ASSERT_EQ(b.size(), d.size());
+    long diff_resume = 0, diff_threads = 0;
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      diff_resume += b[k] != d[k];
+      diff_threads += a[k] != d[k];
+    }
+    std::printf("3D resume: %ld values differ; 1 vs 2 threads: %ld differ (of %zu); %ld retriangulations\n",
+                diff_resume, diff_threads, a.size(), c1.stats().retriangulations);
+    EXPECT_EQ(diff_resume, 0) << "resumed vs uninterrupted";
+    EXPECT_EQ(diff_threads, 0) << "2 threads vs 1 thread";
+  }
+  std::filesystem::remove(path);
+  omp_set_num_threads(2);
+}
+
+}  // namespace
+}  // namespace ff::coupling
