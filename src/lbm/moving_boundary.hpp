@@ -111,6 +111,7 @@ class MovingBoundary {
     std::uint8_t q;    // incoming direction: x - c_q is solid
     bool has_second;   // x + c_q is fluid
     std::int32_t particle;
+    std::int32_t solid;  // its solid cell (index into cells_)
     T delta;           // wall fraction along the link from x
     T uw[3];           // wall velocity at x_w
     Vec3 arm;          // x_w minus particle centre
@@ -120,7 +121,10 @@ class MovingBoundary {
   CellIndex pre(const int* x, int q, bool odd) const;   // slot g_q is read from in a step of parity odd
   CellIndex post(const int* x, int q, bool odd) const;  // slot g*_q is written to
   bool fluid_now(CellIndex c) const { return fluid_[std::size_t(c)] && owner_[std::size_t(c)] < 0; }
-  void build_links(const ParticleSet& p);
+  void build_links(const ParticleSet& p, bool incremental);
+  void add_links(std::int32_t solid, const ParticleSet& p);  // the links of one solid cell
+  void link_motion(MovingLink& k, const ParticleSet& p) const;  // delta, arm, u_w of a link
+  void mark_dirty(CellIndex changed);  // particles whose links may see a changed cell
 
   Grid grid_;
   ParticleScheme scheme_;
@@ -130,7 +134,17 @@ class MovingBoundary {
   std::vector<std::int32_t> owner_;   // per padded cell: index into cells_ of the current set, -1 if fluid
   std::vector<std::int32_t> next_;    // per padded cell: scratch for the new set
   std::vector<SolidCell> cells_, new_cells_;
-  std::vector<MovingLink> links_;
+  std::vector<MovingLink> links_, new_links_;
+  // Incremental links: per particle its range in cells_ (cfirst_/ccount_; nfirst_/ncount_ for
+  // new_cells_) and in links_; a particle is dirty when its cells or a cell within two lattice
+  // steps of them changed, and only dirty particles rebuild their links.
+  std::vector<std::int32_t> cfirst_, ccount_, nfirst_, ncount_, lfirst_, lcount_, nlfirst_, nlcount_;
+  std::vector<std::uint8_t> dirty_;
+  // The cell indices of cells_ / new_cells_ alone (the passes over every solid cell read only
+  // these), and the cells that turned solid (in new_cells_) and fluid (in cells_) in this set.
+  std::vector<CellIndex> cell_, new_cell_;
+  std::vector<std::int32_t> covered_, uncovered_;
+  bool links_valid_ = false;          // links_ belong to cells_ (false after set_fluid_mask())
   std::vector<double> link_force_;    // 3 per link
   std::vector<Vec3> impulse_, impulse_torque_;  // per particle, from covering and refill
   std::vector<Vec3> force_, torque_;

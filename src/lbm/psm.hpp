@@ -109,6 +109,7 @@ class Psm {
     double eps = 0;                     // sum of the particles' fractions (before the cap at 1)
     T B = 0;
     bool boundary = false;
+    bool edge = false;  // on a periodic lattice edge
   };
   struct Entry {
     std::int32_t slot;      // cell
@@ -126,6 +127,13 @@ class Psm {
   std::vector<std::int32_t> slot_;   // per padded cell: index into cells_, -1 if uncovered
   std::vector<Cell> cells_;
   std::vector<Entry> raw_, entries_; // in particle order; grouped by cell
+  struct Candidate {                 // an entry before its cell has a slot (set_particles, step 1)
+    CellIndex cell;
+    bool boundary, edge;
+    Entry e;
+  };
+  static constexpr std::size_t kChunks = 64;  // particle chunks of the parallel fraction pass
+  std::vector<std::vector<Candidate>> chunk_;
   struct BulkCell {
     CellIndex cell;
     std::int32_t slot;
