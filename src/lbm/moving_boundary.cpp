@@ -269,27 +269,25 @@ void MovingBoundary<L, T>::set_particles(const ParticleSet& p, T* f, bool odd, b
   torque_.assign(np, Vec3::Zero());
 }
 
-// A changed cell alters the links of the solid cells within two lattice steps of it (a link
-// from solid cell y needs y + c_q fluid, its second node y + 2 c_q): their particles are dirty.
-// Called before the swap: next_ holds the new set.
+// A changed cell c alters the links of the solid cells y with c = y + c_q (the link's fluid
+// node) or c = y + 2 c_q (its second node): their particles are dirty. Called before the swap:
+// next_ holds the new set.
 template <class L, class T>
 void MovingBoundary<L, T>::mark_dirty(CellIndex changed) {
   const auto x = grid_.coords(changed);
   const int n[3] = {grid_.nx, grid_.ny, grid_.nz};
-  const int r[3] = {2, 2, L::D == 3 ? 2 : 0};
-  for (int dz = -r[2]; dz <= r[2]; ++dz)
-    for (int dy = -r[1]; dy <= r[1]; ++dy)
-      for (int dx = -r[0]; dx <= r[0]; ++dx) {
-        int y[3] = {x[0] + dx, x[1] + dy, x[2] + dz};
-        bool inside = true;
-        for (int a = 0; a < L::D; ++a) {
-          if (grid_.periodic[a]) y[a] = ((y[a] % n[a]) + n[a]) % n[a];
-          else inside = inside && y[a] >= 0 && y[a] < n[a];
-        }
-        if (!inside) continue;
-        const std::int32_t o = next_[std::size_t(grid_.index(y[0], y[1], y[2]))];
-        if (o >= 0) dirty_[std::size_t(new_cells_[std::size_t(o)].particle)] = 1;
+  for (int q = 1; q < Q; ++q)
+    for (int k = 1; k <= 2; ++k) {
+      int y[3] = {x[0] - k * L::c[q][0], x[1] - k * L::c[q][1], x[2] - k * L::c[q][2]};
+      bool inside = true;
+      for (int a = 0; a < L::D; ++a) {
+        y[a] = wrap_axis(y[a], n[a], grid_.periodic[a]);
+        inside = inside && y[a] >= 0;
       }
+      if (!inside) continue;
+      const std::int32_t o = next_[std::size_t(grid_.index(y[0], y[1], y[2]))];
+      if (o >= 0) dirty_[std::size_t(new_cells_[std::size_t(o)].particle)] = 1;
+    }
 }
 
 // Wall point, fraction and velocity of a link from its solid cell's arm and the particle's motion.

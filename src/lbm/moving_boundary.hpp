@@ -37,8 +37,12 @@
 // solid cell to f^eq(1, u_s) (cost proportional to covered cells), so solid cells hold finite values
 // and their sampled moments are the particle's velocity. This works because in the AA pattern
 // every slot a fluid cell reads at t+1 is written by the post-pass after every cell of step t has
-// run. set_particles() visits each particle's bounding box and the cells of the previous set:
-// the cost of a change is proportional to the cells involved, never to the lattice.
+// run. set_particles() visits the rows of each particle's bounding box that it can cover and the
+// cells of the previous set: the cost is proportional to the covered cells, never to the lattice.
+// Links are rebuilt only for the particles whose solid cells changed or lie within two lattice
+// steps of a cell that changed; the others keep their nodes and slots and only move (new wall
+// fraction and velocity), with the same arithmetic, so the result does not depend on which
+// particles were rebuilt (benchmarks/coupled checks the populations against the full rebuild).
 //
 // Resume: the solid cells of the last step are state (the refill of the next change depends on
 // them). A resumed run calls Solver::restore() and then Solver::restore_particles() with the set

@@ -140,7 +140,6 @@ void Psm<L, T>::set_particles(const ParticleSet& p) {
   for (const std::int32_t sp : touched_) span_count_[std::size_t(sp)] = 0;
   touched_.clear();
   cells_.clear();
-  raw_.clear();
   // 1. The covered fractions, particle by particle, in parallel: fixed chunks of consecutive
   //    particles (independent of the thread count), each into its own buffer, which step 2 reads
   //    in chunk order, i.e. in particle order as a serial loop would.
@@ -205,29 +204,42 @@ void Psm<L, T>::set_particles(const ParticleSet& p) {
     }
   }
   // 2. Cells in order of first touch, entries in particle order (serial, one lookup per entry).
-  for (std::size_t ch = 0; ch < nchunk; ++ch)
-    for (const Candidate& cd : chunk_[ch]) {
+  std::size_t nentries = 0;
+  for (std::size_t ch = 0; ch < nchunk; ++ch) {
+    for (Candidate& cd : chunk_[ch]) {
       std::int32_t& sl = slot_[std::size_t(cd.cell)];
       if (sl < 0) {
         sl = std::int32_t(cells_.size());
         cells_.push_back(Cell{cd.cell, 0, 0, 0.0, T(0), cd.boundary, cd.edge});
       }
-      raw_.push_back(cd.e);
-      raw_.back().slot = sl;
+      cd.e.slot = sl;
       ++cells_[std::size_t(sl)].count;
       cells_[std::size_t(sl)].eps += cd.e.eps;
     }
-  // Group the entries by cell (counting sort, stable: particle order within a cell).
+    nentries += chunk_[ch].size();
+  }
+  // Group the entries by cell (counting sort, stable: particle order within a cell), straight
+  // from the chunk buffers.
   std::int32_t off = 0;
   for (Cell& c : cells_) {
     c.first = off;
     off += c.count;
     c.count = 0;
   }
-  entries_.resize(raw_.size());
-  for (const Entry& e : raw_) {
-    Cell& c = cells_[std::size_t(e.slot)];
-    entries_[std::size_t(c.first + c.count++)] = e;
+  entries_.resize(nentries);
+  for (std::size_t ch = 0; ch < nchunk; ++ch)
+    for (const Candidate& cd : chunk_[ch]) {
+      Cell& c = cells_[std::size_t(cd.e.slot)];
+      entries_[std::size_t(c.first + c.count++)] = cd.e;
+    }
+  // The weights B and B_s, cell by cell (each cell writes its own entries).
+  const std::int64_t ncell = std::int64_t(cells_.size());
+#pragma omp parallel for schedule(static) if (ncell > 16384)
+  for (std::int64_t i = 0; i < ncell; ++i) {
+    Cell& c = cells_[std::size_t(i)];
+    const double B = psm_weight(std::min(1.0, c.eps), tau_);
+    c.B = T(B);
+    for (std::int32_t k = c.first; k < c.first + c.count; ++k) entries_[std::size_t(k)].Bs = T(B * entries_[std::size_t(k)].eps / c.eps);
   }
   // Bulk cells grouped by the span that updates them (offsets in order of first touch).
   for (const Cell& c : cells_) {
@@ -243,10 +255,7 @@ void Psm<L, T>::set_particles(const ParticleSet& p) {
   }
   bulk_.resize(std::size_t(nbulk));
   for (std::size_t i = 0; i < cells_.size(); ++i) {
-    Cell& c = cells_[i];
-    const double B = psm_weight(std::min(1.0, c.eps), tau_);
-    c.B = T(B);
-    for (std::int32_t k = c.first; k < c.first + c.count; ++k) entries_[std::size_t(k)].Bs = T(B * entries_[std::size_t(k)].eps / c.eps);
+    const Cell& c = cells_[i];
     if (c.boundary) continue;
     const std::int32_t sp = span_of_[std::size_t(c.cell)];
     bulk_[std::size_t(span_first_[std::size_t(sp)] + span_count_[std::size_t(sp)]++)] = BulkCell{c.cell, std::int32_t(i), c.edge};
