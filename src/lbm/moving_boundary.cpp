@@ -308,10 +308,13 @@ void MovingBoundary<L, T>::link_motion(MovingLink& k, const ParticleSet& p) cons
     const double disc = std::max(0.0, b * b - cc * e);
     delta = std::clamp((b - std::sqrt(disc)) / cc, 0.0, 1.0);
   }
-  k.delta = T(delta);
-  k.arm = ax - delta * c;
-  const Vec3 uw = p.velocity[s] + w.cross(k.arm);
-  for (int a = 0; a < 3; ++a) k.uw[a] = T(a < D ? uw[a] : 0.0);
+  k.delta = delta;
+  const Vec3 arm = ax - delta * c;  // x_w minus the particle centre (reduce() recomputes it)
+  const Vec3 uw = p.velocity[s] + w.cross(arm);
+  T u[3];
+  for (int a = 0; a < 3; ++a) u[a] = T(a < D ? uw[a] : 0.0);
+  const T cu = L::c[q][0] * u[0] + L::c[q][1] * u[1] + L::c[q][2] * u[2];
+  k.mw = T(6 * L::w[q]) * cu;
 }
 
 template <class L, class T>
@@ -322,7 +325,7 @@ void MovingBoundary<L, T>::add_links(std::int32_t solid, const ParticleSet& p) {
     if (!fluid_now(xc)) continue;
     MovingLink k;
     const auto xs = grid_.coords(xc);
-    for (int a = 0; a < 3; ++a) k.x[a] = xs[a];
+    const int kx[3] = {xs[0], xs[1], xs[2]};
     k.q = std::uint8_t(q);
     k.particle = sc.particle;
     k.solid = solid;
@@ -330,13 +333,13 @@ void MovingBoundary<L, T>::add_links(std::int32_t solid, const ParticleSet& p) {
     k.has_second = fluid_now(second);
     link_motion(k, p);
     const int o = L::opp[q];
-    const int x2[3] = {grid_.step(k.x[0], L::c[q][0], 0), grid_.step(k.x[1], L::c[q][1], 1),
-                       grid_.step(k.x[2], L::c[q][2], 2)};
+    const int x2[3] = {grid_.step(kx[0], L::c[q][0], 0), grid_.step(kx[1], L::c[q][1], 1),
+                       grid_.step(kx[2], L::c[q][2], 2)};
     for (int odd = 0; odd < 2; ++odd) {
-      k.slot[odd][0] = post(k.x, o, odd);
-      k.slot[odd][1] = post(k.x, q, odd);
+      k.slot[odd][0] = post(kx, o, odd);
+      k.slot[odd][1] = post(kx, q, odd);
       k.slot[odd][2] = post(x2, o, odd);
-      k.slot[odd][3] = pre(k.x, q, !odd);
+      k.slot[odd][3] = pre(kx, q, !odd);
     }
     new_links_.push_back(k);
   }
@@ -398,9 +401,7 @@ void MovingBoundary<L, T>::apply(T* f, bool odd) {
       B = f[sl[1]];  // g*_q(x, t)
       C = f[sl[2]];  // g*_o(x + c_q, t)
     }
-    const T cu = L::c[q][0] * k.uw[0] + L::c[q][1] * k.uw[1] + L::c[q][2] * k.uw[2];
-    const T mw = T(6 * L::w[q]) * cu;
-    const T g = reflect<T>(ws, k.delta, k.has_second, A, B, C, mw);
+    const T g = reflect<T>(ws, T(k.delta), k.has_second, A, B, C, k.mw);
     f[sl[3]] = g;
     for (int a = 0; a < 3; ++a) link_force_[3 * std::size_t(l) + std::size_t(a)] = double(L::c[o][a]) * (double(A) + double(g));
   }
@@ -429,8 +430,13 @@ void MovingBoundary<L, T>::reduce() {
   for (std::size_t l = 0; l < links_.size(); ++l) {
     const MovingLink& k = links_[l];
     const Vec3 F(link_force_[3 * l], link_force_[3 * l + 1], link_force_[3 * l + 2]);
+    // The wall point x_w - X as link_motion() computed it.
+    const int q = k.q;
+    const Vec3 c(L::c[q][0], L::c[q][1], L::D == 3 ? L::c[q][2] : 0);
+    const Vec3 ax = cells_[std::size_t(k.solid)].arm + c;
+    const Vec3 arm = ax - k.delta * c;
     force_[std::size_t(k.particle)] += F;
-    torque_[std::size_t(k.particle)] += k.arm.cross(F);
+    torque_[std::size_t(k.particle)] += arm.cross(F);
   }
 }
 

@@ -110,15 +110,15 @@ class MovingBoundary {
     T us[3];           // particle velocity at the cell centre
     bool edge;         // on a periodic lattice edge: neighbours wrap (slow path)
   };
+  // 96 bytes (double): apply(), the links' update and reduce() each stream the whole array, so
+  // what can be recomputed from the solid cell is not stored (the fluid node, the wall point).
   struct MovingLink {
-    int x[3];          // fluid cell
-    std::uint8_t q;    // incoming direction: x - c_q is solid
+    std::uint8_t q;    // incoming direction: the fluid node x = solid cell + c_q
     bool has_second;   // x + c_q is fluid
     std::int32_t particle;
     std::int32_t solid;  // its solid cell (index into cells_)
-    T delta;           // wall fraction along the link from x
-    T uw[3];           // wall velocity at x_w
-    Vec3 arm;          // x_w minus particle centre
+    double delta;      // wall fraction along the link from x (x_w = x - delta c_q)
+    T mw;              // moving-wall term 6 w_q c_q . u_w, u_w the wall velocity at x_w
     // Slots per step parity: g*_o(x), g*_q(x), g*_o(x + c_q) of this step, g_q(x) of the next.
     CellIndex slot[2][4];
   };
