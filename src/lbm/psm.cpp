@@ -206,13 +206,12 @@ void Psm<L, T>::set_particles(const ParticleSet& p) {
   // 2. Cells in order of first touch, entries in particle order (serial, one lookup per entry).
   std::size_t nentries = 0;
   for (std::size_t ch = 0; ch < nchunk; ++ch) {
-    for (Candidate& cd : chunk_[ch]) {
+    for (const Candidate& cd : chunk_[ch]) {
       std::int32_t& sl = slot_[std::size_t(cd.cell)];
       if (sl < 0) {
         sl = std::int32_t(cells_.size());
         cells_.push_back(Cell{cd.cell, 0, 0, 0.0, T(0), cd.boundary, cd.edge});
       }
-      cd.e.slot = sl;
       ++cells_[std::size_t(sl)].count;
       cells_[std::size_t(sl)].eps += cd.e.eps;
     }
@@ -229,8 +228,11 @@ void Psm<L, T>::set_particles(const ParticleSet& p) {
   entries_.resize(nentries);
   for (std::size_t ch = 0; ch < nchunk; ++ch)
     for (const Candidate& cd : chunk_[ch]) {
-      Cell& c = cells_[std::size_t(cd.e.slot)];
-      entries_[std::size_t(c.first + c.count++)] = cd.e;
+      const std::int32_t sl = slot_[std::size_t(cd.cell)];
+      Cell& c = cells_[std::size_t(sl)];
+      Entry& e = entries_[std::size_t(c.first + c.count++)];
+      e = cd.e;
+      e.slot = sl;
     }
   // The weights B and B_s, cell by cell (each cell writes its own entries).
   const std::int64_t ncell = std::int64_t(cells_.size());
