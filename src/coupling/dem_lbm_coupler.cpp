@@ -127,6 +127,8 @@ template <class L, class T>
 void DemLbmCoupler<L, T>::pressure_loads() {
   const auto& g = fluid_.grid();
   const auto& p = dem_.particles;
+  // Each particle writes its own load: in parallel, the same result on any thread count.
+#pragma omp parallel for schedule(dynamic, 64) if (p.size() > 1024)
   for (std::size_t i = 0; i < p.size(); ++i) {
     dry_force_[i] = Vec3::Zero();
     if (!has_dry_[i]) continue;
@@ -167,8 +169,12 @@ void DemLbmCoupler<L, T>::step(bool sample_fluid) {
   if (set_.size() != p.size()) resize(p.size());  // particles added or removed (not in a plain run)
   build_set();
   bool any_dry = false;
+  // Each particle writes its own flag: in parallel, the same result on any thread count.
+  const std::int64_t np = std::int64_t(p.size());
   if (cs_.pressure_load)
-    for (std::size_t i = 0; i < p.size(); ++i) {
+#pragma omp parallel for schedule(static) reduction(|| : any_dry) if (np > 1024)
+    for (std::int64_t ii = 0; ii < np; ++ii) {
+      const std::size_t i = std::size_t(ii);
       char d = 0;
       const double rl = set_.radius[i];
       for (std::size_t k = 0; k < qn_.size() && !d; ++k) d = dry(set_.position[i] + rl * qn_[k]) ? 1 : 0;

@@ -37,8 +37,12 @@
 // solid cell to f^eq(1, u_s) (cost proportional to covered cells), so solid cells hold finite values
 // and their sampled moments are the particle's velocity. This works because in the AA pattern
 // every slot a fluid cell reads at t+1 is written by the post-pass after every cell of step t has
-// run. set_particles() visits each particle's bounding box and the cells of the previous set:
-// the cost of a change is proportional to the cells involved, never to the lattice.
+// run. set_particles() visits the rows of each particle's bounding box that it can cover and the
+// cells of the previous set: the cost is proportional to the covered cells, never to the lattice.
+// Links are rebuilt only for the particles whose solid cells changed or lie within two lattice
+// steps of a cell that changed; the others keep their nodes and slots and only move (new wall
+// fraction and velocity), with the same arithmetic, so the result does not depend on which
+// particles were rebuilt (benchmarks/coupled checks the populations against the full rebuild).
 //
 // Resume: the solid cells of the last step are state (the refill of the next change depends on
 // them). A resumed run calls Solver::restore() and then Solver::restore_particles() with the set
@@ -106,21 +110,25 @@ class MovingBoundary {
     T us[3];           // particle velocity at the cell centre
     bool edge;         // on a periodic lattice edge: neighbours wrap (slow path)
   };
+  // 96 bytes (double): apply(), the links' update and reduce() each stream the whole array, so
+  // what can be recomputed from the solid cell is not stored (the fluid node, the wall point).
   struct MovingLink {
-    int x[3];          // fluid cell
-    std::uint8_t q;    // incoming direction: x - c_q is solid
+    std::uint8_t q;    // incoming direction: the fluid node x = solid cell + c_q
     bool has_second;   // x + c_q is fluid
     std::int32_t particle;
-    T delta;           // wall fraction along the link from x
-    T uw[3];           // wall velocity at x_w
-    Vec3 arm;          // x_w minus particle centre
+    std::int32_t solid;  // its solid cell (index into cells_)
+    double delta;      // wall fraction along the link from x (x_w = x - delta c_q)
+    T mw;              // moving-wall term 6 w_q c_q . u_w, u_w the wall velocity at x_w
     // Slots per step parity: g*_o(x), g*_q(x), g*_o(x + c_q) of this step, g_q(x) of the next.
     CellIndex slot[2][4];
   };
   CellIndex pre(const int* x, int q, bool odd) const;   // slot g_q is read from in a step of parity odd
   CellIndex post(const int* x, int q, bool odd) const;  // slot g*_q is written to
   bool fluid_now(CellIndex c) const { return fluid_[std::size_t(c)] && owner_[std::size_t(c)] < 0; }
-  void build_links(const ParticleSet& p);
+  void build_links(const ParticleSet& p, bool incremental);
+  void add_links(std::int32_t solid, const ParticleSet& p);  // the links of one solid cell
+  void link_motion(MovingLink& k, const ParticleSet& p) const;  // delta, arm, u_w of a link
+  void mark_dirty(CellIndex changed);  // particles whose links may see a changed cell
 
   Grid grid_;
   ParticleScheme scheme_;
@@ -130,7 +138,17 @@ class MovingBoundary {
   std::vector<std::int32_t> owner_;   // per padded cell: index into cells_ of the current set, -1 if fluid
   std::vector<std::int32_t> next_;    // per padded cell: scratch for the new set
   std::vector<SolidCell> cells_, new_cells_;
-  std::vector<MovingLink> links_;
+  std::vector<MovingLink> links_, new_links_;
+  // Incremental links: per particle its range in cells_ (cfirst_/ccount_; nfirst_/ncount_ for
+  // new_cells_) and in links_; a particle is dirty when its cells or a cell within two lattice
+  // steps of them changed, and only dirty particles rebuild their links.
+  std::vector<std::int32_t> cfirst_, ccount_, nfirst_, ncount_, lfirst_, lcount_, nlfirst_, nlcount_;
+  std::vector<std::uint8_t> dirty_;
+  // The cell indices of cells_ / new_cells_ alone (the passes over every solid cell read only
+  // these), and the cells that turned solid (in new_cells_) and fluid (in cells_) in this set.
+  std::vector<CellIndex> cell_, new_cell_;
+  std::vector<std::int32_t> covered_, uncovered_;
+  bool links_valid_ = false;          // links_ belong to cells_ (false after set_fluid_mask())
   std::vector<double> link_force_;    // 3 per link
   std::vector<Vec3> impulse_, impulse_torque_;  // per particle, from covering and refill
   std::vector<Vec3> force_, torque_;

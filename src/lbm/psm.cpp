@@ -42,6 +42,16 @@ double box_below_plane(const double* m, int k, double a) {
   return std::clamp(acc / (fact * prod), 0.0, 1.0);
 }
 
+// Cell coordinate v on an axis of n cells: wrapped if periodic (v is within a period of the
+// box for particles near it; far ones take the modulo), -1 when outside a closed axis.
+inline int wrap_axis(int v, int n, bool periodic) {
+  if (v >= 0 && v < n) return v;
+  if (!periodic) return -1;
+  if (v < 0 && v >= -n) return v + n;
+  if (v >= n && v < 2 * n) return v - n;
+  return ((v % n) + n) % n;
+}
+
 }  // namespace
 
 double psm_cell_fraction(int dim, const Vec3& d, double r) {
@@ -85,7 +95,7 @@ Psm<L, T>::Psm(const Grid& grid, double tau) : grid_(grid), tau_(tau) {
 // AA pattern: g_q before the step is in f[q][x] (even) or f[opp q][x - c_q] (odd); the kernel
 // writes g*_q to f[opp q][x] (even) or f[q][x + c_q] (odd).
 template <class L, class T>
-void Psm<L, T>::slots(const BulkCell& b, bool odd, CellIndex* pre, CellIndex* post) const {
+FF_LBM_INLINE void Psm<L, T>::slots(const BulkCell& b, bool odd, CellIndex* pre, CellIndex* post) const {
   if (!b.edge) {
     for (int q = 0; q < Q; ++q) {
       pre[q] = b.cell + pre_[odd][q];
@@ -112,14 +122,9 @@ void Psm<L, T>::set_particles(const ParticleSet& p) {
                                  "omega {}, id {}): all must have one entry per particle (id may be empty)",
                                  np, p.position.size(), p.velocity.size(), p.omega.size(), p.id.size()));
   if (np >= std::size_t(INT32_MAX)) throw InputError("PSM particle set: more than 2^31 - 1 particles");
-  if (slot_.empty()) slot_.assign(std::size_t(grid_.padded_size()), -1);
-  for (const Cell& c : cells_) slot_[std::size_t(c.cell)] = -1;
-  for (const std::int32_t sp : touched_) span_count_[std::size_t(sp)] = 0;
-  touched_.clear();
-  cells_.clear();
-  raw_.clear();
   const int D = L::D;
   const int n[3] = {grid_.nx, grid_.ny, grid_.nz};
+  // Checked before anything changes, so that bad input leaves the current set intact.
   for (std::size_t s = 0; s < np; ++s) {
     const Vec3& X = p.position[s];
     const double r = p.radius[s];
@@ -129,59 +134,114 @@ void Psm<L, T>::set_particles(const ParticleSet& p) {
       throw InputError(fmt::format("PSM particle {} (id {}): radius {} at ({}, {}, {}) must be finite and positive "
                                    "(and below half the lattice along a periodic axis), position finite",
                                    s, p.id.empty() ? s : p.id[s], r, X[0], X[1], X[2]));
-    int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
-    for (int a = 0; a < D; ++a) {
-      // Cell x spans [x - 1/2, x + 1/2]: it meets the particle for x in [X - r - 1/2, X + r + 1/2].
-      lo[a] = int(std::ceil(X[a] - r - 0.5));
-      hi[a] = int(std::floor(X[a] + r + 0.5));
-    }
-    const Vec3& v = p.velocity[s];
-    const Vec3 w = D == 3 ? p.omega[s] : Vec3(0, 0, p.omega[s][2]);
-    for (int z = lo[2]; z <= hi[2]; ++z)
-      for (int y = lo[1]; y <= hi[1]; ++y)
-        for (int x = lo[0]; x <= hi[0]; ++x) {
-          int c[3] = {x, y, z};
-          bool inside = true;
-          for (int a = 0; a < D; ++a) {
-            if (grid_.periodic[a]) c[a] = ((c[a] % n[a]) + n[a]) % n[a];
-            else inside = inside && c[a] >= 0 && c[a] < n[a];
-          }
-          if (!inside) continue;
-          const CellIndex ci = grid_.index(c[0], c[1], c[2]);
-          const std::int32_t span = span_of_[std::size_t(ci)];
-          if (span == kNotFluid) continue;
-          const Vec3 arm = D == 3 ? Vec3(x - X[0], y - X[1], z - X[2]) : Vec3(x - X[0], y - X[1], 0);
-          const double eps = psm_cell_fraction(D, arm, r);
-          if (eps <= 0) continue;
-          std::int32_t& sl = slot_[std::size_t(ci)];
-          if (sl < 0) {
-            sl = std::int32_t(cells_.size());
-            cells_.push_back(Cell{ci, 0, 0, 0.0, T(0), span == kBoundaryCell});
-          }
-          Entry e;
-          e.slot = sl;
-          e.particle = std::int32_t(s);
-          e.eps = eps;
-          e.Bs = 0;
-          const Vec3 us = v + w.cross(arm);
-          for (int a = 0; a < 3; ++a) e.us[a] = T(a < D ? us[a] : 0.0);
-          e.arm = arm;
-          raw_.push_back(e);
-          ++cells_[std::size_t(sl)].count;
-          cells_[std::size_t(sl)].eps += eps;
-        }
   }
-  // Group the entries by cell (counting sort, stable: particle order within a cell).
+  if (slot_.empty()) slot_.assign(std::size_t(grid_.padded_size()), -1);
+  for (const Cell& c : cells_) slot_[std::size_t(c.cell)] = -1;
+  for (const std::int32_t sp : touched_) span_count_[std::size_t(sp)] = 0;
+  touched_.clear();
+  cells_.clear();
+  // 1. The covered fractions, particle by particle, in parallel: fixed chunks of consecutive
+  //    particles (independent of the thread count), each into its own buffer, which step 2 reads
+  //    in chunk order, i.e. in particle order as a serial loop would.
+  const std::size_t nchunk = std::min<std::size_t>(kChunks, np);
+  if (chunk_.size() < nchunk) chunk_.resize(nchunk);
+  const double half_diag = D == 3 ? std::sqrt(0.75) : std::sqrt(0.5);
+#pragma omp parallel for schedule(dynamic, 1) if (np > 256)
+  for (std::int64_t ch = 0; ch < std::int64_t(nchunk); ++ch) {
+    std::vector<Candidate>& out = chunk_[std::size_t(ch)];
+    out.clear();
+    const std::size_t s0 = std::size_t(ch) * np / nchunk, s1 = std::size_t(ch + 1) * np / nchunk;
+    for (std::size_t s = s0; s < s1; ++s) {
+      const Vec3& X = p.position[s];
+      const double r = p.radius[s];
+      int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+      for (int a = 0; a < D; ++a) {
+        // Cell x spans [x - 1/2, x + 1/2]: it meets the particle for x in [X - r - 1/2, X + r + 1/2].
+        lo[a] = int(std::ceil(X[a] - r - 0.5));
+        hi[a] = int(std::floor(X[a] + r + 0.5));
+      }
+      // Along x only the cells within r + half a cell diagonal of the centre can be covered
+      // (psm_cell_fraction() is 0 beyond): a row visits that range, not the whole box.
+      const double reach2 = (r + half_diag) * (r + half_diag);
+      const Vec3& v = p.velocity[s];
+      const Vec3 w = D == 3 ? p.omega[s] : Vec3(0, 0, p.omega[s][2]);
+      for (int z = lo[2]; z <= hi[2]; ++z)
+        for (int y = lo[1]; y <= hi[1]; ++y) {
+          const double dy = y - X[1], dz = D == 3 ? z - X[2] : 0.0;
+          const double rest = reach2 - dy * dy - dz * dz;
+          if (rest < -1e-9) continue;  // (margins: rounding never drops a covered cell)
+          const double half = std::sqrt(std::max(rest, 0.0)) + 1e-9;
+          const int x0 = std::max(lo[0], int(std::floor(X[0] - half))), x1 = std::min(hi[0], int(std::ceil(X[0] + half)));
+          const int cy = wrap_axis(y, n[1], grid_.periodic[1]), cz = D == 3 ? wrap_axis(z, n[2], grid_.periodic[2]) : 0;
+          if (cy < 0 || cz < 0) continue;
+          // On a periodic lattice edge the neighbours wrap (slow path of the slots).
+          const bool edge_yz = (grid_.periodic[1] && (cy == 0 || cy == n[1] - 1)) ||
+                               (D == 3 && grid_.periodic[2] && (cz == 0 || cz == n[2] - 1));
+          for (int x = x0; x <= x1; ++x) {
+            const int cx = wrap_axis(x, n[0], grid_.periodic[0]);
+            if (cx < 0) continue;
+            const CellIndex ci = grid_.index(cx, cy, cz);
+            const std::int32_t span = span_of_[std::size_t(ci)];
+            if (span == kNotFluid) continue;
+            const Vec3 arm = D == 3 ? Vec3(x - X[0], y - X[1], z - X[2]) : Vec3(x - X[0], y - X[1], 0);
+            const double eps = psm_cell_fraction(D, arm, r);
+            if (eps <= 0) continue;
+            Candidate cd;
+            cd.cell = ci;
+            cd.boundary = span == kBoundaryCell;
+            cd.edge = edge_yz || (grid_.periodic[0] && (cx == 0 || cx == n[0] - 1));
+            Entry& e = cd.e;
+            e.slot = -1;
+            e.particle = std::int32_t(s);
+            e.eps = eps;
+            e.Bs = 0;
+            const Vec3 us = v + w.cross(arm);
+            for (int a = 0; a < 3; ++a) e.us[a] = T(a < D ? us[a] : 0.0);
+            e.arm = arm;
+            out.push_back(cd);
+          }
+        }
+    }
+  }
+  // 2. Cells in order of first touch, entries in particle order (serial, one lookup per entry).
+  std::size_t nentries = 0;
+  for (std::size_t ch = 0; ch < nchunk; ++ch) {
+    for (const Candidate& cd : chunk_[ch]) {
+      std::int32_t& sl = slot_[std::size_t(cd.cell)];
+      if (sl < 0) {
+        sl = std::int32_t(cells_.size());
+        cells_.push_back(Cell{cd.cell, 0, 0, 0.0, T(0), cd.boundary, cd.edge});
+      }
+      ++cells_[std::size_t(sl)].count;
+      cells_[std::size_t(sl)].eps += cd.e.eps;
+    }
+    nentries += chunk_[ch].size();
+  }
+  // Group the entries by cell (counting sort, stable: particle order within a cell), straight
+  // from the chunk buffers.
   std::int32_t off = 0;
   for (Cell& c : cells_) {
     c.first = off;
     off += c.count;
     c.count = 0;
   }
-  entries_.resize(raw_.size());
-  for (const Entry& e : raw_) {
-    Cell& c = cells_[std::size_t(e.slot)];
-    entries_[std::size_t(c.first + c.count++)] = e;
+  entries_.resize(nentries);
+  for (std::size_t ch = 0; ch < nchunk; ++ch)
+    for (const Candidate& cd : chunk_[ch]) {
+      const std::int32_t sl = slot_[std::size_t(cd.cell)];
+      Cell& c = cells_[std::size_t(sl)];
+      Entry& e = entries_[std::size_t(c.first + c.count++)];
+      e = cd.e;
+      e.slot = sl;
+    }
+  // The weights B and B_s, cell by cell (each cell writes its own entries).
+  const std::int64_t ncell = std::int64_t(cells_.size());
+#pragma omp parallel for schedule(static) if (ncell > 16384)
+  for (std::int64_t i = 0; i < ncell; ++i) {
+    Cell& c = cells_[std::size_t(i)];
+    const double B = psm_weight(std::min(1.0, c.eps), tau_);
+    c.B = T(B);
+    for (std::int32_t k = c.first; k < c.first + c.count; ++k) entries_[std::size_t(k)].Bs = T(B * entries_[std::size_t(k)].eps / c.eps);
   }
   // Bulk cells grouped by the span that updates them (offsets in order of first touch).
   for (const Cell& c : cells_) {
@@ -197,16 +257,10 @@ void Psm<L, T>::set_particles(const ParticleSet& p) {
   }
   bulk_.resize(std::size_t(nbulk));
   for (std::size_t i = 0; i < cells_.size(); ++i) {
-    Cell& c = cells_[i];
-    const double B = psm_weight(std::min(1.0, c.eps), tau_);
-    c.B = T(B);
-    for (std::int32_t k = c.first; k < c.first + c.count; ++k) entries_[std::size_t(k)].Bs = T(B * entries_[std::size_t(k)].eps / c.eps);
+    const Cell& c = cells_[i];
     if (c.boundary) continue;
-    const auto x = grid_.coords(c.cell);
-    bool edge = false;
-    for (int a = 0; a < L::D; ++a) edge = edge || (grid_.periodic[a] && (x[a] == 0 || x[a] == grid_.n(a) - 1));
     const std::int32_t sp = span_of_[std::size_t(c.cell)];
-    bulk_[std::size_t(span_first_[std::size_t(sp)] + span_count_[std::size_t(sp)]++)] = BulkCell{c.cell, std::int32_t(i), edge};
+    bulk_[std::size_t(span_first_[std::size_t(sp)] + span_count_[std::size_t(sp)]++)] = BulkCell{c.cell, std::int32_t(i), c.edge};
   }
   gpre_.resize(std::size_t(Q) * bulk_.size());
   entry_force_.assign(3 * entries_.size(), 0.0);

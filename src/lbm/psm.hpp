@@ -25,8 +25,10 @@
 // Zaleski 2000, J. Comput. Phys. 164:228). Measured against 64^2 / 32^3 sub-cell
 // sampling: total covered volume within 0.1% for r >= 3 cells, each cell within 0.02 (test_psm).
 //
-// Cost: each step clears the cells of the previous particle set and visits each particle's
-// bounding box; nothing sweeps the lattice. Bulk cells that a particle covers keep the bulk
+// Cost: each step clears the cells of the previous particle set and visits, in each row of a
+// particle's bounding box, only the cells within r + half a cell diagonal of its centre; nothing
+// sweeps the lattice. The fractions are computed in parallel over fixed chunks of particles and
+// gathered in particle order, so the cells and entries are the same on any thread count. Bulk cells that a particle covers keep the bulk
 // kernel (untouched, so cells with B = 0 keep its speed): inside the bulk sweep, a span's covered
 // cells save their pre-collision populations right before the kernel runs the span, and the PSM
 // update is applied to the kernel's result right after, g_new = (1 - B) g* + B g + sum_s B_s
@@ -109,6 +111,7 @@ class Psm {
     double eps = 0;                     // sum of the particles' fractions (before the cap at 1)
     T B = 0;
     bool boundary = false;
+    bool edge = false;  // on a periodic lattice edge
   };
   struct Entry {
     std::int32_t slot;      // cell
@@ -125,7 +128,14 @@ class Psm {
   std::vector<std::int32_t> touched_;    // spans with covered cells (cleared by the next set)
   std::vector<std::int32_t> slot_;   // per padded cell: index into cells_, -1 if uncovered
   std::vector<Cell> cells_;
-  std::vector<Entry> raw_, entries_; // in particle order; grouped by cell
+  std::vector<Entry> entries_;       // grouped by cell, particle order within a cell
+  struct Candidate {                 // an entry before its cell has a slot (set_particles, step 1)
+    CellIndex cell;
+    bool boundary, edge;
+    Entry e;
+  };
+  static constexpr std::size_t kChunks = 64;  // particle chunks of the parallel fraction pass
+  std::vector<std::vector<Candidate>> chunk_;
   struct BulkCell {
     CellIndex cell;
     std::int32_t slot;
