@@ -30,6 +30,8 @@ test-long: build
 bench: build
 	@$(BUILD)/benchmarks/dem_ucs
 	@$(BUILD)/benchmarks/lbm
+	@$(BUILD)/benchmarks/coupled
+	@$(BUILD)/benchmarks/porenet
 
 clean:
 	rm -rf $(BUILD)

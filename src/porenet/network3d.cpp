@@ -112,8 +112,6 @@ Network2D build_network_3d(const Particles3D& p, const NetworkParams& params, Re
     if (!(p.radius[k] > 0)) throw InputError(fmt::format("porenet: particle {} has radius {}; must be > 0", k, p.radius[k]));
   if (!(pfv_factor > 0)) throw InputError(fmt::format("porenet: pfv_factor = {}; must be > 0", pfv_factor));
   auto gid = [&](Index k) -> std::int64_t { return p.gid.empty() ? k : p.gid[k]; };
-  auto pos = [&](Index k) { return V3{p.x[k], p.y[k], p.z[k]}; };
-
   Network2D net;
   net.dim = 3;
   net.params = params;

@@ -54,7 +54,6 @@ PressureSystem::PressureSystem(const Network2D& net) : n_(net.n_pores()) {
 
 void PressureSystem::setup_preconditioner(Preconditioner pc) {
   const Real* val = A_.valuePtr();
-  const auto* outer = A_.outerIndexPtr();
   const auto* inner = A_.innerIndexPtr();
   if (pc == Preconditioner::Jacobi) {
     for (Index i = 0; i < n_; ++i) pivot_[i] = 1 / val[diag_pos_[i]];
@@ -79,7 +78,6 @@ void PressureSystem::apply_preconditioner(Preconditioner pc, const std::vector<R
     return;
   }
   const Real* val = A_.valuePtr();
-  const auto* outer = A_.outerIndexPtr();
   const auto* inner = A_.innerIndexPtr();
   const Index nb = (n_ + kDicBlock - 1) / kDicBlock;
 #pragma omp parallel for schedule(static) if (nb > 1)

@@ -391,7 +391,9 @@ TEST(Coupler, PressureDifferenceAcrossParticleWallInWalledChannelLoadsTheWalls) 
   for (const auto& [t, F, want, Fw] : s) {
     std::printf("walled channel, step %.0f: F_x disks = %.5g N/m, channel walls = %.5g N/m, sum %.5g, "
                 "(p_L - p_R) H = %.5g N/m\n", t, F, Fw, F + Fw, want);
-    if (t >= 600) EXPECT_LT(std::abs((F + Fw) / want - 1), 0.03) << "step " << t;
+    if (t >= 600) {
+      EXPECT_LT(std::abs((F + Fw) / want - 1), 0.03) << "step " << t;
+    }
   }
   EXPECT_LT(s.back()[1], 0.05 * s.back()[2]);
   EXPECT_GT(s.back()[2], 0.2 * s.front()[2]) << "the difference is held";
