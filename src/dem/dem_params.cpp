@@ -15,7 +15,8 @@ void declare_dem_params(ParamTable& t) {
   t.integer("dem.dim", 3, "-", "space dimension: 3 = spheres, 2 = disks of unit thickness in the x-y plane").range(2, 3);
   // The laws' names come from their registry (laws.hpp); each law declares its own keys below.
   t.string("dem.contact_law", "linear", "contact law between particles and with walls").one_of(law_name_list(ContactLaws{}));
-  t.string("dem.bond_law", "parallel", "bond law: parallel (Potyondy & Cundall 2004), rotational (Wang & Mora 6-DOF), none")
+  t.string("dem.bond_law", "parallel", "bond law: parallel (Potyondy & Cundall 2004), rotational (Wang & Mora 6-DOF), cohesive (seed 004's A1-A7, with "
+           "dem.contact_law = \"cohesive\"), none")
       .one_of(law_name_list(BondLaws{}));
   t.real("dem.local_damping", 0.7, "-", "Cundall local damping coefficient (PFC default 0.7)").range(0, 1).below(1);
   t.real("dem.normal_damping_ratio", 0.0, "-", "viscous normal dashpot as a fraction of critical damping").range(0, 1);

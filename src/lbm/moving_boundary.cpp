@@ -12,20 +12,6 @@
 
 namespace ff::lbm {
 
-namespace {
-
-// Cell coordinate v on an axis of n cells: wrapped if periodic (v is within a period of the
-// box for particles near it; far ones take the modulo), -1 when outside a closed axis.
-inline int wrap_axis(int v, int n, bool periodic) {
-  if (v >= 0 && v < n) return v;
-  if (!periodic) return -1;
-  if (v < 0 && v >= -n) return v + n;
-  if (v >= n && v < 2 * n) return v - n;
-  return ((v % n) + n) % n;
-}
-
-}  // namespace
-
 const char* particle_scheme_name(ParticleScheme s) {
   switch (s) {
     case ParticleScheme::Psm: return "psm";

@@ -13,7 +13,6 @@ namespace ff::lbm {
 
 namespace {
 
-
 // Volume of {xi in [0,1]^k : m . xi <= a} for m_i > 0 (inclusion-exclusion over the corners of
 // the cube: each corner v cuts off the simplex (a - m.v)^k / (k! prod m), signed by its parity).
 double box_below_plane(const double* m, int k, double a) {
@@ -40,16 +39,6 @@ double box_below_plane(const double* m, int k, double a) {
     acc += (bits % 2 == 0) ? p : -p;
   }
   return std::clamp(acc / (fact * prod), 0.0, 1.0);
-}
-
-// Cell coordinate v on an axis of n cells: wrapped if periodic (v is within a period of the
-// box for particles near it; far ones take the modulo), -1 when outside a closed axis.
-inline int wrap_axis(int v, int n, bool periodic) {
-  if (v >= 0 && v < n) return v;
-  if (!periodic) return -1;
-  if (v < 0 && v >= -n) return v + n;
-  if (v >= n && v < 2 * n) return v - n;
-  return ((v % n) + n) % n;
 }
 
 }  // namespace
