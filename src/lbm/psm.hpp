@@ -94,7 +94,13 @@ class Psm {
   void apply_span(std::int64_t span, T* f, bool odd, const Relax<T>& r, bool force, bool incomp);
   // One cell: g holds the kernel's post-collision populations, gpre the pre-collision ones.
   void apply(std::int32_t slot, const T* gpre, T* g, const Relax<T>& r, bool force, bool incomp);
-  void reduce();  // per-particle force and torque of the step, in entry order
+  void reduce();  // per-particle force and torque of the step (fixed order per particle)
+  // The tangential part Ft of a wall link's momentum exchange in `cell` (Solver::reduce_forces,
+  // after reduce(), in link order): B_s Ft goes to each particle s covering the cell (torque with
+  // the cell's arm); returns the sum handed out, B Ft (zero if the cell is uncovered).
+  Vec3 book_wall_link(CellIndex cell, const Vec3& Ft);
+  // Per particle, the part of forces() booked from wall links in the last step.
+  const std::vector<Vec3>& wall_link_forces() const { return wall_force_; }
 
   // ---- results of the last step, lattice units, indexed like the ParticleSet
   const std::vector<Vec3>& forces() const { return force_; }
@@ -114,11 +120,9 @@ class Psm {
     bool edge = false;  // on a periodic lattice edge
   };
   struct Entry {
-    std::int32_t slot;      // cell
     std::int32_t particle;
-    double eps;
     T Bs;                   // B_s
-    T us[3];                // particle velocity at the cell centre
+    double eps;
     Vec3 arm;               // cell centre minus particle centre (unwrapped)
   };
   Grid grid_;
@@ -126,16 +130,27 @@ class Psm {
   std::vector<std::int32_t> span_of_;    // per padded cell (set_cell_spans)
   std::vector<std::int32_t> span_first_, span_count_;  // per span: its covered cells in bulk_
   std::vector<std::int32_t> touched_;    // spans with covered cells (cleared by the next set)
-  std::vector<std::int32_t> slot_;   // per padded cell: index into cells_, -1 if uncovered
-  std::vector<Cell> cells_;
+  // Per padded cell: index into cells_, -1 if uncovered; while set_particles() counts the
+  // entries of a cell, -1 - count.
+  std::vector<std::int32_t> slot_;
+  std::vector<std::int32_t> row_lo_, row_hi_;  // per lattice row (y, z): x range touched (set_particles)
+  std::vector<Cell> cells_;          // in lattice order (x fastest), so that the sweep reads them in order
   std::vector<Entry> entries_;       // grouped by cell, particle order within a cell
   struct Candidate {                 // an entry before its cell has a slot (set_particles, step 1)
     CellIndex cell;
-    bool boundary, edge;
-    Entry e;
+    std::int32_t particle, row, x;
+    double eps;
+    Vec3 arm;
   };
   static constexpr std::size_t kChunks = 64;  // particle chunks of the parallel fraction pass
   std::vector<std::vector<Candidate>> chunk_;
+  struct Kinematics {
+    Vec3 v, w;
+  };
+  std::vector<Kinematics> kin_;
+  // Per particle: its entries, pentry_[pfirst_[s] .. pfirst_[s + 1]) (in the order its cells were
+  // visited), so that reduce() sums each particle's force alone, in parallel and in a fixed order.
+  std::vector<std::int32_t> pfirst_, pentry_;      // per particle: velocity and angular velocity (u_s = v + w x arm)
   struct BulkCell {
     CellIndex cell;
     std::int32_t slot;
@@ -148,7 +163,7 @@ class Psm {
   void slots(const BulkCell& b, bool odd, CellIndex* pre, CellIndex* post) const;
   std::vector<T> gpre_;              // Q per bulk cell: pre-collision populations
   std::vector<double> entry_force_;  // 3 per entry
-  std::vector<Vec3> force_, torque_;
+  std::vector<Vec3> force_, torque_, wall_force_;
 };
 
 extern template class Psm<D2Q9, double>;

@@ -470,6 +470,7 @@ const std::vector<Vec3>& Solver<L, T>::particle_torques() const {
 }
 
 // Sums the link forces per object in link order: the same result on any thread count.
+// Runs after Psm::reduce(), which it adds the particles' share of covered cells' wall links to.
 template <class L, class T>
 void Solver<L, T>::reduce_forces() {
   for (auto& o : objects_) {
@@ -481,7 +482,21 @@ void Solver<L, T>::reduce_forces() {
     const BoundaryCell& b = bcells_[k.cell];
     if (mb_ && mb_->solid(b.cell)) continue;  // a particle covers the cell: its wall sees no fluid there
     SolidObject& obj = objects_[k.object];
-    const Vec3 F(link_force_[3 * l], link_force_[3 * l + 1], link_force_[3 * l + 2]);
+    Vec3 F(link_force_[3 * l], link_force_[3 * l + 1], link_force_[3 * l + 2]);
+    // A cell covered by PSM particles: the share B_s of the exchange's part tangential to the wall
+    // pushes particle s; the wall keeps the normal part and (1 - B) of the tangential one
+    // (lbm/psm.hpp, "Wall links of covered cells"). Wall normal: the sum of the cell's link
+    // directions towards the wall.
+    if (psm_ && psm_->active() && psm_->slot(b.cell) >= 0) {
+      Vec3 n = Vec3::Zero();
+      for (int j = b.first_link; j < b.first_link + b.num_links; ++j) {
+        const int oj = L::opp[links_[std::size_t(j)].q];
+        n += Vec3(L::c[oj][0], L::c[oj][1], L::c[oj][2]);
+      }
+      const double nn = n.squaredNorm();
+      const Vec3 Ft = nn > 0 ? Vec3(F - (F.dot(n) / nn) * n) : F;
+      F -= psm_->book_wall_link(b.cell, Ft);
+    }
     const int o = L::opp[k.q];
     const Vec3 xw = Vec3(b.x, b.y, b.z) + double(k.delta) * Vec3(L::c[o][0], L::c[o][1], L::c[o][2]);
     obj.force += F;
