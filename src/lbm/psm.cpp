@@ -239,7 +239,9 @@ void Psm<L, T>::set_particles(const ParticleSet& p) {
     Cell& c = cells_[std::size_t(i)];
     const double B = psm_weight(std::min(1.0, c.eps), tau_);
     c.B = T(B);
-    for (std::int32_t k = c.first; k < c.first + c.count; ++k) entries_[std::size_t(k)].Bs = T(B * entries_[std::size_t(k)].eps / c.eps);
+    if (c.count == 1) entries_[std::size_t(c.first)].Bs = T(B);  // (most cells: no division)
+    else
+      for (std::int32_t k = c.first; k < c.first + c.count; ++k) entries_[std::size_t(k)].Bs = T(B * entries_[std::size_t(k)].eps / c.eps);
   }
   // Bulk cells grouped by the span that updates them (offsets in order of first touch).
   for (const Cell& c : cells_) {
@@ -290,19 +292,6 @@ void Psm<L, T>::save_span(std::int64_t span, const T* f, bool odd) {
   }
 }
 
-template <class L, class T>
-void Psm<L, T>::apply_span(std::int64_t span, T* f, bool odd, const Relax<T>& r, bool force, bool incomp) {
-  const std::int32_t k0 = span_first_[std::size_t(span)], k1 = k0 + span_count_[std::size_t(span)];
-  for (std::int32_t k = k0; k < k1; ++k) {
-    CellIndex pre[Q], post[Q];
-    slots(bulk_[std::size_t(k)], odd, pre, post);
-    T g[Q];
-    for (int q = 0; q < Q; ++q) g[q] = f[post[q]];
-    apply(bulk_[std::size_t(k)].slot, &gpre_[std::size_t(Q) * std::size_t(k)], g, r, force, incomp);
-    for (int q = 0; q < Q; ++q) f[post[q]] = g[q];
-  }
-}
-
 // Shifted equilibrium (as equilibrium() in collision.hpp) with compile-time directions.
 template <class L, class T>
 FF_LBM_INLINE void psm_equilibrium(T rho, T rho_u, const T* u, T* geq) {
@@ -311,6 +300,161 @@ FF_LBM_INLINE void psm_equilibrium(T rho, T rho_u, const T* u, T* geq) {
     const T cu = cdot<L::c[q][0], L::c[q][1], L::c[q][2]>(u[0], u[1], u[2]);
     geq[q] = T(L::w[q]) * ((rho - T(1)) + rho_u * (T(3) * cu + T(4.5) * cu * cu - usq15));
   });
+}
+
+namespace {
+
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define FF_PSM_CLONES __attribute__((target_clones("default", "arch=x86-64-v3", "arch=x86-64-v4")))
+#else
+#define FF_PSM_CLONES
+#endif
+
+// Covered bulk cells of one span in batches of kBatch, structure of arrays, so that the arithmetic
+// of the update runs over the lanes in vector registers (one cell at a time, scalar, it cost
+// 10-20 times the bulk kernel's cell). Compiled like the bulk kernel (bulk_sweep.cpp): one clone
+// per vector width, the same IEEE operations in each (-ffp-contract=off), so a cell's result does
+// not depend on its lane, its batch or the clone.
+constexpr int kBatch = 16;
+
+template <class L, class T>
+struct PsmBatch {
+  alignas(64) T pre[L::Q][kBatch];   // g_q before the step
+  alignas(64) T post[L::Q][kBatch];  // g*_q from the kernel, then the PSM result
+  alignas(64) T sum[L::Q][kBatch];   // sum_s B_s Omega^s_q
+  alignas(64) T geqf[L::Q][kBatch];  // f^eq_q(rho, u)
+  alignas(64) T B[kBatch], Bs[kBatch], us[3][kBatch], rho[kBatch], rho_u[kBatch], u[3][kBatch];
+  alignas(64) double F[3][kBatch];   // force of each lane's first entry
+};
+
+// Fluid moments, f^eq(rho, u), and the solid term of each lane's first particle (the others are
+// added by the caller); as Psm::apply() does for one cell.
+template <class L, class T, bool kForce, bool kIncomp>
+FF_PSM_CLONES void psm_batch_solid(PsmBatch<L, T>& b, const T* force) {
+  constexpr int Q = L::Q;
+  T hf[3] = {0, 0, 0};
+  if constexpr (kForce)
+    for (int a = 0; a < L::D; ++a) hf[a] = T(0.5) * force[a];
+  for (int i = 0; i < kBatch; ++i) {
+    T drho = 0, j[3] = {0, 0, 0};
+    static_for<Q>([&](auto q) FF_LBM_LAMBDA_INLINE {
+      const T g = b.pre[q][i];
+      drho += g;
+      static_for<L::D>([&](auto a) FF_LBM_LAMBDA_INLINE {
+        if constexpr (L::c[q][a] > 0) j[a] += g;
+        if constexpr (L::c[q][a] < 0) j[a] -= g;
+      });
+    });
+    if constexpr (kForce)
+      for (int a = 0; a < L::D; ++a) j[a] += hf[a];
+    const T rho = T(1) + drho;
+    const T rho_u = kIncomp ? T(1) : rho;
+    const T inv = kIncomp ? T(1) : T(1) / rho;
+    const T u[3] = {j[0] * inv, j[1] * inv, j[2] * inv};
+    b.rho[i] = rho;
+    b.rho_u[i] = rho_u;
+    const T usq15 = T(1.5) * (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    const T us[3] = {b.us[0][i], b.us[1][i], b.us[2][i]};
+    const T ssq15 = T(1.5) * (us[0] * us[0] + us[1] * us[1] + us[2] * us[2]);
+    T geqf[Q], geqs[Q];
+    static_for<Q>([&](auto q) FF_LBM_LAMBDA_INLINE {
+      const T cu = cdot<L::c[q][0], L::c[q][1], L::c[q][2]>(u[0], u[1], u[2]);
+      geqf[q] = T(L::w[q]) * ((rho - T(1)) + rho_u * (T(3) * cu + T(4.5) * cu * cu - usq15));
+      const T cs = cdot<L::c[q][0], L::c[q][1], L::c[q][2]>(us[0], us[1], us[2]);
+      geqs[q] = T(L::w[q]) * ((rho - T(1)) + rho_u * (T(3) * cs + T(4.5) * cs * cs - ssq15));
+      b.geqf[q][i] = geqf[q];
+    });
+    const T Bs = b.Bs[i];
+    double F[3] = {0, 0, 0};
+    static_for<Q>([&](auto q) FF_LBM_LAMBDA_INLINE {
+      constexpr int o = L::opp[q];
+      const T om = Bs * ((b.pre[o][i] - b.pre[q][i]) + (geqs[q] - geqf[o]));
+      b.sum[q][i] = T(0) + om;
+      static_for<L::D>([&](auto a) FF_LBM_LAMBDA_INLINE {
+        if constexpr (L::c[q][a] > 0) F[a] -= double(om);
+        if constexpr (L::c[q][a] < 0) F[a] += double(om);
+      });
+    });
+    for (int a = 0; a < 3; ++a) b.F[a][i] = F[a];
+  }
+}
+
+// g = (1 - B) g* + B g + sum_s B_s Omega^s, lane by lane.
+template <class L, class T>
+FF_PSM_CLONES void psm_batch_combine(PsmBatch<L, T>& b) {
+  for (int q = 0; q < L::Q; ++q)
+    for (int i = 0; i < kBatch; ++i) {
+      const T B = b.B[i], fluid = T(1) - B;
+      b.post[q][i] = fluid * b.post[q][i] + B * b.pre[q][i] + b.sum[q][i];
+    }
+}
+
+}  // namespace
+
+template <class L, class T>
+void Psm<L, T>::apply_span(std::int64_t span, T* f, bool odd, const Relax<T>& r, bool force, bool incomp) {
+  const std::int32_t k0 = span_first_[std::size_t(span)], k1 = k0 + span_count_[std::size_t(span)];
+  using Fn = void (*)(PsmBatch<L, T>&, const T*);
+  const Fn solid = force ? (incomp ? &psm_batch_solid<L, T, true, true> : &psm_batch_solid<L, T, true, false>)
+                         : (incomp ? &psm_batch_solid<L, T, false, true> : &psm_batch_solid<L, T, false, false>);
+  PsmBatch<L, T> b;
+  CellIndex post[kBatch][Q];
+  for (std::int32_t kb = k0; kb < k1; kb += kBatch) {
+    const int n = int(std::min<std::int32_t>(kBatch, k1 - kb));
+    for (int i = 0; i < n; ++i) {
+      const BulkCell& bc = bulk_[std::size_t(kb + i)];
+      CellIndex pre[Q];
+      slots(bc, odd, pre, post[i]);
+      const T* gp = &gpre_[std::size_t(Q) * std::size_t(kb + i)];
+      for (int q = 0; q < Q; ++q) {
+        b.pre[q][i] = gp[q];
+        b.post[q][i] = f[post[i][q]];
+      }
+      const Cell& c = cells_[std::size_t(bc.slot)];
+      const Entry& e = entries_[std::size_t(c.first)];
+      b.B[i] = c.B;
+      b.Bs[i] = e.Bs;
+      const Kinematics& m = kin_[std::size_t(e.particle)];
+      const Vec3 us = m.v + m.w.cross(e.arm);
+      for (int a = 0; a < 3; ++a) b.us[a][i] = T(a < L::D ? us[a] : 0.0);
+    }
+    for (int i = n; i < kBatch; ++i) {  // idle lanes: a fluid at rest
+      for (int q = 0; q < Q; ++q) b.pre[q][i] = b.post[q][i] = T(0);
+      b.B[i] = b.Bs[i] = T(0);
+      for (int a = 0; a < 3; ++a) b.us[a][i] = T(0);
+    }
+    solid(b, r.force);
+    // Cells with more than one particle: the others' terms, in entry order (as apply()).
+    for (int i = 0; i < n; ++i) {
+      const Cell& c = cells_[std::size_t(bulk_[std::size_t(kb + i)].slot)];
+      for (int a = 0; a < 3; ++a) entry_force_[3 * std::size_t(c.first) + std::size_t(a)] = b.F[a][i];
+      if (c.count == 1) continue;
+      T gpre[Q], geq_f[Q], geq_s[Q];
+      for (int q = 0; q < Q; ++q) gpre[q] = b.pre[q][i], geq_f[q] = b.geqf[q][i];
+      for (std::int32_t k = c.first + 1; k < c.first + c.count; ++k) {
+        const Entry& e = entries_[std::size_t(k)];
+        const Kinematics& m = kin_[std::size_t(e.particle)];
+        const Vec3 us = m.v + m.w.cross(e.arm);
+        const T ut[3] = {T(us[0]), T(us[1]), T(L::D == 3 ? us[2] : 0.0)};
+        psm_equilibrium<L, T>(b.rho[i], b.rho_u[i], ut, geq_s);
+        double F[3] = {0, 0, 0};
+        const T Bs = e.Bs;
+        static_for<Q>([&](auto q) FF_LBM_LAMBDA_INLINE {
+          constexpr int o = L::opp[q];
+          const T om = Bs * ((gpre[o] - gpre[q]) + (geq_s[q] - geq_f[o]));
+          b.sum[q][i] += om;
+          static_for<L::D>([&](auto a) FF_LBM_LAMBDA_INLINE {
+            if constexpr (L::c[q][a] > 0) F[a] -= double(om);
+            if constexpr (L::c[q][a] < 0) F[a] += double(om);
+          });
+        });
+        for (int a = 0; a < 3; ++a) entry_force_[3 * std::size_t(k) + std::size_t(a)] = F[a];
+      }
+    }
+    psm_batch_combine<L, T>(b);
+    for (int i = 0; i < n; ++i)
+      for (int q = 0; q < Q; ++q) f[post[i][q]] = b.post[q][i];
+  }
 }
 
 template <class L, class T>
