@@ -263,7 +263,7 @@ void Psm<L, T>::set_particles(const ParticleSet& p) {
     bulk_[std::size_t(span_first_[std::size_t(sp)] + span_count_[std::size_t(sp)]++)] = BulkCell{c.cell, std::int32_t(i), c.edge};
   }
   gpre_.resize(std::size_t(Q) * bulk_.size());
-  entry_force_.assign(3 * entries_.size(), 0.0);
+  entry_force_.resize(3 * entries_.size());  // every entry is written by its cell's update
   force_.assign(np, Vec3::Zero());
   torque_.assign(np, Vec3::Zero());
   wall_force_.assign(np, Vec3::Zero());

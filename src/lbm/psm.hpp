@@ -25,17 +25,22 @@
 // Zaleski 2000, J. Comput. Phys. 164:228). Measured against 64^2 / 32^3 sub-cell
 // sampling: total covered volume within 0.1% for r >= 3 cells, each cell within 0.02 (test_psm).
 //
+// Wall links of a covered boundary cell: each covering particle s takes B_s times the part of the
+// link's momentum exchange tangential to the wall, the wall the normal part and the rest
+// (Solver::reduce_forces; docs/coupling.md, "Wall links of covered cells").
+//
 // Cost: each step clears the cells of the previous particle set and visits, in each row of a
 // particle's bounding box, only the cells within r + half a cell diagonal of its centre; nothing
 // sweeps the lattice. The fractions are computed in parallel over fixed chunks of particles and
-// gathered in particle order, so the cells and entries are the same on any thread count. Bulk cells that a particle covers keep the bulk
-// kernel (untouched, so cells with B = 0 keep its speed): inside the bulk sweep, a span's covered
-// cells save their pre-collision populations right before the kernel runs the span, and the PSM
-// update is applied to the kernel's result right after, g_new = (1 - B) g* + B g + sum_s B_s
-// Omega^s, while the rows are in the cache (as two separate passes in particle order the update
-// made a 128^3 step with 28% of the cells covered twice as slow). Boundary cells apply the same
-// update inside their own path. Every cell owns its slots (AA pattern), so cells are independent;
-// the per-particle sums run in a fixed order: results are the same on any thread count.
+// gathered in particle order; the covered cells are then listed in lattice order (x fastest), so
+// the cells and entries are the same on any thread count and the sweep reads them in order. Bulk
+// cells that a particle covers keep the bulk kernel (untouched, so cells with B = 0 keep its
+// speed): inside the bulk sweep, a span's covered cells save their pre-collision populations right
+// before the kernel runs the span, and the PSM update is applied to the kernel's result right
+// after, g_new = (1 - B) g* + B g + sum_s B_s Omega^s, while the rows are in the cache, in batches
+// of cells (structure of arrays, vectorised). Boundary cells apply the same update inside their
+// own path. Every cell owns its slots (AA pattern), so cells are independent; each particle's
+// force is summed over its own entries in a fixed order: results are the same on any thread count.
 #pragma once
 #include <cstdint>
 #include <vector>
