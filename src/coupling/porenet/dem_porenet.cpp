@@ -53,8 +53,9 @@ void DemPorenetCoupling::build_pairs(const dem::DemSystem& sys) {
   }
 }
 
-// sigma_n = F_n / (2 min(R) t) from the bond's and the contact's loads of this step (F on the second
-// particle; compression pushes it away from the first: F.n > 0).
+// sigma_n = F_n / (2 min(R) h), h the force's height (t or 2 min(R)), from the bond's and the
+// contact's loads of this step (F on the second particle; compression pushes it away from the first:
+// F.n > 0).
 void DemPorenetCoupling::fill_pair_state(const dem::DemSystem& sys) {
   const auto& P = sys.particles;
   const auto adj_off = sys.neighbors().adjacency_offsets();

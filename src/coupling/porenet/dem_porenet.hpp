@@ -3,8 +3,9 @@
 //
 // One coupled step (DemPorenetCoupling::step) uses the DemSystem's public stages:
 //   update_neighbors(); compute_forces();
-//   pair states from the fresh loads: sigma_n = F_n / (2 min(R_a, R_b) t) (compression > 0, clamped
-//     at 0 for Eq. B1), broken bonds with their opening max(0, |d| - R_a - R_b);
+//   pair states from the fresh loads: sigma_n = F_n / (2 min(R_a, R_b) h), h = t or, with
+//     ForceHeight::Diameter, 2 min(R_a, R_b) (compression > 0, clamped at 0 for Eq. B1), broken bonds
+//     with their opening max(0, |d| - R_a - R_b);
 //   retriangulate when the largest particle displacement since the last triangulation exceeds
 //     `retriangulation_tolerance` x the mean radius (phase masses carried by porenet's remap), else
 //     update the network's geometry with the moved discs: the new void volumes V^{n+1} (B19) drive the

@@ -175,7 +175,8 @@ TEST(PorePressureBonds, CompressedVapourCondensesBackToLiquid) {
     const Real rq = prm.fluid.liquid.density(pv, true), rv = prm.fluid.gas.density(pv, false);
     const Real M1 = c.flow().liquid_mass()[0] + c.flow().gas_mass()[0];
     std::printf("%s: p %.6g Pa, S %.9f, total mass change %.3g, vapour left %.3g kg, condensed %.3g kg\n",
-                all ? "all condenses" : "back to p_v", c.flow().pressure()[0], c.flow().liquid_fraction()[0], M1 / M - 1,
+                all ? "all condenses" : "back to p_v", c.flow().pressure()[0], c.flow().liquid_fraction()[0],
+                M1 / M - 1,
                 c.total_vapour(), c.stats().condensed_mass);
     EXPECT_NEAR(M1 / M, 1.0, 1e-12);
     EXPECT_EQ(c.stats().condensations, 1);
