@@ -53,8 +53,9 @@ void DemPorenetCoupling::build_pairs(const dem::DemSystem& sys) {
   }
 }
 
-// sigma_n = F_n / (2 min(R) t) from the bond's and the contact's loads of this step (F on the second
-// particle; compression pushes it away from the first: F.n > 0).
+// sigma_n = F_n / (2 min(R) h), h the force's height (t or 2 min(R)), from the bond's and the
+// contact's loads of this step (F on the second particle; compression pushes it away from the first:
+// F.n > 0).
 void DemPorenetCoupling::fill_pair_state(const dem::DemSystem& sys) {
   const auto& P = sys.particles;
   const auto adj_off = sys.neighbors().adjacency_offsets();
@@ -62,6 +63,10 @@ void DemPorenetCoupling::fill_pair_state(const dem::DemSystem& sys) {
   const auto first = sys.neighbors().first(), second = sys.neighbors().second();
   const auto& pl = sys.pair_loads();
   const Real t = prm_.network.thickness;
+  // The contact's area is 2 min(R) times the height its force acts over: the disc thickness t, or
+  // with sphere forces (ForceHeight::Diameter, the seed's law) the sphere's 2 min(R), the height
+  // B27 wets: a force of spheres over a 1 m thick section would leave B1 at h0 under any load.
+  const bool sphere_height = prm_.force_height == ForceHeight::Diameter;
   const auto n = static_cast<Index>(pairs_.size());
 #pragma omp parallel for schedule(static) if (static_cast<std::size_t>(n) > sys.settings.parallel_min)
   for (Index q = 0; q < n; ++q) {
@@ -82,7 +87,8 @@ void DemPorenetCoupling::fill_pair_state(const dem::DemSystem& sys) {
       if (other != b || k >= pl.size()) continue;
       fn += (first[k] == a ? 1.0 : -1.0) * pl[k].f.dot(nrm);
     }
-    pairs_.sigma_n[q] = std::max(fn, 0.0) / (2 * std::min(P.radius[a], P.radius[b]) * t);
+    const Real rmin = std::min(P.radius[a], P.radius[b]);
+    pairs_.sigma_n[q] = std::max(fn, 0.0) / (2 * rmin * (sphere_height ? 2 * rmin : t));
     pairs_.opening[q] = pairs_.state[q] == porenet::PairState::BrokenBond
                             ? std::max(dist - P.radius[a] - P.radius[b], 0.0)
                             : 0.0;
@@ -90,6 +96,7 @@ void DemPorenetCoupling::fill_pair_state(const dem::DemSystem& sys) {
 }
 
 void DemPorenetCoupling::set_boundaries(porenet::TwoPhaseFlow& flow, const porenet::Network2D& net) {
+  bc_pore_.assign(static_cast<std::size_t>(net.n_pores()), 0);
   if (prm_.drainage != Drainage::Sides) return;
   Real xmin = x_[0], xmax = x_[0], rmax = 0;
   for (std::size_t k = 0; k < x_.size(); ++k) {
@@ -98,8 +105,10 @@ void DemPorenetCoupling::set_boundaries(porenet::TwoPhaseFlow& flow, const poren
     rmax = std::max(rmax, r_[k]);
   }
   for (Index i = 0; i < net.n_pores(); ++i)
-    if (net.pore_hull[i] && (net.pore_cx[i] < xmin + 2 * rmax || net.pore_cx[i] > xmax - 2 * rmax))
+    if (net.pore_hull[i] && (net.pore_cx[i] < xmin + 2 * rmax || net.pore_cx[i] > xmax - 2 * rmax)) {
       flow.set_bc(i, porenet::PoreBc::Pressure, prm_.ambient_pressure, prm_.saturation);
+      bc_pore_[static_cast<std::size_t>(i)] = 1;
+    }
 }
 
 void DemPorenetCoupling::make_network_and_flow(std::unique_ptr<porenet::Network2D>& net,
@@ -107,6 +116,7 @@ void DemPorenetCoupling::make_network_and_flow(std::unique_ptr<porenet::Network2
   const porenet::Particles2D parts{x_, y_, r_, {}};
   net = std::make_unique<porenet::Network2D>(porenet::build_network_2d(parts, pairs_, prm_.network));
   flow = std::make_unique<porenet::TwoPhaseFlow>(*net, prm_.fluid);
+  if (prm_.implicit_above > 0) flow->prepare_implicit();  // no allocation in the time loop
   ref_x_ = x_;
   ref_y_ = y_;
 }
@@ -131,6 +141,8 @@ void DemPorenetCoupling::init(dem::DemSystem& sys, const PorenetCouplingParams& 
   flow_->init(prm_.initial_pressure, prm_.saturation);
   set_boundaries(*flow_, *net_);
   pg_.assign(static_cast<std::size_t>(net_->n_pores()), 0);
+  vap_.assign(static_cast<std::size_t>(net_->n_pores()), 0);
+  mp_prev_.assign(flow_->gas_mass().begin(), flow_->gas_mass().end());
   stats_ = {};
 }
 
@@ -150,7 +162,26 @@ void DemPorenetCoupling::retriangulate(const dem::DemSystem& sys) {
   set_boundaries(*flow_, *net_);
   porenet::remap_two_phase(*old_net, *old_flow, *net_, *flow_);
   pg_.assign(static_cast<std::size_t>(net_->n_pores()), 0);
+  const std::vector<Real> old_vap = vap_;
+  carry_vapour(*old_net, old_vap, old_flow->gas_mass());
   ++stats_.retriangulations;
+}
+
+// Each new pore's gas takes the vapour fraction of the old pore nearest to it (the composition is
+// carried as porenet's remap carries the phase fractions).
+void DemPorenetCoupling::carry_vapour(const porenet::Network2D& old_net, std::span<const Real> old_vap,
+                                      std::span<const Real> old_mp) {
+  const auto np = static_cast<std::size_t>(net_->n_pores());
+  const auto mp = flow_->gas_mass();
+  vap_.assign(np, 0);
+  if (prm_.cavitation_pressure > 0) {
+    const std::vector<Index> near = porenet::nearest_pores(old_net, *net_);
+    for (std::size_t k = 0; k < np; ++k) {
+      const auto o = static_cast<std::size_t>(near[k]);
+      if (!bc_pore_[k] && old_mp[o] > 0) vap_[k] = std::min(1.0, old_vap[o] / old_mp[o]) * mp[k];
+    }
+  }
+  mp_prev_.assign(mp.begin(), mp.end());
 }
 
 void DemPorenetCoupling::add_forces(dem::DemSystem& sys) {
@@ -189,21 +220,36 @@ void DemPorenetCoupling::step(dem::DemSystem& sys) {
   } else {
     porenet::update_network_2d(*net_, porenet::Particles2D{x_, y_, r_, {}}, pairs_);
   }
-  // Flow sub-steps inside the DEM step (the first one sees V^{n+1}: the compaction source).
+  // Flow sub-steps inside the DEM step (the first one sees V^{n+1}: the compaction source). When the
+  // stable step is below the DEM step, it is evaluated again before each sub-step: cavitation and
+  // condensation reset pores between sub-steps, and a pore whose pressure jumped (a condensed bubble)
+  // would otherwise give away more than it holds at the rates of the step's start.
   const Real dt = sys.settings.dt;
   stats_.last_stable_dt = flow_->stable_dt();
-  const Real limit = prm_.dt_safety * stats_.last_stable_dt;
-  long nsub = 1;
-  if (limit < dt) nsub = static_cast<long>(std::ceil(dt / limit));
-  if (nsub > prm_.max_substeps)
-    throw NumericalError(fmt::format(
-        "coupling.porenet: the flow needs {} sub-steps of {:.3g} s per DEM step of {:.3g} s (more than {}); "
-        "reduce the liquid bulk modulus or the DEM step, or raise the apertures",
-        nsub, limit, dt, prm_.max_substeps));
-  const Real h = dt / static_cast<Real>(nsub);
-  for (long s = 0; s < nsub; ++s) {
+  Real limit = prm_.dt_safety * stats_.last_stable_dt;
+  long nsub = 0;
+  Real left = dt, h = dt;
+  while (left > 0) {
+    const long need = limit < left ? static_cast<long>(std::ceil(left / limit)) : 1;
+    if (prm_.implicit_above > 0 && need > prm_.implicit_above) {
+      flow_->step_implicit(left);
+      cavitate();
+      ++nsub;
+      ++stats_.implicit_steps;
+      h = left;
+      break;
+    }
+    if (nsub + need > prm_.max_substeps)
+      throw NumericalError(fmt::format(
+          "coupling.porenet: the flow needs more than {} sub-steps of {:.3g} s per DEM step of {:.3g} s; "
+          "reduce the liquid bulk modulus or the DEM step, or raise the apertures",
+          prm_.max_substeps, limit, dt));
+    h = need == 1 ? left : left / static_cast<Real>(need);
     flow_->step_explicit(h);
     cavitate();
+    ++nsub;
+    left = need == 1 ? 0 : left - h;
+    if (left > 0) limit = prm_.dt_safety * flow_->stable_dt();
   }
   stats_.last_substeps = nsub;
   stats_.last_flow_dt = h;
@@ -212,26 +258,79 @@ void DemPorenetCoupling::step(dem::DemSystem& sys) {
   sys.integrate();
 }
 
+// Cavitation and condensation after each flow sub-step (prm_.cavitation_pressure pc).
+// 1. Vapour follows the gas: a pore whose gas mass fell since the last call kept its vapour fraction;
+//    gas that came in carries the sample's mean vapour fraction (the flow's per-channel rates are not
+//    seen here; exact when all the gas is vapour, S = 1 at the start, or when there is no vapour).
+//    Note the mechanics barely depend on it: vapour at pc compressed to p keeps pc/p of its volume.
+// 2. A pore below pc keeps its liquid mass and fills the rest of its void with vapour at pc.
+// 3. Vapour exists only at pc (the liquid's vapour pressure): a vapour pore above pc (compressed)
+//    condenses vapour into liquid at constant total mass, back to pc with the vapour volume
+//    V - m_q'/rho_q(pc) - m_air/rho_v(pc) if that is positive (m_q' the liquid after condensing),
+//    else all of it (the pore is then a compressed liquid, B23 solved for its pressure).
 void DemPorenetCoupling::cavitate() {
   const Real pc = prm_.cavitation_pressure;
   if (!(pc > 0)) return;
   const auto p = flow_->pressure();
   const auto mq = flow_->liquid_mass();
   const auto mp = flow_->gas_mass();
-  const Real rho_q = prm_.fluid.liquid.density(pc, true), rho_v = prm_.fluid.gas.density(pc, false);
-  for (Index i = 0; i < net_->n_pores(); ++i) {
-    if (!(p[i] < pc)) continue;
-    // Same liquid mass at the vapour pressure; the rest of the void is vapour at pc. Vapour is only
-    // added: a pore whose gas would fill that space already is left alone (gas mass never falls).
-    const Real V = net_->pore_void[i];
-    const Real S = std::min(1.0, mq[i] / (V * rho_q));
-    const Real needed = (1 - S) * V * rho_v;
-    const Real mp_old = mp[i];
-    if (needed < mp_old) continue;
-    flow_->set_pore_state(i, pc, S);
-    stats_.vapour_mass += flow_->gas_mass()[i] - mp_old;
-    ++stats_.cavitations;
+  const auto alpha = flow_->liquid_fraction();
+  const Index np = net_->n_pores();
+  Real vsum = 0, gsum = 0;  // serial fixed-order sums
+  for (Index i = 0; i < np; ++i) {
+    vsum += vap_[i];
+    gsum += mp_prev_[i];
   }
+  // A sample filled with liquid at the start holds no air: all its gas is vapour.
+  const Real chi = prm_.saturation >= 1 ? 1.0 : gsum > 0 ? std::min(1.0, vsum / gsum) : 0.0;
+  const Real rho_q = prm_.fluid.liquid.density(pc, true), rho_v = prm_.fluid.gas.density(pc, false);
+  for (Index i = 0; i < np; ++i) {
+    if (bc_pore_[i]) {
+      vap_[i] = 0;
+      continue;
+    }
+    const Real dm = mp[i] - mp_prev_[i];
+    if (dm < 0)
+      vap_[i] = mp_prev_[i] > 0 ? vap_[i] * (mp[i] / mp_prev_[i]) : 0.0;
+    else
+      vap_[i] = std::min(mp[i], vap_[i] + chi * dm);
+    const Real V = net_->pore_void[i];
+    if (p[i] < pc) {
+      // Same liquid mass at the vapour pressure; the rest of the void is vapour at pc. Vapour is only
+      // added: a pore whose gas would fill that space already is left alone (gas mass never falls).
+      const Real S = std::min(1.0, mq[i] / (V * rho_q));
+      const Real needed = (1 - S) * V * rho_v;
+      const Real mp_old = mp[i];
+      if (needed < mp_old) continue;
+      flow_->set_pore_state(i, pc, S);
+      const Real added = mp[i] - mp_old;
+      stats_.vapour_mass += added;
+      vap_[i] = std::min(mp[i], vap_[i] + added);
+      ++stats_.cavitations;
+    } else if (p[i] > pc && vap_[i] > 0) {
+      const Real mv = vap_[i], air = std::max(mp[i] - mv, 0.0), liquid = mq[i];
+      const Real keep = (V - (liquid + mv) / rho_q - air / rho_v) / (1 / rho_v - 1 / rho_q);  // vapour at pc
+      if (keep >= mv) continue;  // round-off: the pore is at pc already
+      if (keep > 0) {
+        flow_->set_pore_state(i, pc, (liquid + mv - keep) / (V * rho_q));
+        vap_[i] = std::min(keep, mp[i]);
+      } else {
+        Real pn = 0;
+        const Real a = flow_->solve_shared_pressure(liquid + mv, air, V, alpha[i], pn);
+        flow_->set_pore_state(i, pn, std::clamp(a, 0.0, 1.0));
+        vap_[i] = 0;
+      }
+      stats_.condensed_mass += mv - std::max(keep, 0.0);
+      ++stats_.condensations;
+    }
+  }
+  std::copy(mp.begin(), mp.end(), mp_prev_.begin());
+}
+
+Real DemPorenetCoupling::total_vapour() const {
+  Real v = 0;
+  for (Real x : vap_) v += x;
+  return v;
 }
 
 Real DemPorenetCoupling::max_pressure() const {
@@ -254,6 +353,8 @@ void DemPorenetCoupling::save(CheckpointWriter& w) const {
   w.put("porenet.mp", vec(flow_->gas_mass()));
   w.put("porenet.rq", vec(flow_->liquid_density()));
   w.put("porenet.rp", vec(flow_->gas_density()));
+  w.put("porenet.vapour", vap_);
+  w.put("porenet.implicit_guess", vec(flow_->implicit_guess()));
   w.put_value("porenet.stats", stats_);
 }
 
@@ -293,6 +394,16 @@ void DemPorenetCoupling::load(CheckpointReader& r, dem::DemSystem& sys, const Po
     throw InputError(fmt::format("checkpoint: {} pore states for a rebuilt network of {} pores", p.size(), net_->n_pores()));
   flow_->restore_state(p, a, mq, mp, rq, rp);
   pg_.assign(static_cast<std::size_t>(net_->n_pores()), 0);
+  if (r.has("porenet.implicit_guess")) {
+    std::vector<Real> g;
+    r.get("porenet.implicit_guess", g);
+    if (!g.empty()) flow_->restore_implicit_guess(g);
+  }
+  if (r.has("porenet.vapour"))
+    r.get("porenet.vapour", vap_);
+  else
+    vap_.assign(p.size(), 0);  // a checkpoint written before the vapour was tracked
+  mp_prev_ = mp;
   stats_ = r.get_value<CouplingStats>("porenet.stats");
 }
 

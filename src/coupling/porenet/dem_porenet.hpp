@@ -3,14 +3,17 @@
 //
 // One coupled step (DemPorenetCoupling::step) uses the DemSystem's public stages:
 //   update_neighbors(); compute_forces();
-//   pair states from the fresh loads: sigma_n = F_n / (2 min(R_a, R_b) t) (compression > 0, clamped
-//     at 0 for Eq. B1), broken bonds with their opening max(0, |d| - R_a - R_b);
+//   pair states from the fresh loads: sigma_n = F_n / (2 min(R_a, R_b) h), h = t or, with
+//     ForceHeight::Diameter, 2 min(R_a, R_b) (compression > 0, clamped at 0 for Eq. B1), broken bonds
+//     with their opening max(0, |d| - R_a - R_b);
 //   retriangulate when the largest particle displacement since the last triangulation exceeds
 //     `retriangulation_tolerance` x the mean radius (phase masses carried by porenet's remap), else
 //     update the network's geometry with the moved discs: the new void volumes V^{n+1} (B19) drive the
 //     pressure (the undrained compaction effect);
-//   n explicit flow sub-steps of dt_dem / n, n = ceil(dt_dem / (safety dt_flow)), dt_flow the
-//     two-phase stable step (docs/porenet.md §3, §5); when dt_flow > dt_dem one flow step per DEM step;
+//   explicit flow sub-steps of (what is left of dt_dem) / n, n = ceil(left / (safety dt_flow)), dt_flow
+//     the two-phase stable step (docs/porenet.md §3, §5), evaluated again before each sub-step; when
+//     dt_flow > dt_dem one flow step per DEM step; past `implicit_above` sub-steps one implicit step
+//     for the rest; after each sub-step cavitation and condensation;
 //   add_external_loads(); grain forces from the gauge pressure p - p_ambient (pressure B26-B27,
 //     channel shear B25, B28; wetted height t or 2 r_j, ForceHeight) into particles.ext_force;
 //     integrate().
@@ -19,6 +22,7 @@
 #pragma once
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "dem/dem_system.hpp"
@@ -51,11 +55,18 @@ struct PorenetCouplingParams {
   Real retriangulation_tolerance = 0.25;  // x mean radius (cf. YADE defTolerance)
   Real dt_safety = 0.9;                   // flow sub-step <= safety x stable step
   long max_substeps = 200000;             // a flow step this small is an error, not a slow run
+  // When the explicit flow would need more than this many sub-steps (open cracks: h^3 conductances),
+  // the rest of the DEM step is one implicit step (porenet's IMPES, backward-Euler pressure,
+  // conservative phase update). 0 = always explicit (the seed's scheme).
+  long implicit_above = 32;
   bool shear_forces = true;
   // Cavitation: a pore's liquid cannot be pulled below this absolute pressure (water's vapour
   // pressure, 2.34 kPa at 20 C); below it the pore keeps its liquid mass and fills the rest of its
-  // void with vapour (modelled as the gas phase) at this pressure. 0 = off (the barotropic liquid
-  // then takes any tension: a dilating saturated sample is held together by suction).
+  // void with vapour (modelled as the gas phase) at this pressure. Vapour exists only at this
+  // pressure: a vapour pore compressed above it condenses its vapour back into liquid (first until
+  // the pore is back at the vapour pressure, then all of it), so a bubble that opened while the
+  // pore dilated does not stay as a gas cushion once the pore closes again. 0 = off (the
+  // barotropic liquid then takes any tension: a dilating saturated sample is held together by suction).
   Real cavitation_pressure = 2.34e3;  // [Pa]
   ForceHeight force_height = ForceHeight::Thickness;
   Drainage drainage = Drainage::Closed;
@@ -69,6 +80,9 @@ struct CouplingStats {
   Real max_displacement = 0;  // since the last triangulation [m]
   long cavitations = 0;       // pore-steps that cavitated
   Real vapour_mass = 0;       // gas-phase mass created by cavitation [kg per m of depth]
+  long condensations = 0;     // pore-steps whose vapour (partly) condensed
+  Real condensed_mass = 0;    // vapour mass condensed back into liquid [kg per m of depth]
+  long implicit_steps = 0;    // DEM steps finished by an implicit flow step (implicit_above)
 };
 
 class DemPorenetCoupling {
@@ -87,6 +101,9 @@ class DemPorenetCoupling {
   const CouplingStats& stats() const { return stats_; }
   const PorenetCouplingParams& params() const { return prm_; }
   Real max_pressure() const;
+  // Vapour mass (cavitation's part of the gas) per pore [kg per m of depth]; sum = vapour in the sample.
+  std::span<const Real> vapour() const { return vap_; }
+  Real total_vapour() const;
   // Fluid force of the last step on particle k [N] (x, y).
   Real fluid_fx(Index k) const { return fx_[static_cast<std::size_t>(k)]; }
   Real fluid_fy(Index k) const { return fy_[static_cast<std::size_t>(k)]; }
@@ -107,6 +124,7 @@ class DemPorenetCoupling {
   void retriangulate(const dem::DemSystem& sys);
   void add_forces(dem::DemSystem& sys);
   void cavitate();
+  void carry_vapour(const porenet::Network2D& old_net, std::span<const Real> old_vap, std::span<const Real> old_mp);
 
   PorenetCouplingParams prm_;
   std::unique_ptr<porenet::Network2D> net_;
@@ -114,6 +132,10 @@ class DemPorenetCoupling {
   porenet::PairList pairs_;
   std::vector<Index> pair_bond_;  // bond index per pair, -1 for a contact
   std::vector<Real> x_, y_, r_, ref_x_, ref_y_, fx_, fy_, pg_;
+  // Vapour bookkeeping (cavitate): vapour mass per pore, each pore's gas mass after the last
+  // cavitate() (the flow's change since then moves vapour), prescribed-pressure pores (no vapour).
+  std::vector<Real> vap_, mp_prev_;
+  std::vector<std::uint8_t> bc_pore_;
   Real mean_radius_ = 0;
   CouplingStats stats_;
 };

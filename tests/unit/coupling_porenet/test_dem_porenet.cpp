@@ -170,6 +170,53 @@ TEST(CouplingPorenet, UndrainedCompressionRaisesPressure) {
   EXPECT_NEAR(dp / dp_pred, 1.0, 0.02);
 }
 
+// Vapour condenses once compressed (DemPorenetCoupling::cavitate): a closed saturated sample starts
+// with 0.1 % vapour at water's vapour pressure p_v in every pore, then compacts by more than that and
+// equalises (wide channels). All the vapour must be gone (it exists only at p_v; kept as a gas it
+// would stay as bubbles of p_v/p of their volume), and the mean pressure is the liquid's at the mean
+// density, p_liquid(M/V), M the total mass (the barotropic EOS: closed form; tolerance 2e-3, the
+// pressure spread left after equalisation). Mass: condensation conserves it (1e-12 relative).
+TEST(CouplingPorenet, UndrainedCompressionCondensesTheVapour) {
+  auto s = specimen(0.02);
+  DemPorenetCoupling c;
+  auto prm = fluid(1.0, 5e7);
+  prm.initial_pressure = prm.ambient_pressure = 1e4;
+  prm.fluid.liquid = porenet::Eos::barotropic(1000, 1e4, 5e7);
+  // Wide channels, so that the pressure equalises within the 600 steps with the platens stopped.
+  prm.network.b1_h0 = 2e-5;
+  prm.network.b1_h_inf = 2e-6;
+  prm.network.b2_gamma = 0.2;
+  c.init(s->sys, prm);
+  c.set_uniform_state(2.34e3, 0.999);
+  const Real V0 = sum_void(c.network());
+  const Real M0 = c.flow().total_liquid_mass() + c.flow().total_gas_mass();
+  c.step(s->sys);
+  const Real vap0 = c.total_vapour(), gas0 = c.flow().total_gas_mass();
+  for (int k = 0; k < 1500; ++k) c.step(s->sys);
+  s->sys.walls[0].velocity.setZero();
+  s->sys.walls[1].velocity.setZero();
+  for (int k = 0; k < 600; ++k) c.step(s->sys);
+  const auto& net = c.network();
+  const Real V = sum_void(net);
+  Real pv = 0;
+  const auto p = c.flow().pressure();
+  for (Index i = 0; i < net.n_pores(); ++i) pv += p[i] * net.pore_void[i];
+  const Real M = c.flow().total_liquid_mass() + c.flow().total_gas_mass();
+  const Real p_pred = prm.fluid.liquid.pressure(M / V);
+  std::printf("condensing: dV/V0 %.4g, vapour at start %.3g kg, %ld condensations (%.3g kg), vapour left %.3g kg, gas "
+              "left %.3g kg, mean p %.6g Pa, p_liquid(M/V) %.6g Pa, rel err %.3g, mass balance %.3g\n",
+              (V0 - V) / V0, vap0, c.stats().condensations, c.stats().condensed_mass, c.total_vapour(),
+              c.flow().total_gas_mass(), pv / V, p_pred, std::abs(pv / V / p_pred - 1),
+              (M - M0 - c.stats().vapour_mass) / M0);
+  EXPECT_GT((V0 - V) / V0, 2e-3);   // compacted by more than the vapour's volume
+  EXPECT_NEAR(vap0 / gas0, 1.0, 1e-12);  // the start's gas is vapour (S = 1 sample)
+  EXPECT_GT(c.stats().condensations, 0);
+  EXPECT_EQ(c.total_vapour(), 0);
+  EXPECT_LT(c.flow().total_gas_mass(), 1e-9 * gas0);  // round-off of the last condensations
+  EXPECT_NEAR(pv / V / p_pred, 1.0, 2e-3);
+  EXPECT_NEAR((M - M0 - c.stats().vapour_mass) / M0, 0.0, 1e-12);
+}
+
 // Each phase's mass is conserved in a closed sample during DEM motion, across retriangulations
 // (porenet's remap rescales per phase).
 TEST(CouplingPorenet, PhaseMassesConservedWithRetriangulation) {

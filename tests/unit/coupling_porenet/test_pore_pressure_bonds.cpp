@@ -87,6 +87,29 @@ TEST(PorePressureBonds, SeedDiameterHeightGivesTwoROverTOfIt) {
   EXPECT_NEAR(T, expected, 1e-3 * expected);
 }
 
+// The contact stress of Eq. B1 acts over the same height as the force: suction -|P| in the pore
+// pulls the three discs together and each bonded pair carries the compression F = |P| h R / sqrt(3)
+// (statics as above), so sigma_n = F / (2 R h) = |P| / (2 sqrt(3)) whichever the height h. With the
+// seed's sphere forces (h = 2R) over a 1 m section it would be 2R/t = 2e-3 of that, and B1's
+// exp(-1.5e-7 sigma_n) would leave every channel at h0 under any load. Tolerance 1e-3 (statics).
+TEST(PorePressureBonds, ContactStressOfB1IsThePorePressuresOverTheSameHeight) {
+  for (const ForceHeight h : {ForceHeight::Thickness, ForceHeight::Diameter}) {
+    dem::DemSystem s = triangle();
+    DemPorenetCoupling c;
+    c.init(s, gas(h));
+    c.set_uniform_state(5e4, 0);  // gauge -5e4 Pa
+    for (int k = 0; k < 4000; ++k) c.step(s);
+    const Real P = 1e5 - c.flow().pressure()[0];
+    const Real expected = P / (2 * std::sqrt(3.0));
+    ASSERT_EQ(c.pairs().size(), 3u);
+    for (std::size_t q = 0; q < 3; ++q) {
+      std::printf("%s: suction %.6g Pa, sigma_n %.6g Pa, |P|/(2 sqrt 3) %.6g Pa\n",
+                  h == ForceHeight::Diameter ? "diameter" : "thickness", P, c.pairs().sigma_n[q], expected);
+      EXPECT_NEAR(c.pairs().sigma_n[q], expected, 1e-3 * expected);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace ff::coupling
 
@@ -120,6 +143,53 @@ TEST(PorePressureBonds, CavitationHoldsTheVapourPressureAndKeepsTheLiquid) {
     } else {
       EXPECT_LT(p, 1.5e3);
       EXPECT_EQ(c.stats().cavitations, 0);
+    }
+  }
+}
+
+// Condensation: vapour exists only at the vapour pressure p_v. A cavitated pore (all its gas vapour)
+// set above p_v (20 kPa with 10 % vapour; 5 MPa almost all liquid) condenses vapour into
+// liquid at constant total mass M: back to p_v with liquid fraction S = (M/V - rho_v) / (rho_q - rho_v)
+// (both phases at p_v fill V), or, if M/V exceeds the liquid's density at p_v, all of it, leaving a
+// compressed liquid at p = p_liquid(M / V). Closed forms from the EOS; tolerance 1e-12 (round-off).
+TEST(PorePressureBonds, CompressedVapourCondensesBackToLiquid) {
+  const Real pv = 2.34e3;
+  for (const bool all : {false, true}) {
+    dem::DemSystem s = triangle();
+    DemPorenetCoupling c;
+    auto prm = gas(ForceHeight::Thickness);
+    prm.saturation = 1;
+    prm.cavitation_pressure = pv;
+    c.init(s, prm);
+    c.set_uniform_state(1e3, 1.0);
+    c.step(s);  // cavitates: vapour at p_v
+    ASSERT_EQ(c.stats().cavitations, 1);
+    ASSERT_GT(c.total_vapour(), 0);
+    EXPECT_NEAR(c.total_vapour() / c.flow().gas_mass()[0], 1.0, 1e-12);  // all the gas is vapour
+    // Compressed states; the gas that appears is vapour (the sample's gas is all vapour).
+    const Real a0 = all ? 1 - 1e-6 : 0.9;
+    c.flow().set_pore_state(0, all ? 5e6 : 2e4, a0);
+    const Real M = c.flow().liquid_mass()[0] + c.flow().gas_mass()[0];
+    c.step(s);
+    const Real V = c.network().pore_void[0];
+    const Real rq = prm.fluid.liquid.density(pv, true), rv = prm.fluid.gas.density(pv, false);
+    const Real M1 = c.flow().liquid_mass()[0] + c.flow().gas_mass()[0];
+    std::printf("%s: p %.6g Pa, S %.9f, total mass change %.3g, vapour left %.3g kg, condensed %.3g kg\n",
+                all ? "all condenses" : "back to p_v", c.flow().pressure()[0], c.flow().liquid_fraction()[0],
+                M1 / M - 1,
+                c.total_vapour(), c.stats().condensed_mass);
+    EXPECT_NEAR(M1 / M, 1.0, 1e-12);
+    EXPECT_EQ(c.stats().condensations, 1);
+    if (all) {
+      EXPECT_EQ(c.flow().gas_mass()[0], 0);
+      EXPECT_EQ(c.total_vapour(), 0);
+      EXPECT_NEAR(c.flow().pressure()[0] / prm.fluid.liquid.pressure(M / V), 1.0, 1e-12);
+      EXPECT_GT(c.flow().pressure()[0], 1e6);
+    } else {
+      EXPECT_EQ(c.flow().pressure()[0], pv);
+      EXPECT_NEAR(c.flow().liquid_fraction()[0], (M / V - rv) / (rq - rv), 1e-12);
+      EXPECT_NEAR(c.total_vapour() / c.flow().gas_mass()[0], 1.0, 1e-12);
+      EXPECT_GT(c.flow().liquid_fraction()[0], a0);  // vapour went into the liquid
     }
   }
 }
