@@ -62,6 +62,10 @@ void declare(ParamTable& t) {
            "time stepping of the pore flow: auto (2D explicit with sub-steps, 3D implicit), explicit or implicit "
            "(3D only: one backward-Euler step per DEM step)")
       .one_of({"auto", "explicit", "implicit"});
+  t.real("fluid.cg_tolerance", 1e-12, "-",
+         "3D implicit flow: relative residual of the conjugate-gradient pressure solve (stiff water and drained pores "
+         "may need 1e-10; the phase masses stay conserved at any value, the channel fluxes being antisymmetric)")
+      .open_range(0, 1);
   t.real("fluid.min_void_relative", 0.05, "-",
          "floor of a pore's void volume as a fraction of the mean cell (slivers set the explicit flow step)")
       .open_range(0, 1);
@@ -83,7 +87,7 @@ void declare(ParamTable& t) {
 // Keys of one dimension only: set in the other, they are an error (not silently ignored).
 const std::vector<std::string> k2DOnly = {"fluid.aperture_h0", "fluid.aperture_hinf", "fluid.aperture_gamma",
                                           "fluid.shear_forces", "fluid.cavitation_pressure", "fluid.force_height"};
-const std::vector<std::string> k3DOnly = {"fluid.pfv_factor"};
+const std::vector<std::string> k3DOnly = {"fluid.pfv_factor", "fluid.cg_tolerance"};
 
 porenet::TwoPhaseParams fluid_params(const Config& cfg) {
   porenet::TwoPhaseParams f;
@@ -123,6 +127,7 @@ coupling::Porenet3DParams params_3d(const Config& cfg) {
   p.saturation = cfg.real("fluid.saturation");
   p.network.min_void_relative = cfg.real("fluid.min_void_relative");
   p.pfv_factor = cfg.real("fluid.pfv_factor");
+  p.fluid.cg_tolerance = cfg.real("fluid.cg_tolerance");
   p.retriangulation_tolerance = cfg.real("fluid.retriangulation_tolerance");
   p.implicit = cfg.string("fluid.flow_scheme") != "explicit";
   p.drained = false;  // the lateral hull pores only: set by SaturatedUcsRun's on_network
