@@ -63,8 +63,8 @@ void declare(ParamTable& t) {
            "(3D only: one backward-Euler step per DEM step)")
       .one_of({"auto", "explicit", "implicit"});
   t.real("fluid.cg_tolerance", 1e-12, "-",
-         "3D implicit flow: relative residual of the conjugate-gradient pressure solve (stiff water and drained pores "
-         "may need 1e-10; the phase masses stay conserved at any value, the channel fluxes being antisymmetric)")
+         "3D implicit flow: relative residual of the conjugate-gradient pressure solve (porenet; the phase masses stay "
+         "conserved at any value, the channel fluxes being antisymmetric)")
       .open_range(0, 1);
   t.real("fluid.min_void_relative", 0.05, "-",
          "floor of a pore's void volume as a fraction of the mean cell (slivers set the explicit flow step)")
@@ -198,10 +198,6 @@ class PoreFluid {
  private:
   void setup(const dem::DemSystem& sys, const Config& cfg, const dem::SampleInfo& info) {
     dim3_ = info.dim == 3;
-    for (const auto& k : dim3_ ? k2DOnly : k3DOnly)
-      if (cfg.has(k)) cfg.fail(k, fmt::format("applies to {} samples only; this one is {}D", dim3_ ? "2D" : "3D", info.dim));
-    if (!dim3_ && cfg.string("fluid.flow_scheme") == "implicit")
-      cfg.fail("fluid.flow_scheme", "the 2D coupling steps the flow explicitly (sub-steps); use auto or explicit");
     if (!dim3_) return;
     // Sides drained: hull pores whose centroid is more than two max radii from both ends of the
     // sample along the loading axis (the platens are impermeable), at every (re)build.
@@ -393,7 +389,20 @@ class SaturatedUcsRun final : public UcsRun {
   PvdSeries pvd_;
 };
 
-RunStatus run(const Config& cfg, const RunOptions& opt) { return SaturatedUcsRun(cfg, opt).run(); }
+// `fracflow check` and run: the sample's checks, and keys of the other dimension.
+void validate(const Config& cfg) {
+  dem::validate_dem_sample(cfg);
+  const bool dim3 = cfg.integer("dem.dim") == 3;
+  for (const auto& k : dim3 ? k2DOnly : k3DOnly)
+    if (cfg.has(k)) cfg.fail(k, fmt::format("applies to {} samples only; this one has dem.dim = {}", dim3 ? "2D" : "3D", cfg.integer("dem.dim")));
+  if (!dim3 && cfg.string("fluid.flow_scheme") == "implicit")
+    cfg.fail("fluid.flow_scheme", "the 2D coupling steps the flow explicitly (sub-steps); use auto or explicit");
+}
+
+RunStatus run(const Config& cfg, const RunOptions& opt) {
+  validate(cfg);
+  return SaturatedUcsRun(cfg, opt).run();
+}
 
 }  // namespace
 
@@ -401,7 +410,7 @@ Driver saturated_ucs_driver() {
   return Driver{"saturated_ucs",
                 "uniaxial compression of a bonded sample with water and gas in its pores (2D: seed 004 network; 3D: "
                 "PFV-style network)",
-                declare, run, dem::validate_dem_sample};
+                declare, run, validate};
 }
 
 }  // namespace ff::drivers

@@ -1,5 +1,5 @@
 // The saturated_ucs driver (UcsRun + the pore fluid through its hooks) run whole, in-process, on a
-// small bonded sphere specimen (~300 spheres, 6 mm cube) with the 3D PFV-style network
+// small bonded sphere specimen (226 spheres, 6 mm cube) with the 3D PFV-style network
 // (coupling::DemPorenet3D), and on the 2D example for its checkpoint.
 #include <gtest/gtest.h>
 
@@ -7,6 +7,7 @@
 #include <fstream>
 #include <string>
 
+#include "core/error.hpp"
 #include "resume_compare.hpp"
 #include "ucs_test_support.hpp"
 
@@ -188,6 +189,32 @@ TEST(SaturatedUcs2D, ResumeBitIdentical) {
   test::expect_same_results(whole, parts, "2D saturated UCS, resumed at step 300");
   std::filesystem::remove_all(whole);
   std::filesystem::remove_all(parts);
+}
+
+}  // namespace
+
+namespace {
+
+// A key of the other dimension is an error naming it (not silently ignored), as in `fracflow check`.
+TEST(SaturatedUcs, KeysOfTheOtherDimensionAreRefused) {
+  const auto out = test::scratch("sat_keys");
+  try {
+    test::run_scenario(scenario_3d("cavitation_pressure = 0\n"), {}, out, 1);
+    FAIL() << "a 2D-only key was accepted for a 3D sample";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("fluid.cavitation_pressure"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("2D samples only"), std::string::npos) << e.what();
+  }
+  try {
+    std::ifstream f(std::string(FRACFLOW_SOURCE_DIR) + "/examples/saturated_ucs_2d.toml");
+    std::stringstream ss;
+    ss << f.rdbuf();
+    test::run_scenario(ss.str(), {"fluid.pfv_factor=0.1"}, out, 1);
+    FAIL() << "a 3D-only key was accepted for a 2D sample";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("fluid.pfv_factor"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(out);
 }
 
 }  // namespace
