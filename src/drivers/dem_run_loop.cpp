@@ -38,6 +38,13 @@ void DemRun::write_checkpoint(const fs::path& dir) {
   w.commit();
 }
 
+// A particle snapshot, then the driver's own files for it (vtk_written).
+void DemRun::write_vtk() {
+  const long index = (*c_.vtk_index)++;
+  vtk_writer_.write(sys, index, extent_);
+  vtk_written(index);
+}
+
 void DemRun::checkpoint() {
   write_checkpoint(cp_dir_);
   control_.checkpoint_written();
@@ -63,7 +70,7 @@ void DemRun::begin_curve() {
   start_energy();
   add_energy_columns();
   series_.open(opt.out_dir / "series.csv", columns);
-  if (vtk_) vtk_writer_.write(sys, (*c_.vtk_index)++, extent_);
+  if (vtk_) write_vtk();
   checkpoint();  // the end of a stage
 }
 
@@ -90,7 +97,7 @@ void DemRun::open_outputs() {
   if (vtk_) vtk_writer_.open(opt.out_dir / "vtk", opt.resume, sys.time, vtk_membrane);
   if (sample_particles > 0) vtk_writer_.set_sample_particles(sample_particles);
   if (vtk_ && !opt.resume) {
-    vtk_writer_.write(sys, (*c_.vtk_index)++, extent_);
+    write_vtk();
     if (on_curve()) *c_.next_vtk_strain = vtk_every_;
   }
   if (opt.resume && on_curve() && *c_.rows > 0) {  // the elastic fit needs the whole curve
@@ -121,7 +128,7 @@ std::string DemRun::curve_row(const DemRowReport& r, double& fraction) {
   }
   ++*c_.rows;
   if (vtk_ && r.strain >= *c_.next_vtk_strain) {
-    vtk_writer_.write(sys, (*c_.vtk_index)++, extent_);
+    write_vtk();
     while (*c_.next_vtk_strain <= r.strain) *c_.next_vtk_strain += vtk_every_;
   }
   std::string stop;
@@ -217,7 +224,7 @@ RunStatus DemRun::run() {
 }
 
 void DemRun::finish(const std::string& stop_reason) {
-  if (vtk_) vtk_writer_.write(sys, (*c_.vtk_index)++, extent_);
+  if (vtk_) write_vtk();
   DemOutcome out;
   out.stop_reason = stop_reason;
   out.fit = fit_elastic(e_hist_, s_hist_, l_hist_, static_cast<std::size_t>(*c_.peak_row));

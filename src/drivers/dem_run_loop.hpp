@@ -97,6 +97,8 @@ class DemRun {
   // summary.json's driver part, its plots and its closing line.
   virtual void summarize(nlohmann::json& j, const DemOutcome& out) = 0;
   virtual void plots() {}
+  // After each particle snapshot number `index` (at sys.time): the driver's own VTK files.
+  virtual void vtk_written(long /*index*/) {}
   virtual void report(const DemOutcome& out) = 0;
 
   // --- services for the hooks ---
@@ -119,6 +121,7 @@ class DemRun {
 
  private:
   void write_checkpoint(const std::filesystem::path& dir);
+  void write_vtk();
   void check_finite(const DemRowReport& r) const;  // throws NumericalError naming the column
   void open_outputs();
   std::string curve_row(const DemRowReport& r, double& fraction);

@@ -1,26 +1,31 @@
-// Uniaxial compression of a partially saturated 2D bonded-disc specimen (seed 004, Krzaczek,
-// Tejchman & Nitka 2024): the UCS driver's sample, platens and measurements, with the pore network
-// and two-phase flow of src/coupling/porenet stepped inside each DEM step. Extra series columns:
-// the largest and the mean pore pressure, the liquid saturation and the retriangulations.
+// Uniaxial compression of a partially saturated bonded specimen (seed 004, Krzaczek, Tejchman &
+// Nitka 2024): the UCS test (UcsRun: sample, platens, time step, gauge, curve, checkpoints) plus the
+// pore fluid through UcsRun's hooks. 2D discs: seed 004's network (DemPorenetCoupling, explicit
+// flow, contact channels, cavitation); 3D spheres: the PFV-style network of tetrahedral pores and
+// facet throats (DemPorenet3D, implicit flow by default). Either one steps the DEM stages itself
+// inside each time step. Extra series columns: the largest and the mean pore pressure, the liquid
+// saturation, the retriangulations and the flow sub-steps.
 #include "drivers/saturated/saturated_ucs_driver.hpp"
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 
 #include "core/log.hpp"
 #include "coupling/porenet/dem_porenet.hpp"
+#include "coupling/porenet/dem_porenet3d.hpp"
 #include "dem/dem_params.hpp"
 #include "dem/diagnostics.hpp"
 #include "dem/sample_builder.hpp"
-#include "drivers/dem_results.hpp"
-#include "drivers/dem_run_loop.hpp"
 #include "drivers/ucs/ucs_driver.hpp"
-#include "drivers/ucs/ucs_measure.hpp"
-#include "io/plot.hpp"
+#include "drivers/ucs/ucs_run.hpp"
+#include "io/pvd.hpp"
+#include "io/vtk.hpp"
 
 namespace fs = std::filesystem;
 
@@ -46,51 +51,59 @@ void declare(ParamTable& t) {
            "pores held at the ambient pressure: sides (hull pores at the free lateral faces; platens impermeable) or "
            "closed (undrained sample)")
       .one_of({"sides", "closed"});
-  t.real("fluid.aperture_h0", 1e-6, "m", "Eq. B1 contact/bond channel aperture at zero normal stress").positive();
-  t.real("fluid.aperture_hinf", 1e-7, "m", "Eq. B1 aperture at infinite normal stress").positive();
-  t.real("fluid.aperture_gamma", 0.01, "-", "Eq. B2 reduction factor of pore-to-pore channel apertures").positive();
+  t.real("fluid.aperture_h0", 1e-6, "m", "2D: Eq. B1 contact/bond channel aperture at zero normal stress").positive();
+  t.real("fluid.aperture_hinf", 1e-7, "m", "2D: Eq. B1 aperture at infinite normal stress").positive();
+  t.real("fluid.aperture_gamma", 0.01, "-", "2D: Eq. B2 reduction factor of pore-to-pore channel apertures").positive();
+  t.real("fluid.pfv_factor", 1.0, "-",
+         "3D: factor on the PFV throat conductance A_f R_h^2 / (2 mu L) (Chareyre et al. 2012; < 1: tighter, "
+         "concrete-like throats)")
+      .positive();
+  t.string("fluid.flow_scheme", "auto",
+           "time stepping of the pore flow: auto (2D explicit with sub-steps, 3D implicit), explicit or implicit "
+           "(3D only: one backward-Euler step per DEM step)")
+      .one_of({"auto", "explicit", "implicit"});
+  t.real("fluid.cg_tolerance", 1e-12, "-",
+         "3D implicit flow: relative residual of the conjugate-gradient pressure solve (porenet; the phase masses stay "
+         "conserved at any value, the channel fluxes being antisymmetric)")
+      .open_range(0, 1);
   t.real("fluid.min_void_relative", 0.05, "-",
          "floor of a pore's void volume as a fraction of the mean cell (slivers set the explicit flow step)")
       .open_range(0, 1);
   t.real("fluid.retriangulation_tolerance", 0.25, "-",
          "retriangulate when a particle has moved this fraction of the mean radius since the last triangulation")
       .positive();
-  t.boolean("fluid.shear_forces", true, "add the channel shear forces (B25, B28) to the pressure forces (B26-B27)");
+  t.boolean("fluid.shear_forces", true, "2D: add the channel shear forces (B25, B28) to the pressure forces (B26-B27)");
   t.real("fluid.cavitation_pressure", 2.34e3, "Pa",
-         "absolute pressure below which a pore's liquid cavitates (vapour fills the rest of its void at this pressure; "
-         "water at 20 C: 2.34e3); 0 = the liquid takes any tension")
+         "2D: absolute pressure below which a pore's liquid cavitates (vapour fills the rest of its void at this "
+         "pressure; water at 20 C: 2.34e3); 0 = the liquid takes any tension")
       .non_negative();
   t.string("fluid.force_height", "auto",
-           "wetted height of a grain in B27/B28, to match the height its contacts and bonds act over: thickness (1 m "
+           "2D: wetted height of a grain in B27/B28, to match the height its contacts and bonds act over: thickness (1 m "
            "discs: linear/parallel laws), diameter (the seed's 2 r_j: spheres in one layer, its cohesive law A1-A7), "
            "auto (diameter with dem.contact_law = cohesive, else thickness)")
       .one_of({"auto", "thickness", "diameter"});
 }
 
-const std::vector<std::string> kColumns = {
-    "step", "time_s", "axial_strain", "axial_stress_Pa", "lateral_strain", "volumetric_strain", "cracks_tensile",
-    "cracks_shear", "cracks_total", "intact_bonds", "kinetic_energy_J", "unbalanced_force_ratio",
-    "max_pore_pressure_Pa", "mean_pore_pressure_Pa", "saturation", "retriangulations", "flow_substeps"};
+// Keys of one dimension only: set in the other, they are an error (not silently ignored).
+const std::vector<std::string> k2DOnly = {"fluid.aperture_h0", "fluid.aperture_hinf", "fluid.aperture_gamma",
+                                          "fluid.shear_forces", "fluid.cavitation_pressure", "fluid.force_height"};
+const std::vector<std::string> k3DOnly = {"fluid.pfv_factor", "fluid.cg_tolerance"};
 
-struct SatState {
-  Real peak_stress = 0, strain_at_peak = 0;
-  long peak_row = 0, rows = 0, cracks_written = 0, vtk_index = 0;
-  Real next_vtk_strain = 0, h0 = 0;
-  int finished = 0;
-  Real max_pore_pressure = 0, strain_at_max_pressure = 0;
-};
+porenet::TwoPhaseParams fluid_params(const Config& cfg) {
+  porenet::TwoPhaseParams f;
+  const Real T = 293.15;
+  f.liquid = cfg.string("fluid.liquid_eos") == "peng_robinson"
+                 ? porenet::Eos::water_pr(T)
+                 : porenet::Eos::barotropic(1000, cfg.real("fluid.initial_pressure"), cfg.real("fluid.liquid_bulk_modulus"));
+  f.gas = cfg.string("fluid.gas_eos") == "peng_robinson" ? porenet::Eos::air_pr(T) : porenet::Eos::ideal_gas(T, 28.9586);
+  f.mu_liquid = cfg.real("fluid.liquid_viscosity");
+  f.mu_gas = cfg.real("fluid.gas_viscosity");
+  return f;
+}
 
 coupling::PorenetCouplingParams coupling_params(const Config& cfg) {
   coupling::PorenetCouplingParams p;
-  const Real T = 293.15;
-  p.fluid.liquid = cfg.string("fluid.liquid_eos") == "peng_robinson"
-                       ? porenet::Eos::water_pr(T)
-                       : porenet::Eos::barotropic(1000, cfg.real("fluid.initial_pressure"),
-                                                  cfg.real("fluid.liquid_bulk_modulus"));
-  p.fluid.gas = cfg.string("fluid.gas_eos") == "peng_robinson" ? porenet::Eos::air_pr(T)
-                                                                : porenet::Eos::ideal_gas(T, 28.9586);
-  p.fluid.mu_liquid = cfg.real("fluid.liquid_viscosity");
-  p.fluid.mu_gas = cfg.real("fluid.gas_viscosity");
+  p.fluid = fluid_params(cfg);
   p.initial_pressure = p.ambient_pressure = cfg.real("fluid.initial_pressure");
   p.saturation = cfg.real("fluid.saturation");
   p.drainage = cfg.string("fluid.drainage") == "closed" ? coupling::Drainage::Closed : coupling::Drainage::Sides;
@@ -107,105 +120,176 @@ coupling::PorenetCouplingParams coupling_params(const Config& cfg) {
   return p;
 }
 
+coupling::Porenet3DParams params_3d(const Config& cfg) {
+  coupling::Porenet3DParams p;
+  p.fluid = fluid_params(cfg);
+  p.initial_pressure = p.ambient_pressure = cfg.real("fluid.initial_pressure");
+  p.saturation = cfg.real("fluid.saturation");
+  p.network.min_void_relative = cfg.real("fluid.min_void_relative");
+  p.pfv_factor = cfg.real("fluid.pfv_factor");
+  p.fluid.cg_tolerance = cfg.real("fluid.cg_tolerance");
+  p.retriangulation_tolerance = cfg.real("fluid.retriangulation_tolerance");
+  p.implicit = cfg.string("fluid.flow_scheme") != "explicit";
+  p.drained = false;  // the lateral hull pores only: set by SaturatedUcsRun's on_network
+  return p;
+}
+
+// Checkpointed with the UCS state (raw bytes: the layout is the format of "saturated.state").
+struct SatExtra {
+  Real max_pore_pressure = 0;  // largest pore pressure of any step [Pa]
+  Real void0 = 0;              // the network's void volume at the start [m^3]
+  Real liquid_mass0 = 0, gas_mass0 = 0;  // [kg] (2D: per m of depth)
+};
+
 }  // namespace
 }  // namespace ff::drivers
 
 namespace ff {
-template <> struct is_checkpoint_pod<drivers::SatState> : std::true_type {};
+template <> struct is_checkpoint_pod<drivers::SatExtra> : std::true_type {};
 }  // namespace ff
 
 namespace ff::drivers {
 namespace {
 
-void make_plots(const fs::path& out, const Config& cfg) {
-  if (!cfg.boolean("output.plots")) return;
-  fs::create_directories(out / "plots");
-  std::vector<PlotJob> jobs = {
-      axial_strain_plot(out, "stress_strain_cracks", "Saturated uniaxial compression: stress and cracks",
-                        {"axial_stress_Pa"}, 1e-6, "axial stress [MPa]"),
-      axial_strain_plot(out, "pore_pressure", "Saturated uniaxial compression: pore pressure",
-                        {"max_pore_pressure_Pa", "mean_pore_pressure_Pa"}, 1e-6, "pore pressure [MPa]")};
-  jobs[0].spec.y2 = {"cracks_total", "cracks_tensile", "cracks_shear"};
-  jobs[0].spec.y2label = "number of cracks";
-  plot_series(jobs);
-}
-
-class SaturatedUcsRun final : public DemRun {
+// The pore fluid of either dimension: seed 004's 2D network or the 3D PFV network.
+class PoreFluid {
  public:
-  SaturatedUcsRun(const Config& c, const RunOptions& o)
-      : DemRun(c, o, {"ucs", "stress", "axial_stress_Pa", "ucs.platen_velocity or ucs.max_strain"}) {}
+  void init(dem::DemSystem& sys, const Config& cfg, const dem::SampleInfo& info) {
+    setup(sys, cfg, info);
+    if (dim3_) c3_.init(sys, params_3d(cfg));
+    else c2_.init(sys, coupling_params(cfg));
+  }
+  void load(CheckpointReader& r, dem::DemSystem& sys, const Config& cfg, const dem::SampleInfo& info) {
+    setup(sys, cfg, info);
+    if (dim3_) c3_.load(r, sys, params_3d(cfg));
+    else c2_.load(r, sys, coupling_params(cfg));
+  }
+  void save(CheckpointWriter& w) const {
+    if (dim3_) c3_.save(w);
+    else c2_.save(w);
+  }
+  void step(dem::DemSystem& sys) {
+    if (dim3_) c3_.step(sys);
+    else c2_.step(sys);
+  }
+  bool dim3() const { return dim3_; }
+  const porenet::Network2D& network() const { return dim3_ ? c3_.network() : c2_.network(); }
+  porenet::TwoPhaseFlow& flow() { return dim3_ ? c3_.flow() : c2_.flow(); }
+  Real max_pressure() const { return dim3_ ? c3_.max_pressure() : c2_.max_pressure(); }
+  long retriangulations() const { return dim3_ ? c3_.stats().retriangulations : c2_.stats().retriangulations; }
+  long substeps() const { return dim3_ ? c3_.stats().last_substeps : c2_.stats().last_substeps; }
+  const coupling::DemPorenetCoupling& c2() const { return c2_; }
+  const coupling::DemPorenet3D& c3() const { return c3_; }
+  Index drained_pores() const { return drained_; }
 
- private:
-  DemLoopCounters counters() override {
-    return {&st_.rows, &st_.peak_row, &st_.peak_stress, &st_.strain_at_peak, &st_.cracks_written, &st_.vtk_index,
-            &st_.next_vtk_strain, &st_.finished};
-  }
-  void set_up() override {
-    info = dem::build_sample(cfg, sys);
-    if (info.dim != 2) throw InputError("saturated_ucs: dem.dim must be 2 (the seed 004 network is 2D)");
-    dem::add_platens(sys, info, cfg.real("ucs.platen_friction"));
-    dem::choose_time_step(cfg, sys);
-    const Real v = cfg.real("ucs.platen_velocity");
-    sys.walls[0].velocity[info.axis] = v;
-    sys.walls[1].velocity[info.axis] = -v;
-    gauge_.init(sys, info);
-    st_.h0 = gauge_.initial_height();
-    fluid_.init(sys, coupling_params(cfg));
-    log::info("pore network: {} pores, {} channels ({} pairs); DEM step {:.3g} s, flow stable step {:.3g} s",
-              fluid_.network().n_pores(), fluid_.network().n_channels(), fluid_.pairs().size(), sys.settings.dt,
-              fluid_.flow().stable_dt());
-  }
-  void save_after_dem(CheckpointWriter& w) const override {
-    w.put_value("ucs.state", st_);
-    w.put_value("ucs.sample", sample_record(info));
-    w.put("ucs.gauge", gauge_.particles());
-    fluid_.save(w);
-  }
-  void load_after_dem(CheckpointReader& r) override {
-    st_ = r.get_value<SatState>("ucs.state");
-    info = sample_info(r.get_value<SampleRecord>("ucs.sample"));
-    std::vector<Index> g;
-    r.get("ucs.gauge", g);
-    gauge_.restore(std::move(g), st_.h0);
-    fluid_.load(r, sys, coupling_params(cfg));
-  }
-  void ready() override { columns = kColumns; }
-  double planned_steps() const override {
-    return cfg.real("ucs.max_strain") * st_.h0 / (2 * cfg.real("ucs.platen_velocity") * sys.settings.dt);
-  }
-  void advance(long steps) override {
-    for (long s = 0; s < steps; ++s) {
-      fluid_.step(sys);
-      const Real pm = fluid_.max_pressure();
-      if (pm > st_.max_pore_pressure) st_.max_pore_pressure = pm;
-    }
-  }
-  DemRowReport measure() override {
-    const CompressionState m = gauge_.measure(sys, info);
-    const auto& net = fluid_.network();
-    const auto p = fluid_.flow().pressure();
+  // Void-weighted mean pressure [Pa] and the total void volume [m^3 (2D: per m of depth x t)].
+  void mean_pressure(Real& p_mean, Real& void_volume) {
+    const auto& net = network();
+    const auto p = flow().pressure();
     Real pv = 0, v = 0;
     for (Index i = 0; i < net.n_pores(); ++i) {
       pv += p[i] * net.pore_void[i];
       v += net.pore_void[i];
     }
-    row = {static_cast<double>(sys.step_count), sys.time, m.axial_strain, m.axial_stress, m.lateral_strain,
-           m.volumetric_strain, static_cast<double>(sys.cracks.tensile), static_cast<double>(sys.cracks.shear),
-           static_cast<double>(sys.cracks.total()), static_cast<double>(intact_bonds(sys)), kinetic_energy(sys),
-           max_unbalanced_force_ratio(sys), fluid_.max_pressure(), pv / v, fluid_.flow().saturation(),
-           static_cast<double>(fluid_.stats().retriangulations), static_cast<double>(fluid_.stats().last_substeps)};
-    if (m.axial_stress >= st_.peak_stress) write_pores("pores_at_peak.csv");
-    status.clear();
-    fmt::format_to(std::back_inserter(status), "strain {:.3f}%  stress {:.3f} MPa  p_max {:.3f} MPa  cracks {}",
-                   100 * m.axial_strain, 1e-6 * m.axial_stress, 1e-6 * fluid_.max_pressure(), sys.cracks.total());
-    return {true, m.axial_strain, m.axial_stress, m.lateral_strain};
+    p_mean = pv / v;
+    void_volume = v;
   }
-  // The pore field for pictures: triangle corners and pressure, liquid fraction.
-  void write_pores(const std::string& name) const {
+
+ private:
+  void setup(const dem::DemSystem& sys, const Config& cfg, const dem::SampleInfo& info) {
+    dim3_ = info.dim == 3;
+    if (!dim3_) return;
+    // Sides drained: hull pores whose centroid is more than two max radii from both ends of the
+    // sample along the loading axis (the platens are impermeable), at every (re)build.
+    Real rmax = 0, lo = std::numeric_limits<Real>::infinity(), hi = -lo;
+    for (std::size_t k = 0; k < sys.particles.size(); ++k) {
+      rmax = std::max(rmax, sys.particles.radius[k]);
+      lo = std::min(lo, sys.particles.pos[k][info.axis]);
+      hi = std::max(hi, sys.particles.pos[k][info.axis]);
+    }
+    if (cfg.string("fluid.drainage") != "sides") return;
+    const Real p_out = cfg.real("fluid.initial_pressure"), s_out = cfg.real("fluid.saturation");
+    const int axis = info.axis;
+    c3_.on_network = [this, rmax, lo, hi, p_out, s_out, axis](porenet::TwoPhaseFlow& f, const porenet::Network2D& net) {
+      drained_ = 0;
+      for (Index i = 0; i < net.n_pores(); ++i) {
+        if (!net.pore_hull[i]) continue;
+        const Real c = axis == 0 ? net.pore_cx[i] : axis == 1 ? net.pore_cy[i] : net.pore_cz[i];
+        if (c - lo < 2 * rmax || hi - c < 2 * rmax) continue;
+        f.set_bc(i, porenet::PoreBc::Pressure, p_out, s_out);
+        ++drained_;
+      }
+    };
+  }
+
+  bool dim3_ = false;
+  Index drained_ = 0;
+  coupling::DemPorenetCoupling c2_;
+  coupling::DemPorenet3D c3_;
+};
+
+class SaturatedUcsRun final : public UcsRun {
+ public:
+  using UcsRun::UcsRun;
+
+ private:
+  void after_set_up() override {
+    fluid_.init(sys, cfg, info);
+    const auto& net = fluid_.network();
+    if (fluid_.dim3())
+      log::info("pore network (3D): {} pores, {} throats, {} drained; DEM step {:.3g} s, {} flow", net.n_pores(),
+                net.n_channels(), fluid_.drained_pores(), sys.settings.dt,
+                fluid_.c3().params().implicit ? "implicit" : "explicit");
+    else
+      log::info("pore network: {} pores, {} channels ({} pairs); DEM step {:.3g} s, flow stable step {:.3g} s",
+                net.n_pores(), net.n_channels(), fluid_.c2().pairs().size(), sys.settings.dt, fluid_.flow().stable_dt());
+    Real p;
+    fluid_.mean_pressure(p, ex_.void0);
+    ex_.liquid_mass0 = fluid_.flow().total_liquid_mass();
+    ex_.gas_mass0 = fluid_.flow().total_gas_mass();
+  }
+  void dem_step() override { fluid_.step(sys); }
+  void after_step() override {
+    const Real pm = fluid_.max_pressure();
+    if (pm > ex_.max_pore_pressure) ex_.max_pore_pressure = pm;
+  }
+  void extra_columns(std::vector<std::string>& c) const override {
+    for (const char* k : {"max_pore_pressure_Pa", "mean_pore_pressure_Pa", "saturation", "retriangulations",
+                          "flow_substeps"})
+      c.emplace_back(k);
+  }
+  void extra_row(const CompressionState& m) override {
+    Real pmean, v;
+    fluid_.mean_pressure(pmean, v);
+    for (const double x : {fluid_.max_pressure(), pmean, fluid_.flow().saturation(),
+                           static_cast<double>(fluid_.retriangulations()), static_cast<double>(fluid_.substeps())})
+      row.push_back(x);
+    if (m.axial_stress >= ucs_state().peak_stress) write_pores("pores_at_peak.csv");
+    fmt::format_to(std::back_inserter(status), "  p_max {:.3f} MPa", 1e-6 * fluid_.max_pressure());
+  }
+  void save_extra(CheckpointWriter& w) const override {
+    w.put_value("saturated.state", ex_);
+    fluid_.save(w);
+  }
+  void load_extra(CheckpointReader& r) override {
+    ex_ = r.get_value<SatExtra>("saturated.state");
+    fluid_.load(r, sys, cfg, info);
+    resume_time_ = sys.time;
+  }
+
+  // The pore field for pictures. 2D: triangle corners; 3D: tetrahedron centroid and void.
+  void write_pores(const std::string& name) {
     const auto& net = fluid_.network();
     const auto p = fluid_.flow().pressure();
     const auto a = fluid_.flow().liquid_fraction();
     std::ofstream f(opt.out_dir / name);
+    if (fluid_.dim3()) {
+      f << "x_m,y_m,z_m,void_m3,hull,pressure_Pa,liquid_fraction\n";
+      for (Index i = 0; i < net.n_pores(); ++i)
+        f << fmt::format("{:.9g},{:.9g},{:.9g},{:.6g},{},{:.9g},{:.6g}\n", net.pore_cx[i], net.pore_cy[i],
+                         net.pore_cz[i], net.pore_void[i], int(net.pore_hull[i]), p[i], a[i]);
+      return;
+    }
     f << "x0_m,y0_m,x1_m,y1_m,x2_m,y2_m,pressure_Pa,liquid_fraction\n";
     for (Index i = 0; i < net.n_pores(); ++i) {
       for (int k = 0; k < 3; ++k) {
@@ -215,56 +299,118 @@ class SaturatedUcsRun final : public DemRun {
       f << fmt::format("{:.9g},{:.6g}\n", p[i], a[i]);
     }
   }
-  void summarize(nlohmann::json& j, const DemOutcome& out) override {
-    j["ucs_Pa"] = out.no_peak.empty() ? nlohmann::json(st_.peak_stress) : nlohmann::json(nullptr);
-    if (!out.no_peak.empty()) j["peak"]["largest_stress_Pa"] = st_.peak_stress;
-    put_elastic_fit(j, out.fit, "least squares on the pre-peak curve between 20% and 50% of the peak stress");
-    j["fluid"]["max_pore_pressure_Pa"] = st_.max_pore_pressure;
-    j["fluid"]["saturation_initial"] = cfg.real("fluid.saturation");
-    j["fluid"]["saturation_final"] = fluid_.flow().saturation();
-    j["fluid"]["retriangulations"] = fluid_.stats().retriangulations;
-    j["fluid"]["dem_dt_s"] = sys.settings.dt;
-    j["fluid"]["flow_stable_dt_s"] = fluid_.stats().last_stable_dt;
-    j["fluid"]["flow_substeps"] = fluid_.stats().last_substeps;
-    j["fluid"]["pores"] = fluid_.network().n_pores();
-    j["fluid"]["cavitations"] = fluid_.stats().cavitations;
-    j["fluid"]["vapour_mass_kg_per_m"] = fluid_.stats().vapour_mass;
-    // With sphere forces (force_height = diameter) the sample is a layer of spheres ~2 r thick,
-    // while the axial stress divides by the discs' 1 m: the same peak per mean diameter.
-    const bool layer = fluid_.params().force_height == coupling::ForceHeight::Diameter;
-    Real rm = 0;
-    for (Real r : sys.particles.radius) rm += r;
-    rm /= static_cast<Real>(sys.particles.size());
-    j["fluid"]["force_height"] = layer ? "diameter" : "thickness";
-    if (layer && out.no_peak.empty()) {
-      j["layer"]["thickness_m"] = 2 * rm;
-      j["layer"]["ucs_Pa"] = st_.peak_stress / (2 * rm);
+
+  // vtk/pores_INDEX.vtp beside the particles: 2D the triangles (cells), 3D the tetrahedra's
+  // centroids (vertices), with pressure, liquid fraction and void volume.
+  void extra_vtk(long index) override {
+    const fs::path dir = opt.out_dir / "vtk";
+    if (!pvd_.is_open()) pvd_.open(dir / "pores.pvd", opt.resume, opt.resume ? resume_time_ : sys.time);
+    const auto& net = fluid_.network();
+    const auto n = static_cast<std::size_t>(net.n_pores());
+    const auto p = fluid_.flow().pressure();
+    const auto a = fluid_.flow().liquid_fraction();
+    std::vector<Vec3> pts;
+    std::vector<std::int64_t> conn;
+    if (fluid_.dim3()) {
+      pts.reserve(n);
+      for (std::size_t i = 0; i < n; ++i) pts.emplace_back(net.pore_cx[i], net.pore_cy[i], net.pore_cz[i]);
+    } else {
+      pts.assign(sys.particles.pos.begin(), sys.particles.pos.end());
+      conn.assign(net.pore_v.begin(), net.pore_v.end());
+    }
+    const std::vector<VtkArray> data = {vtk_array("pressure_Pa", p), vtk_array("liquid_fraction", a),
+                                        vtk_array("void_volume_m3", std::span<const Real>(net.pore_void)),
+                                        vtk_array("hull", std::span<const std::uint8_t>(net.pore_hull))};
+    const std::string file = fmt::format("pores_{:06d}.vtp", index);
+    if (fluid_.dim3()) write_vtp(dir / file, pts, VtpCells{}, data, {});
+    else write_vtp(dir / file, pts, VtpCells{VtpCells::Triangles, conn}, {}, data);
+    pvd_.add(sys.time, file);
+  }
+
+  void extra_summary(nlohmann::json& j, const DemOutcome& out) override {
+    auto& f = j["fluid"];
+    f["dimension"] = fluid_.dim3() ? 3 : 2;
+    f["max_pore_pressure_Pa"] = ex_.max_pore_pressure;
+    f["saturation_initial"] = cfg.real("fluid.saturation");
+    f["saturation_final"] = fluid_.flow().saturation();
+    f["retriangulations"] = fluid_.retriangulations();
+    f["dem_dt_s"] = sys.settings.dt;
+    f["flow_substeps"] = fluid_.substeps();
+    f["pores"] = fluid_.network().n_pores();
+    Real pmean, v;
+    fluid_.mean_pressure(pmean, v);
+    f["mean_pore_pressure_final_Pa"] = pmean;
+    f["pore_void_initial_m3"] = ex_.void0;
+    f["pore_void_final_m3"] = v;
+    f["liquid_mass_initial_kg"] = ex_.liquid_mass0;
+    f["gas_mass_initial_kg"] = ex_.gas_mass0;
+    f["liquid_mass_kg"] = fluid_.flow().total_liquid_mass();
+    f["gas_mass_kg"] = fluid_.flow().total_gas_mass();
+    if (fluid_.dim3()) {
+      const auto& c = fluid_.c3();
+      f["flow_scheme"] = c.params().implicit ? "implicit" : "explicit";
+      f["throats"] = fluid_.network().n_channels();
+      f["drained_pores"] = fluid_.drained_pores();
+      const auto& s = c.stats();
+      f["timing"] = {{"triangulation_seconds", s.t_triangulation}, {"network_update_seconds", s.t_update},
+                     {"flow_seconds", s.t_flow}, {"forces_seconds", s.t_forces}};
+    } else {
+      const auto& st = fluid_.c2().stats();
+      f["flow_stable_dt_s"] = st.last_stable_dt;
+      f["cavitations"] = st.cavitations;
+      f["vapour_mass_kg_per_m"] = st.vapour_mass;
+      // With sphere forces (force_height = diameter) the sample is a layer of spheres ~2 r thick,
+      // while the axial stress divides by the discs' 1 m: the same peak per mean diameter.
+      const bool layer = fluid_.c2().params().force_height == coupling::ForceHeight::Diameter;
+      Real rm = 0;
+      for (Real r : sys.particles.radius) rm += r;
+      rm /= static_cast<Real>(sys.particles.size());
+      f["force_height"] = layer ? "diameter" : "thickness";
+      if (layer && out.no_peak.empty()) {
+        j["layer"]["thickness_m"] = 2 * rm;
+        j["layer"]["ucs_Pa"] = ucs_state().peak_stress / (2 * rm);
+      }
     }
     write_pores("pores_final.csv");
   }
-  void plots() override { make_plots(opt.out_dir, cfg); }
-  void report(const DemOutcome& out) override {
-    log::info("{}, max pore pressure {:.3f} MPa, cracks {} ({} tensile, {} shear), {} retriangulations; {}",
-              out.no_peak.empty() ? fmt::format("UCS {:.3f} MPa at axial strain {:.3f}%", 1e-6 * st_.peak_stress,
-                                                100 * st_.strain_at_peak)
-                                  : std::string("no UCS"),
-              1e-6 * st_.max_pore_pressure, sys.cracks.total(), sys.cracks.tensile, sys.cracks.shear,
-              fluid_.stats().retriangulations, out.stop_reason);
+  std::string extra_report() const override {
+    return fmt::format("max pore pressure {:.3f} MPa, {} retriangulations", 1e-6 * ex_.max_pore_pressure,
+                       fluid_.retriangulations());
+  }
+  std::string test_title() const override { return "Saturated uniaxial compression"; }
+  void extra_plots(std::vector<PlotJob>& jobs) const override {
+    jobs.push_back(axial_strain_plot(opt.out_dir, "pore_pressure", test_title() + ": pore pressure",
+                                     {"max_pore_pressure_Pa", "mean_pore_pressure_Pa"}, 1e-6, "pore pressure [MPa]"));
   }
 
-  SatState st_;
-  CompressionGauge gauge_;
-  coupling::DemPorenetCoupling fluid_;
+  SatExtra ex_;
+  double resume_time_ = 0;
+  PoreFluid fluid_;
+  PvdSeries pvd_;
 };
 
-RunStatus run(const Config& cfg, const RunOptions& opt) { return SaturatedUcsRun(cfg, opt).run(); }
+// `fracflow check` and run: the sample's checks, and keys of the other dimension.
+void validate(const Config& cfg) {
+  dem::validate_dem_sample(cfg);
+  const bool dim3 = cfg.integer("dem.dim") == 3;
+  for (const auto& k : dim3 ? k2DOnly : k3DOnly)
+    if (cfg.has(k)) cfg.fail(k, fmt::format("applies to {} samples only; this one has dem.dim = {}", dim3 ? "2D" : "3D", cfg.integer("dem.dim")));
+  if (!dim3 && cfg.string("fluid.flow_scheme") == "implicit")
+    cfg.fail("fluid.flow_scheme", "the 2D coupling steps the flow explicitly (sub-steps); use auto or explicit");
+}
+
+RunStatus run(const Config& cfg, const RunOptions& opt) {
+  validate(cfg);
+  return SaturatedUcsRun(cfg, opt).run();
+}
 
 }  // namespace
 
 Driver saturated_ucs_driver() {
   return Driver{"saturated_ucs",
-                "uniaxial compression of a 2D bonded sample with water and gas in its pores (seed 004 pore network)",
-                declare, run, dem::validate_dem_sample};
+                "uniaxial compression of a bonded sample with water and gas in its pores (2D: seed 004 network; 3D: "
+                "PFV-style network)",
+                declare, run, validate};
 }
 
 }  // namespace ff::drivers

@@ -1,0 +1,220 @@
+// The saturated_ucs driver (UcsRun + the pore fluid through its hooks) run whole, in-process, on a
+// small bonded sphere specimen (226 spheres, 6 mm cube) with the 3D PFV-style network
+// (coupling::DemPorenet3D), and on the 2D example for its checkpoint.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <string>
+
+#include "core/error.hpp"
+#include "resume_compare.hpp"
+#include "ucs_test_support.hpp"
+
+using namespace ff;
+
+namespace {
+
+// The DemPorenet3D test's specimen (tests/unit/coupling_porenet/test_dem_porenet3d.cpp), compressed
+// by the UCS driver to 0.2 % axial strain (~400 steps).
+std::string scenario_3d(const std::string& fluid) {
+  return R"(driver = "saturated_ucs"
+[dem]
+dim = 3
+bond_law = "parallel"
+[dem.group.matrix]
+density = 2400
+[dem.contact.matrix-matrix]
+emod = 2.0e9
+kratio = 2.5
+friction = 0.4
+[dem.bond.matrix-matrix]
+emod = 2.0e9
+kratio = 2.5
+tensile_strength = 17.4e6
+cohesion = 4.35e6
+[sample]
+shape = "box"
+width = 6e-3
+depth = 6e-3
+height = 6e-3
+radius_min = 0.4e-3
+radius_max = 0.6e-3
+porosity = 0.45
+seed = 5
+[ucs]
+platen_velocity = 0.1
+max_strain = 0.002
+series_interval = 50
+[output]
+vtk = false
+plots = false
+progress_interval = 0
+[fluid]
+)" + fluid;
+}
+
+struct Result {
+  nlohmann::json summary, fluid;
+  CsvTable series;
+};
+
+Result run3d(const std::string& name, const std::string& fluid, const std::vector<std::string>& sets = {}) {
+  const auto out = test::scratch(name);
+  EXPECT_EQ(test::run_scenario(scenario_3d(fluid), sets, out, 1), RunStatus::Finished);
+  Result r;
+  r.summary = nlohmann::json::parse(test::slurp(out / "summary.json"));
+  r.fluid = r.summary["fluid"];
+  r.series = read_csv(out / "series.csv");
+  std::filesystem::remove_all(out);
+  return r;
+}
+
+const Result& undrained() {
+  static const Result r = run3d("sat3d_closed", "saturation = 1.0\nliquid_bulk_modulus = 5e7\ndrainage = \"closed\"\n");
+  return r;
+}
+
+// Undrained compression of a saturated closed sample: once the pressure has equalised the liquid's
+// mass M = rho(p) V with the barotropic rho = rho0 exp((p - p0)/K) gives p - p0 = K ln(V0/V) (Wang 2000,
+// Theory of Linear Poroelasticity, with Skempton B = 1; the check of test_dem_porenet3d, through the
+// driver). Implicit flow with the PFV conductance (pfv_factor 1): the pressure equalises within a
+// step. Tolerance 2 %.
+TEST(SaturatedUcs3D, UndrainedPressureRiseFollowsKfLnV0OverV) {
+  const Result& r = undrained();
+  const double V0 = r.fluid["pore_void_initial_m3"], V = r.fluid["pore_void_final_m3"];
+  const double dp = r.fluid["mean_pore_pressure_final_Pa"].get<double>() - 1e5, pred = 5e7 * std::log(V0 / V);
+  std::printf("3D undrained through the driver: %d pores, dV/V0 = %.4g, mean dp = %.5g Pa, K ln(V0/V) = %.5g Pa, "
+              "rel err %.3g, max p %.5g Pa, %ld retriangulations\n",
+              r.fluid["pores"].get<int>(), (V0 - V) / V0, dp, pred, std::abs(dp / pred - 1),
+              r.fluid["max_pore_pressure_Pa"].get<double>(), r.fluid["retriangulations"].get<long>());
+  EXPECT_EQ(r.fluid["dimension"], 3);
+  EXPECT_EQ(r.fluid["flow_scheme"], "implicit");
+  EXPECT_GT((V0 - V) / V0, 1e-4);  // the sample did compact
+  EXPECT_GT(dp, 0);
+  EXPECT_NEAR(dp / pred, 1.0, 0.02);
+  // The series: the pressure rises with the axial strain; the largest pore is at least the mean.
+  const auto& e = r.series.column("axial_strain");
+  const auto& pm = r.series.column("mean_pore_pressure_Pa");
+  const auto& px = r.series.column("max_pore_pressure_Pa");
+  ASSERT_GT(e.size(), 5u);
+  EXPECT_GT(e.back(), e.front());
+  EXPECT_GT(pm.back(), pm[pm.size() / 2]);
+  EXPECT_GT(pm[pm.size() / 2], 1e5);
+  for (std::size_t k = 0; k < pm.size(); ++k) EXPECT_GE(px[k], pm[k] * (1 - 1e-12));
+  EXPECT_EQ(r.fluid["saturation_initial"], 1.0);
+  EXPECT_NEAR(r.fluid["saturation_final"].get<double>(), 1.0, 1e-12);
+}
+
+// Drained lateral faces (hull pores off the platens at the ambient pressure): the same compression
+// leaves the pressure within a tenth of the undrained rise; the platen pores stay sealed.
+TEST(SaturatedUcs3D, DrainedSidesRelieveThePressure) {
+  const Result& u = undrained();
+  const Result d = run3d("sat3d_sides", "saturation = 1.0\nliquid_bulk_modulus = 5e7\ndrainage = \"sides\"\n");
+  const double du = u.fluid["mean_pore_pressure_final_Pa"].get<double>() - 1e5;
+  const double dd = d.fluid["mean_pore_pressure_final_Pa"].get<double>() - 1e5;
+  const double mu = u.fluid["max_pore_pressure_Pa"].get<double>() - 1e5, md = d.fluid["max_pore_pressure_Pa"].get<double>() - 1e5;
+  std::printf("3D mean dp at the end: undrained %.5g Pa, drained sides %.5g Pa (%d drained pores of %d); max dp %.5g vs "
+              "%.5g Pa\n", du, dd, d.fluid["drained_pores"].get<int>(), d.fluid["pores"].get<int>(), mu, md);
+  EXPECT_GT(d.fluid["drained_pores"].get<int>(), 10);
+  EXPECT_LT(d.fluid["drained_pores"].get<int>(), d.fluid["pores"].get<int>() / 2);
+  EXPECT_LT(std::abs(dd), 0.1 * du);
+  EXPECT_LT(md, 0.5 * mu);
+}
+
+// Two phases, closed, S = 0.5: the gas takes the compaction. With one pressure per pore and the
+// pressure equalised, the gas (ideal: p Vg = const) and the liquid (barotropic K) share the void:
+// p = p0 Vg0 / (V - Vl0 exp(-(p - p0)/K)), Vg0 = Vl0 = V0/2 (closed-form mass balance of both phases;
+// seed 004 B23's shared pressure). Peng-Robinson air at 0.1 MPa, 20 C is ideal to 0.1 % (Z = 0.9997),
+// so the PR pair meets the same prediction; PR water's own stiffness does not matter next to the gas.
+// Tolerance 2 %. Each phase's mass is conserved to round-off.
+TEST(SaturatedUcs3D, TwoPhaseClosedSampleGasCushion) {
+  for (const std::string eos : {"barotropic", "peng_robinson"}) {
+    const std::string gas = eos == "barotropic" ? "ideal" : "peng_robinson";
+    const Result r = run3d("sat3d_two_" + eos, "saturation = 0.5\ndrainage = \"closed\"\nliquid_eos = \"" + eos +
+                                                   "\"\ngas_eos = \"" + gas + "\"\n");
+    const double V0 = r.fluid["pore_void_initial_m3"], V = r.fluid["pore_void_final_m3"];
+    const double p0 = 1e5, K = 2.2e9;
+    double p = p0;
+    for (int it = 0; it < 50; ++it) p = p0 * 0.5 * V0 / (V - 0.5 * V0 * std::exp(-(p - p0) / K));
+    const double dp = r.fluid["mean_pore_pressure_final_Pa"].get<double>() - p0, pred = p - p0;
+    const double eq = std::abs(r.fluid["liquid_mass_kg"].get<double>() / r.fluid["liquid_mass_initial_kg"].get<double>() - 1);
+    const double eg = std::abs(r.fluid["gas_mass_kg"].get<double>() / r.fluid["gas_mass_initial_kg"].get<double>() - 1);
+    std::printf("3D two-phase S = 0.5 (%s liquid, %s gas): dV/V0 = %.4g, mean dp = %.5g Pa, predicted %.5g Pa (rel err "
+                "%.3g); saturation %.6f -> %.6f; mass errors liquid %.3g gas %.3g\n",
+                eos.c_str(), gas.c_str(), (V0 - V) / V0, dp, pred, std::abs(dp / pred - 1),
+                r.fluid["saturation_initial"].get<double>(), r.fluid["saturation_final"].get<double>(), eq, eg);
+    EXPECT_EQ(r.fluid["saturation_initial"], 0.5);
+    EXPECT_GT(r.fluid["saturation_final"].get<double>(), 0.5);  // the gas shrinks, the liquid barely
+    EXPECT_LT(r.fluid["saturation_final"].get<double>(), 0.51);
+    EXPECT_GT(dp, 0);
+    EXPECT_NEAR(dp / pred, 1.0, 0.02);
+    EXPECT_LT(eq, 1e-12);
+    EXPECT_LT(eg, 1e-12);
+  }
+}
+
+// Interrupted at step 150 on one thread and resumed on two = uninterrupted on two (every DEM loop
+// parallel: dem.parallel_min = 1), two phases, with a retriangulation on the way: series.csv,
+// cracks.csv and summary.json byte for byte (timings aside); and one thread whole = two threads whole
+// (series.csv, cracks.csv).
+TEST(SaturatedUcs3D, ResumeAndThreadsBitIdentical) {
+  const std::string text = scenario_3d("saturation = 0.5\ndrainage = \"closed\"\nretriangulation_tolerance = 0.005\n");
+  const std::vector<std::string> sets = {"dem.parallel_min=1", "ucs.max_strain=0.0012"};
+  const auto whole = test::scratch("sat3d_whole"), parts = test::scratch("sat3d_parts"), one = test::scratch("sat3d_one");
+  ASSERT_EQ(test::run_scenario(text, sets, whole, 2), RunStatus::Finished);
+  ASSERT_EQ(test::run_scenario(text, sets, parts, 1, 150), RunStatus::Interrupted);
+  ASSERT_EQ(test::run_scenario(text, sets, parts, 2, 0, true), RunStatus::Finished);
+  ASSERT_EQ(test::run_scenario(text, sets, one, 1), RunStatus::Finished);
+  const auto j = nlohmann::json::parse(test::slurp(whole / "summary.json"));
+  EXPECT_GE(j["fluid"]["retriangulations"].get<long>(), 1);
+  EXPECT_GT(j["steps"].get<long>(), 150);
+  test::expect_same_results(whole, parts, "3D saturated UCS, resumed at step 150");
+  EXPECT_TRUE(test::read_bytes(whole / "series.csv") == test::read_bytes(one / "series.csv")) << "1 vs 2 threads";
+  EXPECT_TRUE(test::read_bytes(whole / "cracks.csv") == test::read_bytes(one / "cracks.csv")) << "1 vs 2 threads";
+  for (const auto& d : {whole, parts, one}) std::filesystem::remove_all(d);
+}
+
+// The 2D driver (seed 004 network, explicit flow, cavitation) through the same hooks: resumed = whole.
+TEST(SaturatedUcs2D, ResumeBitIdentical) {
+  std::ifstream f(std::string(FRACFLOW_SOURCE_DIR) + "/examples/saturated_ucs_2d.toml");
+  std::stringstream ss;
+  ss << f.rdbuf();
+  const std::vector<std::string> sets = {"ucs.max_strain=0.004", "ucs.series_interval=50", "output.vtk=false",
+                                         "output.plots=false"};
+  const auto whole = test::scratch("sat2d_whole"), parts = test::scratch("sat2d_parts");
+  ASSERT_EQ(test::run_scenario(ss.str(), sets, whole, 1), RunStatus::Finished);
+  ASSERT_EQ(test::run_scenario(ss.str(), sets, parts, 1, 300), RunStatus::Interrupted);
+  ASSERT_EQ(test::run_scenario(ss.str(), sets, parts, 1, 0, true), RunStatus::Finished);
+  test::expect_same_results(whole, parts, "2D saturated UCS, resumed at step 300");
+  std::filesystem::remove_all(whole);
+  std::filesystem::remove_all(parts);
+}
+
+}  // namespace
+
+namespace {
+
+// A key of the other dimension is an error naming it (not silently ignored), as in `fracflow check`.
+TEST(SaturatedUcs, KeysOfTheOtherDimensionAreRefused) {
+  const auto out = test::scratch("sat_keys");
+  try {
+    test::run_scenario(scenario_3d("cavitation_pressure = 0\n"), {}, out, 1);
+    FAIL() << "a 2D-only key was accepted for a 3D sample";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("fluid.cavitation_pressure"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("2D samples only"), std::string::npos) << e.what();
+  }
+  try {
+    std::ifstream f(std::string(FRACFLOW_SOURCE_DIR) + "/examples/saturated_ucs_2d.toml");
+    std::stringstream ss;
+    ss << f.rdbuf();
+    test::run_scenario(ss.str(), {"fluid.pfv_factor=0.1"}, out, 1);
+    FAIL() << "a 3D-only key was accepted for a 2D sample";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("fluid.pfv_factor"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(out);
+}
+
+}  // namespace
