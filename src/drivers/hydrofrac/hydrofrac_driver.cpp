@@ -94,6 +94,10 @@ void declare(ParamTable& t) {
          "network, 2D: factor of the geometric pore-to-pore aperture (Eq. B2; 1 = the free gap between the grains: a "
          "permeable packing; 0.02: a tight rock the fluid penetrates over a few grains during the ramp)")
       .positive();
+  t.real("network.throat_factor", 1e-7, "-",
+         "network, 3D: factor on the throats' geometric (PFV) conductance: 1 = the packing's own throats, through which "
+         "the whole block fills within a few DEM steps; 1e-7: a tight rock the fluid penetrates over a few grains")
+      .positive();
   t.real("network.max_conductance_ratio", 100, "-", "network, 3D: throat conductance cap, x the median at a triangulation").positive();
   t.real("network.retriangulation_tolerance", 0.25, "-",
          "network: retriangulate when a particle moved this many mean radii since the last triangulation")
@@ -401,6 +405,7 @@ void HydrofracRun::make_fluid() {
     n.network.b1_h_inf = cfg.real("network.aperture_hinf");
     n.network.b2_gamma = cfg.real("network.b2_gamma");
     n.network.max_cond_ratio = cfg.real("network.max_conductance_ratio");
+    n.pfv_factor = cfg.real("network.throat_factor");
     n.retriangulation_tolerance = cfg.real("network.retriangulation_tolerance");
     n.flow_every = cfg.integer("network.flow_every");
     n.cell = s.cell;
