@@ -407,4 +407,37 @@ void DemPorenetCoupling::load(CheckpointReader& r, dem::DemSystem& sys, const Po
   stats_ = r.get_value<CouplingStats>("porenet.stats");
 }
 
+
+bool DemPorenetCoupling::sync(const dem::DemSystem& sys) {
+  gather_positions(sys);
+  Real dmax2 = 0;
+  for (std::size_t k = 0; k < x_.size(); ++k)
+    dmax2 = std::max(dmax2, (x_[k] - ref_x_[k]) * (x_[k] - ref_x_[k]) + (y_[k] - ref_y_[k]) * (y_[k] - ref_y_[k]));
+  stats_.max_displacement = std::sqrt(dmax2);
+  fill_pair_state(sys);
+  if (stats_.max_displacement > prm_.retriangulation_tolerance * mean_radius_) {
+    retriangulate(sys);
+    stats_.max_displacement = 0;
+    return true;
+  }
+  porenet::update_network_2d(*net_, porenet::Particles2D{x_, y_, r_, {}}, pairs_);
+  return false;
+}
+
+void DemPorenetCoupling::compute_fluid_forces(Real p_floor) {
+  const auto p = flow_->pressure();
+  for (std::size_t i = 0; i < pg_.size(); ++i) pg_[i] = std::max(p[i], p_floor) - prm_.ambient_pressure;
+  std::fill(fx_.begin(), fx_.end(), 0.0);
+  std::fill(fy_.begin(), fy_.end(), 0.0);
+  const porenet::Particles2D parts{x_, y_, r_, {}};
+  porenet::add_pressure_forces(*net_, parts, pg_, fx_, fy_);
+  if (prm_.shear_forces) porenet::add_shear_forces(*net_, parts, pg_, fx_, fy_);
+  if (prm_.force_height == ForceHeight::Thickness)
+    for (std::size_t k = 0; k < fx_.size(); ++k) {
+      const Real scale = prm_.network.thickness / (2 * r_[k]);
+      fx_[k] *= scale;
+      fy_[k] *= scale;
+    }
+}
+
 }  // namespace ff::coupling

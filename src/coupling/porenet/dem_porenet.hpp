@@ -115,6 +115,16 @@ class DemPorenetCoupling {
   // After the DemSystem was restored; params as at init.
   void load(CheckpointReader& r, dem::DemSystem& sys, const PorenetCouplingParams& params);
 
+  // Staged use by a driver with its own step order (hydrofrac's network fluid,
+  // drivers/hydrofrac/network_load.cpp), instead of step(): sync() brings the network to the
+  // system's current positions and pair loads (after compute_forces), retriangulating past the
+  // tolerance (returns true then: a new flow object, boundary conditions to set again); the
+  // caller steps flow() itself; compute_fluid_forces() fills fluid_fx/fluid_fy from the current
+  // pressures, each clamped below at p_floor (absolute: a liquid under tension cavitates, so the
+  // grains feel at most ambient - p_floor of suction), without adding them to the system.
+  bool sync(const dem::DemSystem& sys);
+  void compute_fluid_forces(Real p_floor);
+
  private:
   void gather_positions(const dem::DemSystem& sys);
   void build_pairs(const dem::DemSystem& sys);

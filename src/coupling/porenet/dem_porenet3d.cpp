@@ -49,7 +49,7 @@ void DemPorenet3D::make_network_and_flow(std::unique_ptr<porenet::Network2D>& ne
   stats_.t_triangulation += seconds_since(t0);
 }
 
-void DemPorenet3D::init(dem::DemSystem& sys, const Porenet3DParams& params) {
+void DemPorenet3D::init(const dem::DemSystem& sys, const Porenet3DParams& params) {
   if (sys.settings.dim != 3)
     throw InputError("coupling.porenet3d: the 3D pore-network coupling needs a sphere sample (dem.dim = 3)");
   if (!(params.saturation >= 0 && params.saturation <= 1))
@@ -113,19 +113,27 @@ void DemPorenet3D::flow_step(Real dt) {
   stats_.last_substeps = nsub;
 }
 
-void DemPorenet3D::add_forces(dem::DemSystem& sys) {
+void DemPorenet3D::compute_fluid_forces(Real p_floor) {
   const auto p = flow_->pressure();
-  for (std::size_t i = 0; i < pg_.size(); ++i) pg_[i] = p[i] - prm_.ambient_pressure;
+  for (std::size_t i = 0; i < pg_.size(); ++i) pg_[i] = std::max(p[i], p_floor) - prm_.ambient_pressure;
   std::fill(fx_.begin(), fx_.end(), 0.0);
   std::fill(fy_.begin(), fy_.end(), 0.0);
   std::fill(fz_.begin(), fz_.end(), 0.0);
   porenet::add_pressure_forces_3d(*net_, view(), pg_, fx_, fy_, fz_);
+}
+
+void DemPorenet3D::add_forces(dem::DemSystem& sys) {
+  compute_fluid_forces(-std::numeric_limits<Real>::infinity());
   for (std::size_t k = 0; k < fx_.size(); ++k) sys.particles.ext_force[k] += Vec3(fx_[k], fy_[k], fz_[k]);
 }
 
-void DemPorenet3D::step(dem::DemSystem& sys) {
-  sys.update_neighbors();
-  sys.compute_forces();
+void DemPorenet3D::advance_flow(Real dt) {
+  const auto t1 = std::chrono::steady_clock::now();
+  flow_step(dt);
+  stats_.t_flow += seconds_since(t1);
+}
+
+bool DemPorenet3D::sync(const dem::DemSystem& sys) {
   gather(sys);
   Real dmax2 = 0;
   for (std::size_t k = 0; k < x_.size(); ++k) {
@@ -136,16 +144,21 @@ void DemPorenet3D::step(dem::DemSystem& sys) {
   if (stats_.max_displacement > prm_.retriangulation_tolerance * mean_radius_) {
     retriangulate();
     stats_.max_displacement = 0;
-  } else {
-    const auto t0 = std::chrono::steady_clock::now();
-    porenet::update_network_3d(*net_, view());
-    stats_.t_update += seconds_since(t0);
+    return true;
   }
-  auto t1 = std::chrono::steady_clock::now();
-  flow_step(sys.settings.dt);
-  stats_.t_flow += seconds_since(t1);
+  const auto t0 = std::chrono::steady_clock::now();
+  porenet::update_network_3d(*net_, view());
+  stats_.t_update += seconds_since(t0);
+  return false;
+}
+
+void DemPorenet3D::step(dem::DemSystem& sys) {
+  sys.update_neighbors();
+  sys.compute_forces();
+  (void)sync(sys);
+  advance_flow(sys.settings.dt);
   sys.add_external_loads();
-  t1 = std::chrono::steady_clock::now();
+  const auto t1 = std::chrono::steady_clock::now();
   add_forces(sys);
   stats_.t_forces += seconds_since(t1);
   sys.integrate();
@@ -172,7 +185,7 @@ void DemPorenet3D::save(CheckpointWriter& w) const {
   w.put_value("porenet3d.stats", stats_);
 }
 
-void DemPorenet3D::load(CheckpointReader& r, dem::DemSystem& sys, const Porenet3DParams& params) {
+void DemPorenet3D::load(CheckpointReader& r, const dem::DemSystem& sys, const Porenet3DParams& params) {
   prm_ = params;
   const auto n = sys.particles.size();
   x_.assign(n, 0);

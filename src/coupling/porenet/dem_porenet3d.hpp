@@ -12,6 +12,11 @@
 //   add_external_loads(); grain forces from the gauge pressure p - p_ambient (pressure integrated over
 //     each sphere's patches inside its tetrahedra, porenet::add_pressure_forces_3d); integrate().
 // Channel shear (B25) is not applied in 3D. Results are bit-identical on any thread count.
+// Cracks in 3D: no separate crack channels; a broken bond's spheres move apart, and the facets
+// they share grow in fluid area and hydraulic radius (update_network_3d each step), so the
+// throats across an opening crack conduct more (up to NetworkParams::max_cond_ratio x the
+// median conductance of the last triangulation). Staged use (drivers with their own step
+// order, e.g. drivers/hydrofrac/network_load.cpp): sync(), advance_flow(), compute_fluid_forces().
 #pragma once
 #include <cstdint>
 #include <functional>
@@ -49,7 +54,7 @@ struct Porenet3DStats {
 class DemPorenet3D {
  public:
   // Builds network and flow from the system's current state (3D, after sys.initialise()).
-  void init(dem::DemSystem& sys, const Porenet3DParams& params);
+  void init(const dem::DemSystem& sys, const Porenet3DParams& params);
   void step(dem::DemSystem& sys);
   void run(dem::DemSystem& sys, long steps) {
     for (long s = 0; s < steps; ++s) step(sys);
@@ -69,7 +74,16 @@ class DemPorenet3D {
 
   // Checkpoint sections (prefix "porenet3d."): triangulation positions, per-pore state, CG start.
   void save(CheckpointWriter& w) const;
-  void load(CheckpointReader& r, dem::DemSystem& sys, const Porenet3DParams& params);
+  void load(CheckpointReader& r, const dem::DemSystem& sys, const Porenet3DParams& params);
+
+  // The network to the system's current positions, retriangulating past the tolerance (true
+  // then: on_network has run for the new network).
+  bool sync(const dem::DemSystem& sys);
+  // One flow step of dt (implicit, or explicit sub-steps).
+  void advance_flow(Real dt);
+  // Grain forces (fluid_force) from the current pressures clamped below at p_floor (absolute;
+  // cavitation bounds the suction), not added to the system.
+  void compute_fluid_forces(Real p_floor);
 
   // Called after every (re)build of the network, before the state is carried over: boundary conditions.
   std::function<void(porenet::TwoPhaseFlow&, const porenet::Network2D&)> on_network;

@@ -34,6 +34,7 @@
 #include "drivers/hydrofrac/kirsch.hpp"
 #include "drivers/hydrofrac/sleeve_load.hpp"
 #include "drivers/hydrofrac/lbm_load.hpp"
+#include "drivers/hydrofrac/network_load.hpp"
 #include "drivers/flow/flow_runner.hpp"
 #include "io/pvd.hpp"
 #include "coupling/fluid_spec.hpp"
@@ -75,8 +76,36 @@ void declare(ParamTable& t) {
   t.real("insitu.servo_relaxation", 0.5, "-", "servo relaxation factor alpha (PFC default 0.8)").open_range(0, 1).at_most(1);
   t.string("injection.fluid", "sleeve",
            "fluid model: sleeve (pressure on the hole's wall particles, and on connected crack faces with penetration); "
-           "lbm (lattice Boltzmann fluid over the block, keys fluid.*; docs/hydrofrac.md)")
-      .one_of({"sleeve", "lbm"});
+           "lbm (lattice Boltzmann fluid over the block, keys fluid.*; docs/hydrofrac.md); network (pore-network flow from the "
+           "hole into the rock and its cracks, keys network.*)")
+      .one_of({"sleeve", "lbm", "network"});
+  // The pore network (injection.fluid = "network"; drivers/hydrofrac/network_load.hpp).
+  t.real("network.viscosity", 1e-3, "Pa s", "network: dynamic viscosity of the injected liquid").positive();
+  t.real("network.density", 1000, "kg/m^3", "network: liquid density at network.pore_pressure").positive();
+  t.real("network.pore_pressure", 1e5, "Pa",
+         "network: the rock's initial (absolute) pore pressure, the zero of the reported pressure and of the grain forces")
+      .positive();
+  t.real("network.vapour_pressure", 2.34e3, "Pa", "network: a pore pulled below it cavitates (held there, its liquid mass kept)")
+      .non_negative();
+  t.real("network.aperture_h0", 1e-6, "m", "network, 2D: contact/bond channel aperture at zero normal stress (Eq. B1 h0)").positive();
+  t.real("network.aperture_hinf", 1e-7, "m", "network, 2D: contact/bond channel aperture at infinite normal stress (Eq. B1 h_inf)")
+      .positive();
+  t.real("network.b2_gamma", 0.02, "-",
+         "network, 2D: factor of the geometric pore-to-pore aperture (Eq. B2; 1 = the free gap between the grains: a "
+         "permeable packing; 0.02: a tight rock the fluid penetrates over a few grains during the ramp)")
+      .positive();
+  t.real("network.throat_factor", 1e-7, "-",
+         "network, 3D: factor on the throats' geometric (PFV) conductance: 1 = the packing's own throats, through which "
+         "the whole block fills within a few DEM steps; 1e-7: a tight rock the fluid penetrates over a few grains")
+      .positive();
+  t.real("network.max_conductance_ratio", 100, "-", "network, 3D: throat conductance cap, x the median at a triangulation").positive();
+  t.real("network.retriangulation_tolerance", 0.25, "-",
+         "network: retriangulate when a particle moved this many mean radii since the last triangulation")
+      .positive();
+  t.integer("network.flow_every", 0, "steps",
+            "network: DEM steps per implicit flow step (0: from the fluid-grain stiffness, see docs/hydrofrac.md)")
+      .non_negative();
+  t.boolean("network.vtk", true, "network: write the pores (vtk/pores_*.vtu: gauge pressure per pore) with the particle snapshots");
   // The lattice Boltzmann fluid (injection.fluid = "lbm"), SI units (coupling::FluidSpec).
   t.real("fluid.density", 1000, "kg/m^3", "lbm: fluid density").positive();
   t.real("fluid.viscosity", 1e-6, "m^2/s", "lbm: kinematic viscosity (set this or fluid.dynamic_viscosity)").positive();
@@ -313,6 +342,8 @@ class HydrofracRun {
   std::vector<hydrofrac::JointPair> joints_;
   std::unique_ptr<hydrofrac::FluidLoad> fluid_;
   hydrofrac::LbmLoadBase* lbm_ = nullptr;  // fluid_ when injection.fluid = "lbm"
+  hydrofrac::NetworkLoad* net_ = nullptr;  // fluid_ when injection.fluid = "network"
+  PvdSeries pores_pvd_;                    // vtk/pores.pvd: the pore network, same times as the particles
   PvdSeries fluid_pvd_;                    // vtk/fluid.pvd: the lattice, same times as the particles
   HfState st_;
   Vec3 targets_;
@@ -359,6 +390,32 @@ void HydrofracRun::make_fluid() {
   s.cell = cell;
   s.inflate = std::min(0.5 * cfg.real("sample.bond_gap"), 0.5 * rmin);
   s.reach = 1.5 * rmax;
+  if (cfg.string("injection.fluid") == "network") {
+    hydrofrac::NetworkSettings n;
+    n.rate_mode = s.rate_mode;
+    n.ramp_rate = s.ramp_rate;
+    n.initial_pressure = s.initial_pressure;
+    n.flow_rate = s.flow_rate;
+    n.bulk_modulus = s.bulk_modulus;
+    n.density = cfg.real("network.density");
+    n.viscosity = cfg.real("network.viscosity");
+    n.pore_pressure = cfg.real("network.pore_pressure");
+    n.vapour_pressure = cfg.real("network.vapour_pressure");
+    n.network.b1_h0 = cfg.real("network.aperture_h0");
+    n.network.b1_h_inf = cfg.real("network.aperture_hinf");
+    n.network.b2_gamma = cfg.real("network.b2_gamma");
+    n.network.max_cond_ratio = cfg.real("network.max_conductance_ratio");
+    n.pfv_factor = cfg.real("network.throat_factor");
+    n.retriangulation_tolerance = cfg.real("network.retriangulation_tolerance");
+    n.flow_every = cfg.integer("network.flow_every");
+    n.cell = s.cell;
+    n.inflate = s.inflate;
+    n.reach = s.reach;
+    auto nl = std::make_unique<hydrofrac::NetworkLoad>(n, sys.settings.dim);
+    net_ = nl.get();
+    fluid_ = std::move(nl);
+    return;
+  }
   if (cfg.string("injection.fluid") != "lbm") {
     fluid_ = std::make_unique<hydrofrac::SleeveLoad>(s);
     return;
@@ -537,7 +594,10 @@ void HydrofracRun::begin_injection() {
   st_.injection_time = sys.time;
   fluid_->begin(sys, hole_, joints_);
   if (lbm_) log::info("hydrofrac: lattice Boltzmann fluid ({}): {}", cfg.string("fluid.scheme"), lbm_->info().describe());
-  st_.effective_radius = lbm_ ? lbm_->effective_radius() : static_cast<hydrofrac::SleeveLoad&>(*fluid_).effective_radius();
+  if (net_) log::info("hydrofrac: {}", net_->info().describe());
+  st_.effective_radius = lbm_   ? lbm_->effective_radius()
+                         : net_ ? net_->effective_radius()
+                                : static_cast<hydrofrac::SleeveLoad&>(*fluid_).effective_radius();
   insitu_ = snapshot(0);
   const Vec3 ws = wall_stress();
   Real far_xx = 0, far_yy = 0;
@@ -561,6 +621,11 @@ void HydrofracRun::vtk() {
     const std::string name = fmt::format("fluid_{:05d}.vti", st_.vtk_index);
     lbm_->write_vti(opt.out_dir / "vtk" / name);
     fluid_pvd_.add(sys.time, name);
+  }
+  if (net_ && st_.stage == 1 && cfg.boolean("network.vtk")) {
+    const std::string name = fmt::format("pores_{:05d}.vtu", st_.vtk_index);
+    net_->write_vtu(opt.out_dir / "vtk" / name, sys);
+    pores_pvd_.add(sys.time, name);
   }
   vtk_writer_.write(sys, st_.vtk_index++, extent);
   st_.last_vtk_time = sys.time;
@@ -664,6 +729,7 @@ RunStatus HydrofracRun::run() {
   vtk_on_ = cfg.boolean("output.vtk");
   if (vtk_on_) vtk_writer_.open(opt.out_dir / "vtk", opt.resume, sys.time);
   if (vtk_on_ && lbm_) fluid_pvd_.open(opt.out_dir / "vtk" / "fluid.pvd", opt.resume, sys.time);
+  if (vtk_on_ && net_ && cfg.boolean("network.vtk")) pores_pvd_.open(opt.out_dir / "vtk" / "pores.pvd", opt.resume, sys.time);
   if (!opt.resume) {
     vtk();
     checkpoint();
@@ -897,6 +963,39 @@ void HydrofracRun::finish(const std::string& stop) {
     log::info("hydrofrac: LBM mass budget over {} LBM steps ({} new particle sets; m^3 at rho_f): injected {:.4g}, lattice "
               "change {:.4g}, covering and refill {:.4g}, residual (walls) {:.4g}",
               b.lbm_steps, b.set_changes, b.injected, b.lattice_change, b.covering_refill, b.residual);
+  }
+  if (net_) {
+    const auto& in = net_->info();
+    const hydrofrac::NetworkBudget b = net_->budget();
+    const double wall = control_.elapsed_s();
+    j["network"] = {{"pores", in.pores},
+                    {"channels", in.channels},
+                    {"hole_pores", in.hole_pores},
+                    {"dt_flow_s", in.dt_flow},
+                    {"dt_dem_s", in.dt_dem},
+                    {"flow_every", in.flow_every},
+                    {"dt_explicit_s", in.dt_explicit},
+                    {"spring_period_s", in.t_spring},
+                    {"flow_steps", b.flow_steps},
+                    {"retriangulations", b.retriangulations},
+                    {"max_cg_iterations", b.max_cg_iterations},
+                    {"max_substeps", b.max_substeps},
+                    {"cavitations", b.cavitations},
+                    {"vapour_volume_m3", b.vapour_volume},
+                    {"wall_s", {{"network_update", b.t_sync}, {"flow", b.t_flow}, {"forces", b.t_forces},
+                                {"rest_dem_and_output", wall - b.t_sync - b.t_flow - b.t_forces}}},
+                    {"mass_budget_kg",
+                     {{"injected", b.injected_mass},
+                      {"pore_mass_start", b.pore_mass0},
+                      {"pore_mass_end", b.pore_mass},
+                      {"residual", b.residual},
+                      {"definition", "(pore_mass_end - pore_mass_start) - injected; rate mode: injected = rho Q t (a "
+                                     "closed block: the residual is the scheme's mass error); ramp mode: injected is "
+                                     "defined as the change (residual 0)"}}}};
+    log::info("hydrofrac: network mass budget over {} flow steps ({} retriangulations; kg{}): injected {:.6g}, pores "
+              "{:.6g} -> {:.6g}, residual {:.3g}; wall time: network update {:.1f} s, flow {:.1f} s, forces {:.1f} s of {:.1f} s",
+              b.flow_steps, b.retriangulations, sys.settings.dim == 2 ? " per m" : "", b.injected_mass, b.pore_mass0,
+              b.pore_mass, b.residual, b.t_sync, b.t_flow, b.t_forces, wall);
   }
   j["cracks"] = cracks_json(sys);
   j["sample"] = sample_json(sys, info);

@@ -1,0 +1,84 @@
+// injection.fluid = "network" in 3D (drivers/hydrofrac/network_load.hpp): a block of bonded
+// spheres fractured from a vertical borehole through the 3D pore network (regular triangulation,
+// PFV throats), run through the fracflow program. The 2D tests: test_hydrofrac_network.cpp.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "../program_runner.hpp"
+#include "io/csv.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kOutput = R"(
+[output]
+vtk = false
+plots = false
+progress_interval = 0
+)";
+
+struct Scratch : ff::test::TestScratch {
+  Scratch() : TestScratch("hydrofrac_network") {}
+  fs::path write(const std::string& name, const std::string& text) const {
+    const fs::path p = path / name;
+    std::ofstream(p, std::ios::binary) << text;
+    return p;
+  }
+};
+
+ff::test::ProgramResult fracflow(const std::string& args) { return ff::test::run_program(args); }
+
+nlohmann::json run_scenario(const fs::path& file, const fs::path& out, const std::string& sets = "") {
+  const auto r = fracflow("run " + file.string() + " --out " + out.string() + " -q -j1" + sets);
+  EXPECT_EQ(r.code, 0) << r.output;
+  return ff::test::read_json(out / "summary.json");
+}
+
+
+// Distances from the hole's axis of the first `n` cracks of cracks.csv (x_m, y_m columns).
+std::vector<double> first_crack_distances(const fs::path& csv, double cx, double cy, std::size_t n) {
+  const auto t = ff::read_csv(csv);
+  const auto& x = t.column("x_m");
+  const auto& y = t.column("y_m");
+  std::vector<double> d;
+  for (std::size_t r = 0; r < t.rows() && d.size() < n; ++r) d.push_back(std::hypot(x[r] - cx, y[r] - cy));
+  return d;
+}
+
+}  // namespace
+
+// examples/hydrofrac_3d.toml's rock in a 12 x 12 x 4 mm block (~550 spheres, sigma_H = 6, sigma_h = 3,
+// sigma_v = 8 MPa) fractured through the 3D network: breakdown found, the first cracks at the
+// wall; the breakdown pressure against the sleeve model's (no penetration) on the same block.
+// A few minutes (one implicit flow step per DEM step on ~3000 pores): label long.
+TEST(HydrofracNetwork, ThreeDimensionalBlockBreaksFromTheHole) {
+  Scratch s;
+  std::ifstream in(fs::path(FRACFLOW_SOURCE_DIR) / "examples" / "hydrofrac_3d.toml");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const fs::path file = s.write("block3d.toml", ss.str() + kOutput);
+  const std::string sets = " --set hydrofrac.vtk_interval=0 --set sample.width=12e-3 --set sample.depth=12e-3 --set "
+                           "sample.height=4e-3 --set measure.radii=[1.8] --set measure.circle_radius=0.3";
+  const auto js = run_scenario(file, s / "sleeve", sets + " --set injection.penetration=false");
+  const auto j = run_scenario(file, s / "network", sets + " --set injection.fluid=network");
+  ASSERT_FALSE(j["breakdown"]["pressure_Pa"].is_null()) << j["breakdown"].dump();
+  const double pn = j["breakdown"]["pressure_Pa"].get<double>();
+  const double ps = js["breakdown"]["pressure_Pa"].is_null() ? NAN : js["breakdown"]["pressure_Pa"].get<double>();
+  std::printf("3D breakdown: network %.2f MPa, sleeve (no penetration) %.2f MPa; network: %s\n", 1e-6 * pn, 1e-6 * ps,
+              j["network"].dump().c_str());
+  EXPECT_GT(j["fracture"]["connected_cracks"].get<long>(), 5);
+  ASSERT_GE(ff::read_csv(s / "network" / "cracks.csv").rows(), 3u);
+  const double a = j["borehole"]["effective_radius_m"].get<double>();
+  const auto d = first_crack_distances(s / "network" / "cracks.csv", 6e-3, 6e-3, 3);
+  for (double x : d) EXPECT_LT(x, a + 4 * 0.6e-3) << "a first crack away from the hole";
+}
+
