@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <limits>
 
 #include "core/error.hpp"
 #include "porenet/reduce.hpp"
@@ -55,6 +56,18 @@ PressureSystem::PressureSystem(const Network2D& net) : n_(net.n_pores()) {
 void PressureSystem::setup_preconditioner(Preconditioner pc) {
   const Real* val = A_.valuePtr();
   const auto* inner = A_.innerIndexPtr();
+  if (pc == Preconditioner::AMG) {
+    const CsrView v{n_, A_.outerIndexPtr(), inner, val};
+    if (amg_rebuild_ || !amg_.ready()) {
+      amg_.setup(v);
+      amg_rebuild_ = false;
+      amg_check_ = true;  // the next iteration count is the reference
+      ++amg_setups_;
+    } else {
+      amg_.refresh(v);
+    }
+    return;
+  }
   if (pc == Preconditioner::Jacobi) {
     for (Index i = 0; i < n_; ++i) pivot_[i] = 1 / val[diag_pos_[i]];
     return;
@@ -72,6 +85,10 @@ void PressureSystem::setup_preconditioner(Preconditioner pc) {
 }
 
 void PressureSystem::apply_preconditioner(Preconditioner pc, const std::vector<Real>& r, std::vector<Real>& z) {
+  if (pc == Preconditioner::AMG) {
+    amg_.apply(r.data(), z.data());
+    return;
+  }
   if (pc == Preconditioner::Jacobi) {
 #pragma omp parallel for schedule(static) if (n_ > kDicBlock)
     for (Index i = 0; i < n_; ++i) z[i] = r[i] * pivot_[i];
@@ -114,10 +131,30 @@ int PressureSystem::solve(std::span<const Real> b, std::span<Real> x, Preconditi
     return 0;
   }
   const Real tol2 = tol * tol * bnorm2;
+  auto finished = [&](int its) {
+    if (pc == Preconditioner::AMG) {
+      if (amg_check_) {
+        amg_setup_iters_ = its;
+        amg_check_ = false;
+      } else if (its > 2 * amg_setup_iters_ + 10) {
+        amg_rebuild_ = true;  // the aggregates no longer fit the matrix: rebuild at the next solve
+      }
+    }
+    return its;
+  };
   matvec(x.data(), ad_);
 #pragma omp parallel for schedule(static) if (n_ > kDicBlock)
   for (Index i = 0; i < n_; ++i) r_[i] = b[i] - ad_[i];
   if (fixed_order_sum(n_, [&](Index i) { return r_[i] * r_[i]; }, scratch_) <= tol2) return 0;
+  // Round-off floor of the residual: 16 eps ||A||_inf ||x||_2 (max: order-independent).
+  Real anorm = 0;
+#pragma omp parallel for schedule(static) reduction(max : anorm) if (n_ > kDicBlock)
+  for (Index i = 0; i < n_; ++i) {
+    Real s = 0;
+    for (Index k = outer[i]; k < outer[i + 1]; ++k) s += std::abs(val[k]);
+    anorm = std::max(anorm, s);
+  }
+  const Real floor2 = std::pow(16 * std::numeric_limits<Real>::epsilon() * anorm, 2);
   setup_preconditioner(pc);
   apply_preconditioner(pc, r_, z_);
   d_ = z_;
@@ -132,7 +169,14 @@ int PressureSystem::solve(std::span<const Real> b, std::span<Real> x, Preconditi
       r_[i] -= alpha * ad_[i];
     }
     const Real rr = fixed_order_sum(n_, [&](Index i) { return r_[i] * r_[i]; }, scratch_);
-    if (rr <= tol2) return it + 1;
+    if (rr <= tol2) return finished(it + 1);
+    if (rr <= 64 * tol2 || (it & 15) == 15) {  // the floor matters near the end or when stalling
+      const Real xx = fixed_order_sum(n_, [&](Index i) { return x[i] * x[i]; }, scratch_);
+      if (rr <= floor2 * xx) {
+        ++floor_stops_;
+        return finished(it + 1);
+      }
+    }
     apply_preconditioner(pc, r_, z_);
     const Real rz_new = fixed_order_sum(n_, [&](Index i) { return r_[i] * z_[i]; }, scratch_);
     const Real beta = rz_new / rz;
