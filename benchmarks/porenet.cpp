@@ -342,7 +342,8 @@ int main(int argc, char** argv) {
           int its = 0;
           long subs = 0;
           std::string fail;
-          for (int k = 1; k <= M && fail.empty(); ++k) {
+          const int Mk = pc == Preconditioner::DIC ? 3 : M;  // DIC: the first 3 DEM steps only (slow)
+          for (int k = 1; k <= Mk && fail.empty(); ++k) {
             for (Index i = 0; i < net3c.n_pores(); ++i) net3c.pore_void[i] -= void0[i] * deps * w[i];
             if (k % N) continue;
             const auto a = std::chrono::steady_clock::now();
@@ -365,13 +366,13 @@ int main(int argc, char** argv) {
           const auto [lo, hi] = std::minmax_element(g.pressure().begin(), g.pressure().end());
           Real err = 0;
           if (N == 1 && pc == Preconditioner::AMG) pref.assign(g.pressure().begin(), g.pressure().end());
-          for (Index i = 0; i < net3c.n_pores() && !pref.empty(); ++i)
+          for (Index i = 0; i < net3c.n_pores() && !pref.empty() && Mk == M; ++i)
             err = std::max(err, std::abs(g.pressure()[i] - pref[i]));
           std::printf("  closed S %.1f, %s, flow every %2d DEM steps (dt %.2e s): solve %8.1f ms (median), per DEM "
                       "step %7.1f ms = %.2f DEM steps; max %d CG it, %ld sub-steps; after %d DEM steps p in [%.4e, "
                       "%.4e] Pa, max |p - p(N=1)| %.3e Pa; liquid mass error %.1e\n",
                       S, pc == Preconditioner::AMG ? "AMG" : "DIC", N, N * dt_dem, median(ts), median(ts) / N,
-                      t_dem3 > 0 ? median(ts) / N / t_dem3 : 0.0, its, subs, M, *lo, *hi, err,
+                      t_dem3 > 0 ? median(ts) / N / t_dem3 : 0.0, its, subs, Mk, *lo, *hi, err,
                       std::abs(g.total_liquid_mass() - m0) / m0);
           std::fflush(stdout);
         }
@@ -394,6 +395,7 @@ int main(int argc, char** argv) {
   coupling::Porenet3DParams cp;
   cp.saturation = S;
   cp.fluid.max_halvings = halvings;
+  cp.fluid.preconditioner = Preconditioner::AMG;  // the default stays DIC (API unchanged)
   // Masses are conserved whatever the CG residual, and the volume residual enters the next step's
   // right-hand side: a looser tolerance costs pressure accuracy only (1e-8 of the source term).
   cp.fluid.cg_tolerance = 1e-8;
