@@ -49,7 +49,7 @@ PressureSystem::PressureSystem(const Network2D& net) : n_(net.n_pores()) {
     hi_end_[i] = k;
   }
   pivot_.assign(n, 1);
-  r_ = z_ = d_ = ad_ = pivot_;
+  r_ = z_ = d_ = ad_ = x0_ = pivot_;
   scratch_.assign(static_cast<std::size_t>(std::max<Index>(reduce_blocks(n_), 1)), 0);
 }
 
@@ -155,6 +155,16 @@ int PressureSystem::solve(std::span<const Real> b, std::span<Real> x, Preconditi
     anorm = std::max(anorm, s);
   }
   const Real floor2 = std::pow(16 * std::numeric_limits<Real>::epsilon() * anorm, 2);
+  // AMG guard: a stalled or indefinite AMG-CG (seen once on a closed saturated 3D sample) falls back to
+  // DIC from the same start; the aggregates are rebuilt at the next solve.
+  const int amg_try = std::min(max_it, kAmgMaxIterations);
+  if (pc == Preconditioner::AMG) std::copy(x.begin(), x.end(), x0_.begin());
+  auto fallback = [&] {
+    ++amg_fallbacks_;
+    amg_rebuild_ = true;
+    std::copy(x0_.begin(), x0_.end(), x.begin());
+    return solve(b, x, Preconditioner::DIC, tol, max_it);
+  };
   setup_preconditioner(pc);
   apply_preconditioner(pc, r_, z_);
   d_ = z_;
@@ -162,6 +172,7 @@ int PressureSystem::solve(std::span<const Real> b, std::span<Real> x, Preconditi
   for (int it = 0; it < max_it; ++it) {
     matvec(d_.data(), ad_);
     const Real dad = fixed_order_sum(n_, [&](Index i) { return d_[i] * ad_[i]; }, scratch_);
+    if (pc == Preconditioner::AMG && (!(dad > 0) || !(rz > 0) || it >= amg_try)) return fallback();
     const Real alpha = rz / dad;
 #pragma omp parallel for schedule(static) if (n_ > kDicBlock)
     for (Index i = 0; i < n_; ++i) {

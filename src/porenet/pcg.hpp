@@ -11,7 +11,9 @@
 // AMG: one V-cycle of porenet/amg.hpp (plain aggregation, hybrid Gauss-Seidel); the aggregates are
 // built at the first solve and kept for later matrices on the same pattern (each solve refreshes the
 // coarse values only); they are rebuilt when a solve needs more than twice the iterations of the
-// first solve after the last build (plus 10), or after reset_preconditioner().
+// first solve after the last build (plus 10), or after reset_preconditioner(). An AMG-CG that has not
+// converged in kAmgMaxIterations (or meets a non-positive curvature) is redone with DIC from the same
+// start (amg_fallbacks()).
 // Stopping: ||r|| <= tol ||b|| (r, b in the system's units: mass or volume per pore), and no further
 // than the round-off floor: once ||r|| <= 16 eps ||A||_inf ||x|| the residual is below what the
 // floating-point product A x resolves (nearly singular closed samples: the
@@ -29,6 +31,8 @@
 namespace ff::porenet {
 
 inline constexpr Index kDicBlock = 8192;
+// AMG-CG iterations before the DIC fallback (AMG needs < 100 on the 3D networks measured).
+inline constexpr int kAmgMaxIterations = 400;
 
 enum class Preconditioner : std::uint8_t { Jacobi = 0, DIC = 1, AMG = 2 };
 
@@ -50,6 +54,7 @@ class PressureSystem {
   const Amg& amg() const { return amg_; }
   long amg_setups() const { return amg_setups_; }
   long floor_stops() const { return floor_stops_; }
+  long amg_fallbacks() const { return amg_fallbacks_; }  // AMG solves redone with DIC
 
  private:
   void setup_preconditioner(Preconditioner pc);
@@ -59,11 +64,11 @@ class PressureSystem {
   Eigen::SparseMatrix<Real> A_;
   std::vector<Index> entry_channel_, diag_pos_, lo_begin_, hi_end_;
   std::vector<Real> pivot_;  // inverse pivots (DIC) or inverse diagonal (Jacobi)
-  std::vector<Real> r_, z_, d_, ad_, scratch_;
+  std::vector<Real> r_, z_, d_, ad_, x0_, scratch_;
   Amg amg_;
   bool amg_rebuild_ = true, amg_check_ = false;
   int amg_setup_iters_ = 0;
-  long amg_setups_ = 0, floor_stops_ = 0;
+  long amg_setups_ = 0, floor_stops_ = 0, amg_fallbacks_ = 0;
 };
 
 }  // namespace ff::porenet
