@@ -184,15 +184,16 @@ void SinglePhaseFlow::step_implicit(Real dt) {
   Real* val = A.valuePtr();
   const auto* outer = A.outerIndexPtr();
   const auto* inner = A.innerIndexPtr();
-  // Rows (= columns: symmetric). Pressure pores: identity rows, their columns moved to the rhs.
+  // Rows (= columns: symmetric). Pressure pores: diagonal rows, their columns moved to the rhs; the
+  // row keeps the scale of a free row (storage + dt sum G, in kg/Pa), so that the residual norm
+  // weighs it like the others (an identity row with rhs in Pa would dominate ||b|| and stop CG early).
 #pragma omp parallel for schedule(static) if (np_ > kParallelMin)
   for (Index i = 0; i < np_; ++i) {
     const bool fixed_i = bc_[i] == PoreBc::Pressure;
-    Real diag = 0, rhs = 0;
+    Real diag = storage(i), rhs = 0;
     if (!fixed_i) {
       const Real Vnew = void_at(i, p_[i]);
       rhs = m_[i] - rho_[i] * Vnew + (bc_[i] == PoreBc::Flux ? dt * bc_value_[i] : 0);
-      diag = storage(i);
     }
     for (Index k = outer[i]; k < outer[i + 1]; ++k) {
       const Index j = inner[k];
@@ -200,11 +201,11 @@ void SinglePhaseFlow::step_implicit(Real dt) {
       if (c < 0) continue;
       const Real G = dt * g_[c];
       const bool fixed_j = bc_[j] == PoreBc::Pressure;
+      diag += G;
       if (fixed_i) {
         val[k] = 0;
         continue;
       }
-      diag += G;
       rhs -= G * (p_[i] - p_[j]);
       if (fixed_j) {
         rhs += G * (bc_value_[j] - p_[j]);
@@ -214,8 +215,8 @@ void SinglePhaseFlow::step_implicit(Real dt) {
       }
     }
     for (Index k = outer[i]; k < outer[i + 1]; ++k)
-      if (inner[k] == i) val[k] = fixed_i ? 1.0 : diag;
-    rhs_[i] = fixed_i ? bc_value_[i] - p_[i] : rhs;
+      if (inner[k] == i) val[k] = diag;
+    rhs_[i] = fixed_i ? diag * (bc_value_[i] - p_[i]) : rhs;
   }
   if (prm_.solver == LinearSolver::LDLT) {
     if (!ldlt_analysed_) {

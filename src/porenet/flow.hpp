@@ -80,6 +80,7 @@ class SinglePhaseFlow {
   Real injected_mass() const { return injected_; }       // cumulative through Flux pores [kg]
   Real total_mass();                                     // fixed-order sum over pores [kg]
   int last_cg_iterations() const { return cg_iters_; }
+  const PressureSystem& pressure_system() const { return sys_; }
 
  private:
   Real void_at(Index i, Real p) const;

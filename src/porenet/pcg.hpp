@@ -8,6 +8,16 @@
 // block of kDicBlock consecutive pores (couplings between blocks dropped: block-Jacobi DIC), the
 // blocks in parallel and each one's triangular solves in order, so the result does not depend on
 // the thread count. Small systems (one block) run without a parallel region.
+// AMG: one V-cycle of porenet/amg.hpp (plain aggregation, hybrid Gauss-Seidel); the aggregates are
+// built at the first solve and kept for later matrices on the same pattern (each solve refreshes the
+// coarse values only); they are rebuilt when a solve needs more than twice the iterations of the
+// first solve after the last build (plus 10), or after reset_preconditioner(). An AMG-CG that has not
+// converged in kAmgMaxIterations (or meets a non-positive curvature) is redone with DIC from the same
+// start (amg_fallbacks()).
+// Stopping: ||r|| <= tol ||b|| (r, b in the system's units: mass or volume per pore), and no further
+// than the round-off floor: once ||r|| <= 16 eps ||A||_inf ||x|| the residual is below what the
+// floating-point product A x resolves (nearly singular closed samples: the
+// compressibility diagonal V/K is 1e-3..1e-6 of the conductances' dt G); counted in floor_stops().
 // Warm start: the caller passes its initial guess in x (e.g. the last step's pressure change).
 // Storage: Eigen column-major; the matrix is symmetric so column i is also row i.
 #pragma once
@@ -15,25 +25,36 @@
 #include <span>
 #include <vector>
 
+#include "porenet/amg.hpp"
 #include "porenet/network.hpp"
 
 namespace ff::porenet {
 
 inline constexpr Index kDicBlock = 8192;
+// AMG-CG iterations before the DIC fallback (AMG needs < 100 on the 3D networks measured).
+inline constexpr int kAmgMaxIterations = 400;
 
-enum class Preconditioner : std::uint8_t { Jacobi = 0, DIC = 1 };
+enum class Preconditioner : std::uint8_t { Jacobi = 0, DIC = 1, AMG = 2 };
 
 class PressureSystem {
  public:
   explicit PressureSystem(const Network2D& net);
 
   Eigen::SparseMatrix<Real>& matrix() { return A_; }
+  const Eigen::SparseMatrix<Real>& matrix() const { return A_; }
   // Channel of each stored entry, -1 on the diagonal.
   const std::vector<Index>& entry_channel() const { return entry_channel_; }
 
   // Solves A x = b to ||r|| <= tol ||b||, x holding the initial guess; returns the iterations.
   // Throws NumericalError after max_iterations.
   int solve(std::span<const Real> b, std::span<Real> x, Preconditioner pc, Real tol, int max_iterations);
+
+  // AMG: rebuild the aggregates at the next solve (e.g. after the conductances changed by orders).
+  void reset_preconditioner() { amg_rebuild_ = true; }
+  const Amg& amg() const { return amg_; }
+  long amg_setups() const { return amg_setups_; }
+  long floor_stops() const { return floor_stops_; }
+  long amg_fallbacks() const { return amg_fallbacks_; }  // AMG solves redone with DIC
 
  private:
   void setup_preconditioner(Preconditioner pc);
@@ -43,7 +64,11 @@ class PressureSystem {
   Eigen::SparseMatrix<Real> A_;
   std::vector<Index> entry_channel_, diag_pos_, lo_begin_, hi_end_;
   std::vector<Real> pivot_;  // inverse pivots (DIC) or inverse diagonal (Jacobi)
-  std::vector<Real> r_, z_, d_, ad_, scratch_;
+  std::vector<Real> r_, z_, d_, ad_, x0_, scratch_;
+  Amg amg_;
+  bool amg_rebuild_ = true, amg_check_ = false;
+  int amg_setup_iters_ = 0;
+  long amg_setups_ = 0, floor_stops_ = 0, amg_fallbacks_ = 0;
 };
 
 }  // namespace ff::porenet

@@ -35,12 +35,16 @@ TwoPhaseFlow::TwoPhaseFlow(const Network2D& net, const TwoPhaseParams& params)
   if (!(params.mu_liquid > 0 && params.mu_gas > 0))
     throw InputError(fmt::format("porenet: viscosities must be > 0 (liquid {}, gas {} Pa s)", params.mu_liquid,
                                  params.mu_gas));
+  if (params.max_halvings < 0 || params.max_halvings > 30)
+    throw InputError(fmt::format("porenet: max_halvings = {}; allowed 0..30", params.max_halvings));
   const auto n = static_cast<std::size_t>(np_);
   p_.assign(n, 0);
   alpha_ = mq_ = mp_ = rq_ = rp_ = bc_value_ = bc_alpha_ = p_;
   bc_.assign(n, PoreBc::None);
   fq_.assign(static_cast<std::size_t>(nc_), 0);
   fp_ = fq_;
+  lim_q_.assign(n, 1);
+  lim_p_ = lim_q_;
   scratch_.assign(static_cast<std::size_t>(std::max<Index>(reduce_blocks(std::max(np_, nc_)), 1)), 0);
 }
 
@@ -174,7 +178,6 @@ void TwoPhaseFlow::compute_rates() {
 
 Real TwoPhaseFlow::stable_dt() {
   compute_rates();
-  const Real t = net_.params.thickness;
   Real dt = std::numeric_limits<Real>::infinity();
 #pragma omp parallel for schedule(static) reduction(min : dt) if (np_ > kParallelMin)
   for (Index i = 0; i < np_; ++i) {
@@ -183,17 +186,12 @@ Real TwoPhaseFlow::stable_dt() {
     for (Index e = net_.pc_start[i]; e < net_.pc_start[i + 1]; ++e) {
       const Index c = net_.pc_ch[e];
       const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
-      const Index u = p_[a] >= p_[b] ? a : b;
-      if (net_.dim == 2) {
-        const Real h = net_.ch_aperture[c];
-        const StratifiedRates r =
-            stratified_channel_flow(1.0, alpha_[u] * h, (1 - alpha_[u]) * h, prm_.mu_liquid, prm_.mu_gas);
-        mob += (r.q_liquid + r.q_gas) * t / net_.ch_length[c];
-      } else {
-        Real lq, lp;
-        channel_mobilities(c, u, lq, lp);
-        mob += lq + lp;
-      }
+      // The larger mobility of the two upstream choices: within a DEM step the flow can turn, and a
+      // gas pore next to a liquid-full one then pushes its gas (55 x more mobile) into it.
+      Real lqa, lpa, lqb, lpb;
+      channel_mobilities(c, a, lqa, lpa);
+      channel_mobilities(c, b, lqb, lpb);
+      mob += std::max(lqa + lpa, lqb + lpb);
       const Real sgn = a == i ? 1 : -1;
       outq += std::max(sgn * fq_[c], 0.0);
       outp += std::max(sgn * fp_[c], 0.0);
@@ -210,7 +208,42 @@ Real TwoPhaseFlow::stable_dt() {
 
 void TwoPhaseFlow::step_explicit(Real dt) {
   compute_rates();
+  limited_ = limit_outflow(dt, true);
   update_pore_states(dt, "explicit");
+}
+
+// Transport limiter: where a pore would give away more of a phase in dt than it holds (a step above
+// the transport bound of stable_dt(): the rates changed since it was evaluated, e.g. the sub-steps of
+// a DEM step), its outgoing rates of that phase are scaled down to its mass (1 - 1e-12). Each channel's
+// rate is scaled once, by its upstream pore: conservative to round-off. Returns the pores limited.
+Index TwoPhaseFlow::limit_outflow(Real dt, bool apply) {
+  Index limited = 0;
+#pragma omp parallel for schedule(static) reduction(+ : limited) if (np_ > kParallelMin)
+  for (Index i = 0; i < np_; ++i) {
+    lim_q_[i] = lim_p_[i] = 1;
+    if (bc_[i] == PoreBc::Pressure) continue;
+    Real oq = 0, op = 0;
+    for (Index e = net_.pc_start[i]; e < net_.pc_start[i + 1]; ++e) {
+      const Index c = net_.pc_ch[e];
+      const Real sg = net_.ch_pore[2 * c] == i ? 1.0 : -1.0;
+      oq += std::max(sg * fq_[c], 0.0);
+      op += std::max(sg * fp_[c], 0.0);
+    }
+    oq *= dt;
+    op *= dt;
+    if (oq > mq_[i]) lim_q_[i] = (1 - 1e-12) * mq_[i] / oq;
+    if (op > mp_[i]) lim_p_[i] = (1 - 1e-12) * mp_[i] / op;
+    limited += (oq > mq_[i] || op > mp_[i]) ? 1 : 0;
+  }
+  if (apply && limited > 0) {
+#pragma omp parallel for schedule(static) if (nc_ > kParallelMin)
+    for (Index c = 0; c < nc_; ++c) {
+      const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
+      fq_[c] *= fq_[c] > 0 ? lim_q_[a] : lim_q_[b];
+      fp_[c] *= fp_[c] > 0 ? lim_p_[a] : lim_p_[b];
+    }
+  }
+  return limited;
 }
 
 // Phase masses from the channel rates fq_, fp_ (B18), then the shared pressure (B23) at the new void
@@ -275,9 +308,8 @@ void TwoPhaseFlow::step_implicit(Real dt) {
 
 // One backward-Euler step; if a pore would give away more of a phase than it holds (the explicit
 // transport limit, far above the pressure-diffusion limit for liquids), two half steps instead
-// (nothing has been changed yet); past kMaxHalvings the outflow limiter below applies.
+// (nothing has been changed yet); past max_halvings the outflow limiter below applies.
 void TwoPhaseFlow::implicit_substep(Real dt, int depth) {
-  constexpr int kMaxHalvings = 12;
   auto& A = sys_->matrix();
   const auto& entry_channel = sys_->entry_channel();
   Real* val = A.valuePtr();
@@ -296,22 +328,26 @@ void TwoPhaseFlow::implicit_substep(Real dt, int depth) {
 #pragma omp parallel for schedule(static) if (np_ > kParallelMin)
   for (Index i = 0; i < np_; ++i) {
     const bool fixed_i = bc_[i] == PoreBc::Pressure;
-    Real diag = 0, rhs = 0;
-    if (!fixed_i) {
-      const Real vq = mq_[i] / rq_[i], vp = mp_[i] / rp_[i];  // phase volumes at t^n
-      diag = (vq > 0 ? vq / prm_.liquid.bulk_modulus(rq_[i]) : 0) + (vp > 0 ? vp / prm_.gas.bulk_modulus(rp_[i]) : 0);
-      rhs = vq + vp - net_.pore_void[i] + (bc_[i] == PoreBc::Flux ? dt * bc_value_[i] / rq_[i] : 0);
-    }
+    const Real vq = mq_[i] / rq_[i], vp = mp_[i] / rp_[i];  // phase volumes at t^n
+    // The volume balance times the pore's liquid density (mass units): with the channel's upstream
+    // liquid density in W the liquid part is the exact liquid mass balance and stays symmetric.
+    const Real rq = rq_[i];
+    Real diag = rq * ((vq > 0 ? vq / prm_.liquid.bulk_modulus(rq_[i]) : 0) +
+                      (vp > 0 ? vp / prm_.gas.bulk_modulus(rp_[i]) : 0));
+    Real rhs = 0;
+    if (!fixed_i) rhs = rq * (vq + vp - net_.pore_void[i]) + (bc_[i] == PoreBc::Flux ? dt * bc_value_[i] : 0);
+    // Pressure pores: a diagonal row at the scale of a free row [kg/Pa] (see flow.cpp).
     for (Index k = outer[i]; k < outer[i + 1]; ++k) {
       const Index c = entry_channel[k];
       if (c < 0) continue;
       const Index j = inner[k];
+      const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
+      const Real W = dt * rq_[p_[a] >= p_[b] ? a : b] * (tq_[c] + tp_[c]);
+      diag += W;
       if (fixed_i) {
         val[k] = 0;
         continue;
       }
-      const Real W = dt * (tq_[c] + tp_[c]);
-      diag += W;
       rhs -= W * (p_[i] - p_[j]);
       if (bc_[j] == PoreBc::Pressure) {
         rhs += W * (bc_value_[j] - p_[j]);
@@ -320,9 +356,10 @@ void TwoPhaseFlow::implicit_substep(Real dt, int depth) {
         val[k] = -W;
       }
     }
+    if (!(diag > 0)) diag = 1;  // an empty, unconnected pore
     for (Index k = outer[i]; k < outer[i + 1]; ++k)
-      if (inner[k] == i) val[k] = fixed_i ? 1.0 : diag;
-    rhs_[i] = fixed_i ? bc_value_[i] - p_[i] : rhs;
+      if (inner[k] == i) val[k] = diag;
+    rhs_[i] = fixed_i ? diag * (bc_value_[i] - p_[i]) : rhs;
   }
   cg_iters_ = sys_->solve(rhs_, dp_, prm_.preconditioner, prm_.cg_tolerance, prm_.cg_max_iterations);
 #pragma omp parallel for schedule(static) if (np_ > kParallelMin)
@@ -335,40 +372,17 @@ void TwoPhaseFlow::implicit_substep(Real dt, int depth) {
     fq_[c] = rq_[u] * tq_[c] * (pnew_[a] - pnew_[b]);
     fp_[c] = rp_[u] * tp_[c] * (pnew_[a] - pnew_[b]);
   }
-  // Outflow limiter: a pore gives away at most the mass of each phase it holds.
-  Index limited = 0;
-#pragma omp parallel for schedule(static) reduction(+ : limited) if (np_ > kParallelMin)
-  for (Index i = 0; i < np_; ++i) {
-    lim_q_[i] = lim_p_[i] = 1;
-    if (bc_[i] == PoreBc::Pressure) continue;
-    Real oq = 0, op = 0;
-    for (Index e = net_.pc_start[i]; e < net_.pc_start[i + 1]; ++e) {
-      const Index c = net_.pc_ch[e];
-      const Real sg = net_.ch_pore[2 * c] == i ? 1.0 : -1.0;
-      oq += std::max(sg * fq_[c], 0.0);
-      op += std::max(sg * fp_[c], 0.0);
-    }
-    oq *= dt;
-    op *= dt;
-    if (oq > mq_[i]) lim_q_[i] = (1 - 1e-12) * mq_[i] / oq;
-    if (op > mp_[i]) lim_p_[i] = (1 - 1e-12) * mp_[i] / op;
-    limited += (oq > mq_[i] || op > mp_[i]) ? 1 : 0;
-  }
-  if (limited > 0 && depth < kMaxHalvings) {
+  // Outflow limit: a pore gives away at most the mass of each phase it holds (the transport bound of
+  // the frozen mobilities: also what keeps IMPES stable; a net-outflow bound let the 3D test diverge).
+  const Index limited = limit_outflow(dt, false);
+  if (limited > 0 && depth < prm_.max_halvings) {
     implicit_substep(0.5 * dt, depth + 1);
     implicit_substep(0.5 * dt, depth + 1);
     return;
   }
   limited_ = limited;
   ++substeps_;
-  if (limited > 0) {
-#pragma omp parallel for schedule(static) if (nc_ > kParallelMin)
-    for (Index c = 0; c < nc_; ++c) {
-      const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
-      fq_[c] *= fq_[c] > 0 ? lim_q_[a] : lim_q_[b];
-      fp_[c] *= fp_[c] > 0 ? lim_p_[a] : lim_p_[b];
-    }
-  }
+  if (limited > 0) limit_outflow(dt, true);
   update_pore_states(dt, "implicit");
 }
 
