@@ -482,24 +482,28 @@ void MovingBoundary<L, T>::update_delta(std::size_t s) {
 // it the links replace).
 template <class L, class T>
 void MovingBoundary<L, T>::build_links(std::size_t s, const ParticleSet&) {
+  const int n[3] = {grid_.nx, grid_.ny, grid_.nz};
   const Slice& cl = cs_[s];
   new_links_.clear();
   new_eoff_.clear();
   for (std::int32_t i = 0; i < cl.count; ++i) {
     const SolidCell& sc = cells_[std::size_t(cl.first + i)];
-    const auto x = grid_.coords(sc.cell);
+    int x[3] = {0, 0, 0};  // the wrapped coordinates (a solid cell lies on the lattice)
+    for (int a = 0; a < L::D; ++a) x[a] = wrap_axis(sc.xu[a], n[a], grid_.periodic[a]);
     bool exposed = false;
     for (int q = 1; q < Q; ++q) {
-      const CellIndex xc = grid_.neighbour(x[0], x[1], x[2], L::c[q][0], L::c[q][1], L::c[q][2]);
+      int xs[3];
+      for (int a = 0; a < 3; ++a) xs[a] = grid_.step(x[a], L::c[q][a], a);
+      const CellIndex xc = grid_.index(xs[0], xs[1], xs[2]);
       if (owner_[std::size_t(xc)] < 0 && !fluid_[std::size_t(xc)]) exposed = true;  // static solid or off the lattice
       if (!fluid_now(xc)) continue;
       MovingLink k;
       k.node = xc;
       for (int a = 0; a < 3; ++a) k.xu[a] = sc.xu[a];
       k.q = std::uint8_t(q);
-      const auto xs = grid_.coords(xc);
       k.has_second = fluid_now(grid_.neighbour(xs[0], xs[1], xs[2], L::c[q][0], L::c[q][1], L::c[q][2]));
-      k.edge = on_edge(xc);
+      k.edge = false;
+      for (int a = 0; a < L::D; ++a) k.edge = k.edge || (grid_.periodic[a] && (xs[a] == 0 || xs[a] == n[a] - 1));
       k.delta = link_delta(k, mot_[s], radius_[s]);
       new_links_.push_back(k);
     }
@@ -549,6 +553,7 @@ void MovingBoundary<L, T>::apply(T* f, bool odd) {
   for (std::int64_t s = 0; s < np; ++s) {
     update_delta(std::size_t(s));
     const Motion& m = mot_[std::size_t(s)];
+    const bool at_rest = m.v == Vec3::Zero() && m.w == Vec3::Zero();
     const Slice& sl = ls_[std::size_t(s)];
     Vec3 F = Vec3::Zero(), M = Vec3::Zero();
     const std::int32_t end = sl.first + sl.count;
@@ -561,6 +566,10 @@ void MovingBoundary<L, T>::apply(T* f, bool odd) {
         if (!a.edge) {
           __builtin_prefetch(f + a.node + post_off_[odd][L::opp[a.q]], 1);
           __builtin_prefetch(f + a.node + pre_off_[next][a.q], 1);
+          if (ws == WallScheme::Bouzidi && a.has_second) {
+            __builtin_prefetch(f + a.node + post_off_[odd][a.q], 0);
+            __builtin_prefetch(f + a.node + cq_off_[a.q] + post_off_[odd][L::opp[a.q]], 0);
+          }
         }
       }
       const MovingLink& k = links_[std::size_t(l)];
@@ -592,17 +601,21 @@ void MovingBoundary<L, T>::apply(T* f, bool odd) {
       const Vec3 ay(k.xu[0] - m.x[0], k.xu[1] - m.x[1], L::D == 3 ? k.xu[2] - m.x[2] : 0.0);
       const Vec3 ax = ay + c;
       const Vec3 arm = ax - k.delta * c;
-      const Vec3 uw = m.v + m.w.cross(arm);
-      const T cu = T(L::c[q][0]) * T(uw[0]) + T(L::c[q][1]) * T(uw[1]) + T(L::c[q][2]) * T(L::D == 3 ? uw[2] : 0.0);
-      const T mw = T(6 * L::w[q]) * cu;
+      T mw = 0, geq = 0;  // a particle at rest: no moving-wall term, g^eq_o(1, 0) = 0
+      if (!at_rest) {
+        const Vec3 uw = m.v + m.w.cross(arm);
+        const T cu = T(L::c[q][0]) * T(uw[0]) + T(L::c[q][1]) * T(uw[1]) + T(L::c[q][2]) * T(L::D == 3 ? uw[2] : 0.0);
+        mw = T(6 * L::w[q]) * cu;
+        const Vec3 us = m.v + m.w.cross(ay);
+        const T u0 = T(us[0]), u1 = T(us[1]), u2 = T(L::D == 3 ? us[2] : 0.0);
+        const T cuo = L::c[o][0] * u0 + L::c[o][1] * u1 + L::c[o][2] * u2;
+        geq = T(L::w[o]) * (T(0) + T(1) * (T(3) * cuo + T(4.5) * cuo * cuo - T(1.5) * (u0 * u0 + u1 * u1 + u2 * u2)));
+      }
       const T g = reflect<T>(ws, T(k.delta), k.has_second, A, B, C, mw);
       f[sd] = g;
       // Slot A is also what the solid cell y = x - c_q reads from x next step (AA pattern): it
       // gets g^eq_o(1, u_s(y)) instead of the fluid's population (equilibrium(), one direction).
-      const Vec3 us = m.v + m.w.cross(ay);
-      const T u0 = T(us[0]), u1 = T(us[1]), u2 = T(L::D == 3 ? us[2] : 0.0);
-      const T cuo = L::c[o][0] * u0 + L::c[o][1] * u1 + L::c[o][2] * u2;
-      f[sa] = T(L::w[o]) * (T(0) + T(1) * (T(3) * cuo + T(4.5) * cuo * cuo - T(1.5) * (u0 * u0 + u1 * u1 + u2 * u2)));
+      f[sa] = geq;
       const double ag = double(A) + double(g);
       const Vec3 Fl(L::c[o][0] * ag, L::c[o][1] * ag, L::D == 3 ? L::c[o][2] * ag : 0.0);
       F += Fl;
