@@ -629,8 +629,9 @@ void MovingBoundary<L, T>::apply(T* f, bool odd) {
   for (std::int64_t s = 0; s < np; ++s) {
     const Slice& sl = cs_[std::size_t(s)];
     const Motion& m = mot_[std::size_t(s)];
-    for (std::int32_t e = 0; e < ecount_[std::size_t(s)]; ++e) {
-      const SolidCell& sc = cells_[std::size_t(sl.first + eoff_[std::size_t(sl.first + e)])];
+    const std::int32_t ne = reset_all_ ? sl.count : ecount_[std::size_t(s)];
+    for (std::int32_t e = 0; e < ne; ++e) {
+      const SolidCell& sc = cells_[std::size_t(sl.first + (reset_all_ ? e : eoff_[std::size_t(sl.first + e)]))];
       const Vec3 arm(sc.xu[0] - m.x[0], sc.xu[1] - m.x[1], L::D == 3 ? sc.xu[2] - m.x[2] : 0.0);
       reset_cell(f, sc.cell, sc.edge, arm, m, next);
     }

@@ -36,7 +36,8 @@
 // the slot its fluid cell reads in the next step and replaces the population the fluid cell sent
 // into the wall, which the solid cell reads next, by g^eq_o(1, u_s) (cost proportional to links);
 // the cells just covered, and those next to a static solid or the lattice's edge, get f^eq(1, u_s)
-// in every slot. The other inputs of a solid cell come from solid cells, near f^eq(1, u_s)
+// in every slot (with a body force, every solid cell: set_reset_all()). The other inputs of a
+// solid cell come from solid cells, near f^eq(1, u_s)
 // (exactly f^eq(1, 0) for particles at rest), so the solid cells hold finite values near the
 // particle's velocity without a reset of every covered cell; no fluid cell ever reads a solid cell
 // (the links overwrite those slots). This works because in the AA pattern every slot a fluid cell
@@ -101,6 +102,9 @@ class MovingBoundary {
   // then the solid cells' reset. Then reduce() sums the per-particle loads in a fixed order.
   void apply(T* f, bool odd);
   void reduce();
+  // With a body force the solid cells' own collision drives them: every solid cell is then reset
+  // each step (as the links alone keep them near f^eq(1, u_s) only without one). Set by the solver.
+  void set_reset_all(bool all) { reset_all_ = all; }
 
   bool active() const { return ncells_ > 0; }
   bool solid(CellIndex cell) const { return !owner_.empty() && owner_[std::size_t(cell)] >= 0; }
@@ -179,6 +183,7 @@ class MovingBoundary {
   std::size_t ncells_ = 0, nlinks_ = 0;
   bool links_valid_ = false;          // the slices belong to owner_ (false after set_fluid_mask())
   bool applied_ = false;
+  bool reset_all_ = false;
   std::vector<Vec3> impulse_, impulse_torque_;  // per particle, from covering and refill
   std::vector<Vec3> lforce_, ltorque_;          // per particle, from the links of the last apply()
   std::vector<Vec3> force_, torque_;
