@@ -22,8 +22,9 @@
 //         sweep, or the bounce-back post-pass) and LBM;
 //   set   the part of coup before the LBM step (times.coupling alone);
 //   c/L   coup / LBM: the target is c/L <= 1.
-// "cells" is the cells the set covers (PSM: cells with a solid fraction; bounce-back: solid cells)
-// and "chg" the cells that changed between solid and fluid per step (bounce-back schemes).
+// "cells" is the cells the set covers (PSM: cells with a solid fraction; bounce-back: solid cells),
+// "chg" the cells that changed between solid and fluid per step and "links" the fluid-solid links
+// (bounce-back schemes).
 // Every configuration is run with the same number of steps on each thread count; "hash" combines
 // the DEM positions and the fluid populations at the end, and `same` says whether 1 and 2 threads
 // gave bit-identical results.
@@ -183,7 +184,7 @@ Rock make_rock(int dim, bool quick) {
 
 struct Result {
   double lbm = 0, lbm_part = 0, set = 0, coup = 0, dem = 0;
-  double cells = 0, changed = 0;
+  double cells = 0, changed = 0, links = 0;
   std::uint64_t hash = 0;
   long sub = 0;
 };
@@ -241,7 +242,7 @@ Result run_config(const Rock& rock, const std::string& scheme, const std::string
   Result r;
   r.sub = cp.sub_steps();
   std::vector<double> vl, vp, vs, vc, vd;
-  double cells = 0, changed = 0;
+  double cells = 0, changed = 0, links = 0;
   for (long done = 0; done < steps;) {
     const long nb = std::min(block, steps - done);
     const coupling::CouplerTimes t0 = cp.times;
@@ -250,6 +251,7 @@ Result run_config(const Rock& rock, const std::string& scheme, const std::string
       if (const auto* mb = fluid.moving_boundary()) {
         changed += double(mb->stats().covered + mb->stats().uncovered);
         cells += double(mb->num_cells());
+        links += double(mb->num_links());
       } else if (const auto* ps = fluid.psm()) {
         cells += double(ps->num_cells());
       }
@@ -272,6 +274,7 @@ Result run_config(const Rock& rock, const std::string& scheme, const std::string
   r.dem = median(vd);
   r.cells = cells / double(steps);
   r.changed = changed / double(steps);
+  r.links = links / double(steps);
   const auto& P = dem.particles.pos;
   r.hash = fnv(P.data(), P.size() * sizeof(Vec3));
   const auto& f = fluid.populations();
@@ -336,9 +339,9 @@ int main(int argc, char** argv) {
     fmt::print("\n{}D: {} lattice {}^{} cells, {} bonded particles, {} bonds (built in {:.1f} s)\n", dim,
                dim == 2 ? "D2Q9" : "D3Q19", rock.n, dim, rock.dem.particles.size(), rock.dem.bonds.size(),
                seconds_since(t0));
-    fmt::print("{:<7} {:<5} {:>3} {:>4} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9} {:>6} {:>9} {:>8}  {:<16} {}\n", "scheme",
-               "move", "thr", "sub", "LBM", "coup", "set", "DEM", "total", "LBM+part", "c/L", "cells", "chg", "hash",
-               "same");
+    fmt::print("{:<7} {:<5} {:>3} {:>4} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9} {:>6} {:>9} {:>8} {:>9}  {:<16} {}\n",
+               "scheme", "move", "thr", "sub", "LBM", "coup", "set", "DEM", "total", "LBM+part", "c/L", "cells", "chg",
+               "links", "hash", "same");
     for (const std::string scheme : {"psm", "stair", "interp"}) {
       if (!o.scheme.empty() && scheme != o.scheme) continue;
       for (const std::string motion : {"slow", "fast"}) {
@@ -349,9 +352,9 @@ int main(int argc, char** argv) {
                                     : run_config<lbm::D3Q19>(rock, scheme, motion, o.threads[ti], o, steps, block);
           if (ti == 0) first = r.hash;
           fmt::print("{:<7} {:<5} {:>3} {:>4} {:>8.2f} {:>8.2f} {:>8.2f} {:>8.2f} {:>8.2f} {:>9.2f} {:>6.2f} {:>9.0f} "
-                     "{:>8.0f}  {:016x} {}\n",
+                     "{:>8.0f} {:>9.0f}  {:016x} {}\n",
                      scheme, motion, o.threads[ti], r.sub, 1e3 * r.lbm, 1e3 * r.coup, 1e3 * r.set, 1e3 * r.dem,
-                     1e3 * (r.lbm + r.coup + r.dem), 1e3 * r.lbm_part, r.coup / r.lbm, r.cells, r.changed, r.hash,
+                     1e3 * (r.lbm + r.coup + r.dem), 1e3 * r.lbm_part, r.coup / r.lbm, r.cells, r.changed, r.links, r.hash,
                      ti == 0 ? "-" : (r.hash == first ? "yes" : "NO"));
           std::fflush(stdout);
         }

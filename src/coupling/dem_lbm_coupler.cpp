@@ -98,6 +98,27 @@ void DemLbmCoupler<L, T>::resize(std::size_t n) {
   dry_force_.assign(n, Vec3::Zero());
   p_particle_.assign(n, scales_.background_pressure);
   has_dry_.assign(n, 0);
+  dry_clear_.assign(n, 0);
+  dry_x_.assign(n, Vec3::Zero());
+  dry_r_.assign(n, 0.0);
+}
+
+// The nearest cell of a point within r of a centre within kDryMove (per axis) of x lies in
+// floor(x - r - kDryMove + 0.5) .. floor(x + r + kDryMove + 0.5) along each axis (a 1e-6 margin for
+// rounding): none of those is dry, so no surface point is dry while the particle stays there.
+template <class L, class T>
+bool DemLbmCoupler<L, T>::clear_box(const Vec3& x, double r) const {
+  const double reach = r + kDryMove + 1e-6;
+  int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+  for (int a = 0; a < L::D; ++a) {
+    lo[a] = int(std::floor(x[a] - reach + 0.5));
+    hi[a] = int(std::floor(x[a] + reach + 0.5));
+  }
+  for (int z = lo[2]; z <= hi[2]; ++z)
+    for (int y = lo[1]; y <= hi[1]; ++y)
+      for (int v = lo[0]; v <= hi[0]; ++v)
+        if (dry(Vec3(v, y, z))) return false;
+  return true;
 }
 
 template <class L, class T>
@@ -177,7 +198,17 @@ void DemLbmCoupler<L, T>::step(bool sample_fluid) {
       const std::size_t i = std::size_t(ii);
       char d = 0;
       const double rl = set_.radius[i];
-      for (std::size_t k = 0; k < qn_.size() && !d; ++k) d = dry(set_.position[i] + rl * qn_[k]) ? 1 : 0;
+      const Vec3& x = set_.position[i];
+      // Far from every dry cell since the last look (the particles move ~0.002 cells per step):
+      // no surface point can be dry, the same answer as the points give.
+      bool clear = dry_clear_[i] && rl == dry_r_[i];
+      for (int a = 0; a < L::D && clear; ++a) clear = std::abs(x[a] - dry_x_[i][a]) < kDryMove;
+      if (!clear) {
+        for (std::size_t k = 0; k < qn_.size() && !d; ++k) d = dry(x + rl * qn_[k]) ? 1 : 0;
+        dry_clear_[i] = !d && clear_box(x, rl);
+        dry_x_[i] = x;
+        dry_r_[i] = rl;
+      }
       has_dry_[i] = d;
       any_dry = any_dry || d;
     }

@@ -89,6 +89,13 @@ class DemLbmCoupler {
   long n_sub_ = 1;
   lbm::ParticleSet set_;
   std::vector<char> has_dry_;  // per particle: a surface point lies in a dry cell
+  // Per particle: no dry cell within reach of its surface points while it stays within kDryMove
+  // (per axis) of dry_x_ (lattice units; the lattice's geometry is fixed once the coupler exists).
+  static constexpr double kDryMove = 0.5;
+  std::vector<char> dry_clear_;
+  std::vector<Vec3> dry_x_;
+  std::vector<double> dry_r_;
+  bool clear_box(const Vec3& x, double r) const;  // no dry cell that a surface point can reach
   std::vector<Vec3> force_, torque_, dry_force_;
   std::vector<double> p_particle_;
   // Unit-sphere (circle) quadrature: outward normals and weights (sum of weights = 4 pi or 2 pi).

@@ -27,8 +27,11 @@ MovingBoundary<L, T>::MovingBoundary(const Grid& grid, ParticleScheme scheme, bo
   const CellIndex N = grid_.padded_size();
   for (int q = 0; q < Q; ++q) {
     const std::int64_t cq = L::c[q][0] + grid_.px * (L::c[q][1] + grid_.py * L::c[q][2]);
+    cq_off_[q] = cq;
     pre_off_[0][q] = q * N;
     pre_off_[1][q] = q == 0 ? 0 : L::opp[q] * N - cq;
+    post_off_[0][q] = q == 0 ? 0 : L::opp[q] * N;
+    post_off_[1][q] = q == 0 ? 0 : q * N + cq;
   }
 }
 
@@ -36,10 +39,14 @@ template <class L, class T>
 void MovingBoundary<L, T>::set_fluid_mask(std::vector<std::uint8_t> fluid) {
   fluid_ = std::move(fluid);
   owner_.assign(fluid_.size(), -1);
-  next_.assign(fluid_.size(), -1);
+  np_ = 0;
+  cs_.clear();
+  ls_.clear();
   cells_.clear();
-  cell_.clear();
+  eoff_.clear();
   links_.clear();
+  pending_.clear();
+  ncells_ = nlinks_ = 0;
   links_valid_ = false;
 }
 
@@ -62,6 +69,89 @@ CellIndex MovingBoundary<L, T>::post(const int* x, int q, bool odd) const {
 }
 
 template <class L, class T>
+bool MovingBoundary<L, T>::on_edge(CellIndex c) const {
+  const auto x = grid_.coords(c);
+  const int n[3] = {grid_.nx, grid_.ny, grid_.nz};
+  bool e = false;
+  for (int a = 0; a < L::D; ++a) e = e || (grid_.periodic[a] && (x[a] == 0 || x[a] == n[a] - 1));
+  return e;
+}
+
+// Cell centre minus particle centre, minimum image on periodic axes (2D: z = 0).
+template <class L, class T>
+Vec3 MovingBoundary<L, T>::arm_of(CellIndex c, std::size_t s, const std::vector<Motion>& m) const {
+  const auto x = grid_.coords(c);
+  const int n[3] = {grid_.nx, grid_.ny, grid_.nz};
+  Vec3 arm = Vec3::Zero();
+  for (int a = 0; a < L::D; ++a) {
+    double d = x[a] - m[s].x[a];
+    if (grid_.periodic[a]) d -= n[a] * std::round(d / n[a]);
+    arm[a] = d;
+  }
+  return arm;
+}
+
+// Forgets every slice: the cells of the current set become "released" (refilled unless retaken).
+template <class L, class T>
+void MovingBoundary<L, T>::release_all() {
+  for (std::size_t t = 0; t < np_; ++t) {
+    const Slice& sl = cs_[t];
+    for (std::int32_t i = sl.first; i < sl.first + sl.count; ++i) {
+      const CellIndex c = cells_[std::size_t(i)].cell;
+      owner_[std::size_t(c)] = -2 - std::int32_t(t);
+      released_.push_back(c);
+    }
+  }
+  cells_.clear();
+  eoff_.clear();
+  links_.clear();
+  ncells_ = nlinks_ = 0;
+}
+
+// Room for `need` entries in particle self's slice of arr (and of par, parallel to it): in place,
+// else a new slice at the end; when that would reallocate, every slice is first packed into
+// spare (with room to grow) and the arrays swapped. Slice contents keep their order.
+template <class L, class T>
+template <class V>
+void MovingBoundary<L, T>::place(V& arr, Slice& self, std::int32_t need, std::vector<Slice>& all, V& spare,
+                                 std::vector<std::int32_t>* par) {
+  if (need <= self.cap) return;
+  auto room = [](std::int32_t n) { return n + n / 4 + 8; };
+  const std::int32_t cap = room(need);
+  if (arr.size() + std::size_t(cap) > arr.capacity()) {
+    std::size_t total = std::size_t(cap);
+    for (const Slice& sl : all) total += std::size_t(room(sl.count));
+    spare.clear();
+    if (spare.capacity() < total) spare.reserve(2 * total);
+    std::vector<std::int32_t> pspare;
+    if (par) pspare.reserve(spare.capacity());
+    for (Slice& sl : all) {
+      if (&sl == &self) continue;
+      const std::size_t first = spare.size();
+      const std::int32_t c = room(sl.count);
+      spare.insert(spare.end(), arr.begin() + sl.first, arr.begin() + sl.first + sl.count);
+      spare.resize(first + std::size_t(c));
+      if (par) {
+        pspare.insert(pspare.end(), par->begin() + sl.first, par->begin() + sl.first + sl.count);
+        pspare.resize(first + std::size_t(c));
+      }
+      sl.first = std::int32_t(first);
+      sl.cap = c;
+    }
+    arr.swap(spare);
+    if (arr.capacity() < 2 * total) arr.reserve(2 * total);
+    if (par) {
+      par->swap(pspare);
+      par->reserve(arr.capacity());
+    }
+  }
+  self.first = std::int32_t(arr.size());
+  self.cap = cap;
+  arr.resize(arr.size() + std::size_t(cap));
+  if (par) par->resize(arr.size());
+}
+
+template <class L, class T>
 void MovingBoundary<L, T>::set_particles(const ParticleSet& p, T* f, bool odd, bool bookkeeping) {
   const std::size_t np = p.size();
   const char* name = particle_scheme_name(scheme_);
@@ -69,7 +159,7 @@ void MovingBoundary<L, T>::set_particles(const ParticleSet& p, T* f, bool odd, b
     throw InputError(fmt::format("{} particle set: the arrays differ in length (radius {}, position {}, velocity {}, "
                                  "omega {}, id {}): all must have one entry per particle (id may be empty)",
                                  name, np, p.position.size(), p.velocity.size(), p.omega.size(), p.id.size()));
-  if (np >= std::size_t(INT32_MAX)) throw InputError(fmt::format("{} particle set: more than 2^31 - 1 particles", name));
+  if (np >= std::size_t(1) << 30) throw InputError(fmt::format("{} particle set: more than 2^30 particles", name));
   if (fluid_.empty()) throw Error("internal: MovingBoundary used before set_fluid_mask()");
   const int D = L::D;
   const int n[3] = {grid_.nx, grid_.ny, grid_.nz};
@@ -88,176 +178,259 @@ void MovingBoundary<L, T>::set_particles(const ParticleSet& p, T* f, bool odd, b
   stats_ = MovingBoundaryStats{};
   impulse_.assign(np, Vec3::Zero());
   impulse_torque_.assign(np, Vec3::Zero());
-  // 1. The new solid cells: centres strictly inside a particle, first particle wins.
-  new_cells_.clear();
-  new_cell_.clear();
-  nfirst_.resize(np);
-  ncount_.resize(np);
+  // The motion of the new set (the previous one kept for the refill of cells it leaves).
+  mot_.swap(prev_mot_);
+  pid_.swap(prev_pid_);
+  mot_.resize(np);
+  pid_.resize(np);
   for (std::size_t s = 0; s < np; ++s) {
-    nfirst_[s] = std::int32_t(new_cells_.size());
-    const Vec3& X = p.position[s];
-    const double r = p.radius[s];
-    int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
-    for (int a = 0; a < D; ++a) {
-      lo[a] = int(std::ceil(X[a] - r));
-      hi[a] = int(std::floor(X[a] + r));
-    }
-    const Vec3& v = p.velocity[s];
-    const Vec3 w = D == 3 ? p.omega[s] : Vec3(0, 0, p.omega[s][2]);
-    const std::uint64_t id = p.id.empty() ? std::uint64_t(s) : p.id[s];
-    for (int z = lo[2]; z <= hi[2]; ++z)
-      for (int y = lo[1]; y <= hi[1]; ++y) {
-        // Only |x - X| < sqrt(r^2 - dy^2 - dz^2) can be inside: the row visits that range.
-        const double dy = y - X[1], dz = D == 3 ? z - X[2] : 0.0;
-        const double rest = r * r - dy * dy - dz * dz;
-        if (rest < -1e-9) continue;  // (margins: rounding never drops a cell the test below takes)
-        const double half = std::sqrt(std::max(rest, 0.0)) + 1e-9;
-        const int x0 = std::max(lo[0], int(std::floor(X[0] - half))), x1 = std::min(hi[0], int(std::ceil(X[0] + half)));
-        int c[3] = {0, y, z};
-        bool inside = true;
-        for (int a = 1; a < D; ++a) {
-          c[a] = wrap_axis(c[a], n[a], grid_.periodic[a]);
-          inside = inside && c[a] >= 0;
-        }
-        if (!inside) continue;
-        for (int x = x0; x <= x1; ++x) {
-          const Vec3 arm = D == 3 ? Vec3(x - X[0], y - X[1], z - X[2]) : Vec3(x - X[0], y - X[1], 0);
-          if (!(arm.squaredNorm() < r * r)) continue;
-          c[0] = wrap_axis(x, n[0], grid_.periodic[0]);
-          if (c[0] < 0) continue;
-          const CellIndex ci = grid_.index(c[0], c[1], c[2]);
-          if (!fluid_[std::size_t(ci)] || next_[std::size_t(ci)] >= 0) continue;
-          next_[std::size_t(ci)] = std::int32_t(new_cells_.size());
-          SolidCell sc;
-          sc.cell = ci;
-          for (int a = 0; a < 3; ++a) sc.x[a] = c[a];
-          sc.particle = std::int32_t(s);
-          sc.id = id;
-          sc.arm = arm;
-          const Vec3 us = v + w.cross(arm);
-          for (int a = 0; a < 3; ++a) sc.us[a] = T(a < D ? us[a] : 0.0);
-          sc.edge = false;
-          for (int a = 0; a < D; ++a) sc.edge = sc.edge || (grid_.periodic[a] && (c[a] == 0 || c[a] == n[a] - 1));
-          new_cells_.push_back(sc);
-          new_cell_.push_back(ci);
-        }
-      }
-    ncount_[s] = std::int32_t(new_cells_.size()) - nfirst_[s];
+    mot_[s].x = D == 3 ? p.position[s] : Vec3(p.position[s][0], p.position[s][1], 0);
+    mot_[s].v = D == 3 ? p.velocity[s] : Vec3(p.velocity[s][0], p.velocity[s][1], 0);
+    mot_[s].w = D == 3 ? p.omega[s] : Vec3(0, 0, p.omega[s][2]);
+    pid_[s] = p.id.empty() ? std::uint64_t(s) : p.id[s];
   }
-  // Links are rebuilt only around what changed when the set has the same particles as before.
-  const bool incremental = links_valid_ && cfirst_.size() == np;
-  // The cells that change: covered (fluid before) and uncovered (fluid after).
   covered_.clear();
-  uncovered_.clear();
-  for (std::size_t i = 0; i < new_cell_.size(); ++i)
-    if (owner_[std::size_t(new_cell_[i])] < 0) covered_.push_back(std::int32_t(i));
-  for (std::size_t i = 0; i < cell_.size(); ++i)
-    if (next_[std::size_t(cell_[i])] < 0) uncovered_.push_back(std::int32_t(i));
-  if (incremental) {
+  released_.clear();
+  if (!bookkeeping) pending_.clear();  // a resume: the populations are the checkpoint's
+  // A new particle count, a new mask or a resume: everything is rebuilt.
+  const bool full = !links_valid_ || np != np_ || !bookkeeping;
+  if (full) {
+    release_all();
+    cs_.assign(np, Slice{});
+    ls_.assign(np, Slice{});
+    ecount_.assign(np, 0);
+    rescan_.assign(np, 1);
+    contested_.assign(np, 0);
+    scan_x_.assign(np, Vec3::Zero());
+    scan_r_.assign(np, 0.0);
+    margin_.assign(np, 0.0);
+    radius_.assign(np, 0.0);
+    dirty_.assign(np, 1);
+    delta_x_.assign(np, Vec3::Constant(std::nan("")));
+    delta_r_.assign(np, 0.0);
+  } else {
     dirty_.assign(np, 0);
-    for (std::size_t s = 0; s < np; ++s) {
-      bool same = ncount_[s] == ccount_[s];
-      if (same) same = std::equal(new_cell_.begin() + nfirst_[s], new_cell_.begin() + nfirst_[s] + ncount_[s],
-                                  cell_.begin() + cfirst_[s]);
-      if (!same) dirty_[s] = 1;
+  }
+  np_ = np;
+
+  // 1. Ownership in particle order (the first particle that contains a cell owns it), rescanning
+  //    only the particles whose cells can have changed.
+  for (std::size_t s = 0; s < np; ++s) {
+    const double r = p.radius[s];
+    radius_[s] = r;
+    bool need = rescan_[s] || contested_[s] || r != scan_r_[s];
+    if (!need) need = !((mot_[s].x - scan_x_[s]).norm() < margin_[s] - 1e-9);
+    if (need) {
+      scan(s, p);
+      claim(s);
     }
-    for (const std::int32_t i : covered_) mark_dirty(new_cell_[std::size_t(i)]);
-    for (const std::int32_t i : uncovered_) mark_dirty(cell_[std::size_t(i)]);
+    rescan_[s] = 0;
   }
 
   if (bookkeeping) {
     // 2. Covering: a cell that turns solid hands its fluid momentum to its particle.
-    for (const std::int32_t i : covered_) {
-      const SolidCell& sc = new_cells_[std::size_t(i)];
+    for (const CellIndex c : covered_) {
+      const auto xc = grid_.coords(c);
+      const int x[3] = {xc[0], xc[1], xc[2]};
+      const std::size_t s = std::size_t(owner_[std::size_t(c)]);
       double m = 1, j[3] = {0, 0, 0};
       for (int q = 0; q < Q; ++q) {
-        const double g = double(f[pre(sc.x, q, odd)]);
+        const double g = double(f[pre(x, q, odd)]);
         m += g;
         for (int a = 0; a < D; ++a) j[a] += L::c[q][a] * g;
       }
       const Vec3 J(j[0], j[1], j[2]);
-      impulse_[std::size_t(sc.particle)] += J;
-      impulse_torque_[std::size_t(sc.particle)] += sc.arm.cross(J);
+      impulse_[s] += J;
+      impulse_torque_[s] += arm_of(c, s, mot_).cross(J);
       stats_.impulse += J;
       stats_.mass_removed += m;
       ++stats_.covered;
+      pending_.push_back(c);
     }
     // 3. Refill of the cells that turn fluid: f^eq(rho_avg, u_w) with rho_avg over the neighbours
-    //    that are fluid before and after, u_w the uncovering particle's velocity at the cell.
-    for (const std::int32_t i : uncovered_) {
-      const SolidCell& old = cells_[std::size_t(i)];
+    //    that are fluid before and after (owner -1 now), u_w the uncovering particle's velocity at
+    //    the cell (its previous one if it left the set).
+    for (const CellIndex c : released_) {
+      const std::int32_t code = owner_[std::size_t(c)];
+      if (code > -2) continue;  // taken again
+      const std::size_t t = std::size_t(-2 - code);
+      const auto xc = grid_.coords(c);
+      const int x[3] = {xc[0], xc[1], xc[2]};
       double rsum = 0;
       int count = 0;
       for (int q = 1; q < Q; ++q) {
-        int y[3];
-        const CellIndex nb = grid_.neighbour(old.x[0], old.x[1], old.x[2], L::c[q][0], L::c[q][1], L::c[q][2]);
-        if (!fluid_[std::size_t(nb)] || owner_[std::size_t(nb)] >= 0 || next_[std::size_t(nb)] >= 0) continue;
+        const CellIndex nb = grid_.neighbour(x[0], x[1], x[2], L::c[q][0], L::c[q][1], L::c[q][2]);
+        if (!fluid_[std::size_t(nb)] || owner_[std::size_t(nb)] != -1) continue;
         const auto yc = grid_.coords(nb);
-        for (int a = 0; a < 3; ++a) y[a] = yc[a];
+        const int y[3] = {yc[0], yc[1], yc[2]};
         double rho = 1;
         for (int k = 0; k < Q; ++k) rho += double(f[pre(y, k, odd)]);
         rsum += rho;
         ++count;
       }
       const double rho = count > 0 ? rsum / count : 1.0;
-      const std::size_t s = std::size_t(old.particle);
-      const bool same = s < np && (p.id.empty() ? true : p.id[s] == old.id);
-      Vec3 uw(old.us[0], old.us[1], old.us[2]);
-      Vec3 arm = old.arm;
-      if (same) {
-        // The particle's current velocity at the cell centre (minimum image on periodic axes).
-        const Vec3& X = p.position[s];
-        for (int a = 0; a < D; ++a) {
-          double d = old.x[a] - X[a];
-          if (grid_.periodic[a]) d -= n[a] * std::round(d / n[a]);
-          arm[a] = d;
-        }
-        if (D == 2) arm[2] = 0;
-        const Vec3 w = D == 3 ? p.omega[s] : Vec3(0, 0, p.omega[s][2]);
-        uw = p.velocity[s] + w.cross(arm);
-        if (D == 2) uw[2] = 0;
-      } else {
-        ++stats_.unattributed;
-      }
+      const bool same = t < np && (p.id.empty() || p.id[t] == prev_pid_[t]);
+      const std::vector<Motion>& m = same ? mot_ : prev_mot_;
+      const Vec3 arm = arm_of(c, t, m);
+      Vec3 uw = m[t].v + m[t].w.cross(arm);
+      if (D == 2) uw[2] = 0;
+      if (!same) ++stats_.unattributed;
       const T u[3] = {T(uw[0]), T(uw[1]), T(D == 3 ? uw[2] : 0.0)};
       T geq[Q];
       equilibrium<L, T>(T(rho), u, geq, incompressible_);
       double j[3] = {0, 0, 0};
       for (int q = 0; q < Q; ++q) {
-        f[pre(old.x, q, odd)] = geq[q];
+        f[pre(x, q, odd)] = geq[q];
         for (int a = 0; a < D; ++a) j[a] += L::c[q][a] * double(geq[q]);
       }
       const Vec3 J(j[0], j[1], j[2]);  // the refill's momentum as stored
       if (same) {
-        impulse_[s] -= J;
-        impulse_torque_[s] -= arm.cross(J);
+        impulse_[t] -= J;
+        impulse_torque_[t] -= arm.cross(J);
       }
       stats_.impulse -= J;
       stats_.mass_added += rho;
       ++stats_.uncovered;
     }
   }
-
-  // 4. Swap the sets: owner_ of the old cells cleared, of the new ones set; next_ cleared.
-  for (const CellIndex c : cell_) owner_[std::size_t(c)] = -1;
-  cells_.swap(new_cells_);
-  cell_.swap(new_cell_);
-  for (std::size_t i = 0; i < cell_.size(); ++i) {
-    owner_[std::size_t(cell_[i])] = std::int32_t(i);
-    next_[std::size_t(cell_[i])] = -1;
+  // 4. The links that may see a changed cell; the released cells become fluid.
+  if (!full) {
+    for (const CellIndex c : covered_) mark_dirty(c);
+    for (const CellIndex c : released_)
+      if (owner_[std::size_t(c)] <= -2) mark_dirty(c);
   }
-  cfirst_.swap(nfirst_);
-  ccount_.swap(ncount_);
-  build_links(p, incremental);
-  stats_.solid_cells = long(cells_.size());
-  stats_.links = long(links_.size());
+  for (const CellIndex c : released_)
+    if (owner_[std::size_t(c)] <= -2) owner_[std::size_t(c)] = -1;
+  // 5. Links: rebuilt for the dirty particles; the others keep theirs (Bouzidi: new fractions if moved).
+  for (std::size_t s = 0; s < np; ++s)
+    if (dirty_[s]) build_links(s, p);
+  if (full) {
+    // Room for the slices to grow without reallocation in later steps.
+    cells_.reserve(2 * cells_.size() + 1024);
+    eoff_.reserve(cells_.capacity());
+    links_.reserve(2 * links_.size() + 1024);
+  }
+  links_valid_ = true;
+  stats_.solid_cells = long(ncells_);
+  stats_.links = long(nlinks_);
   force_.assign(np, Vec3::Zero());
   torque_.assign(np, Vec3::Zero());
+  lforce_.assign(np, Vec3::Zero());
+  ltorque_.assign(np, Vec3::Zero());
+  applied_ = false;
+}
+
+// The cells of particle s (centres strictly inside, static fluid) in scan order into scan_, and
+// its margin: the smallest distance of a lattice point from its surface (at most 1), so that no
+// cell changes side while it moves less than that.
+template <class L, class T>
+void MovingBoundary<L, T>::scan(std::size_t s, const ParticleSet& p) {
+  const int D = L::D;
+  const int n[3] = {grid_.nx, grid_.ny, grid_.nz};
+  const Vec3& X = mot_[s].x;
+  const double r = p.radius[s];
+  scan_.clear();
+  int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+  for (int a = 0; a < D; ++a) {
+    lo[a] = int(std::ceil(X[a] - r));
+    hi[a] = int(std::floor(X[a] + r));
+  }
+  double margin = 1.0;
+  auto gap = [&](int x, double d2) {
+    const double dx = x - X[0];
+    margin = std::min(margin, std::abs(std::sqrt(dx * dx + d2) - r));
+  };
+  const int zlo = D == 3 ? lo[2] - 1 : 0, zhi = D == 3 ? hi[2] + 1 : 0;
+  for (int z = zlo; z <= zhi; ++z)
+    for (int y = lo[1] - 1; y <= hi[1] + 1; ++y) {
+      const double dy = y - X[1], dz = D == 3 ? z - X[2] : 0.0;
+      const double d2 = dy * dy + dz * dz;
+      const double rest = r * r - d2;
+      // Margin: along a row the distance from the surface falls towards the crossing and rises
+      // beyond it, so the points next to the crossings (or to the centre) are the nearest.
+      if (rest > 0) {
+        const double half = std::sqrt(rest);
+        const int a0 = int(std::floor(X[0] - half)), a1 = int(std::floor(X[0] + half));
+        for (int x = a0 - 1; x <= a0 + 2; ++x) gap(x, d2);
+        for (int x = a1 - 1; x <= a1 + 2; ++x) gap(x, d2);
+      } else {
+        const int a0 = int(std::floor(X[0]));
+        gap(a0, d2);
+        gap(a0 + 1, d2);
+      }
+      if (z < lo[2] || z > hi[2] || y < lo[1] || y > hi[1]) continue;
+      // Only |x - X| < sqrt(r^2 - dy^2 - dz^2) can be inside: the row visits that range.
+      if (rest < -1e-9) continue;  // (margins: rounding never drops a cell the test below takes)
+      const double half = std::sqrt(std::max(rest, 0.0)) + 1e-9;
+      const int x0 = std::max(lo[0], int(std::floor(X[0] - half))), x1 = std::min(hi[0], int(std::ceil(X[0] + half)));
+      int c[3] = {0, y, z};
+      bool inside = true;
+      for (int a = 1; a < D; ++a) {
+        c[a] = wrap_axis(c[a], n[a], grid_.periodic[a]);
+        inside = inside && c[a] >= 0;
+      }
+      if (!inside) continue;
+      for (int x = x0; x <= x1; ++x) {
+        const Vec3 arm = D == 3 ? Vec3(x - X[0], y - X[1], z - X[2]) : Vec3(x - X[0], y - X[1], 0);
+        if (!(arm.squaredNorm() < r * r)) continue;
+        c[0] = wrap_axis(x, n[0], grid_.periodic[0]);
+        if (c[0] < 0) continue;
+        const CellIndex ci = grid_.index(c[0], c[1], c[2]);
+        if (!fluid_[std::size_t(ci)]) continue;
+        bool edge = false;
+        for (int a = 0; a < D; ++a) edge = edge || (grid_.periodic[a] && (c[a] == 0 || c[a] == n[a] - 1));
+        scan_.push_back(SolidCell{ci, {x, y, z}, edge});
+      }
+    }
+  scan_x_[s] = X;
+  scan_r_[s] = r;
+  margin_[s] = margin;
+}
+
+// Ownership of the scanned cells of particle s: free cells and those of later particles are taken
+// (a later particle that loses one rescans), cells of earlier ones are not (s is then contested
+// and rescans every set); its former cells it no longer owns are released.
+template <class L, class T>
+void MovingBoundary<L, T>::claim(std::size_t s) {
+  const std::int32_t me = std::int32_t(s), mark = INT32_MIN + me;
+  bool contested = false;
+  std::size_t keep = 0;
+  for (std::size_t i = 0; i < scan_.size(); ++i) {
+    const CellIndex c = scan_[i].cell;
+    std::int32_t& o = owner_[std::size_t(c)];
+    if (o >= 0 && o < me) {
+      contested = true;
+      continue;
+    }
+    if (o == -1) covered_.push_back(c);
+    else if (o > me) rescan_[std::size_t(o)] = 1;
+    o = mark;
+    scan_[keep++] = scan_[i];
+  }
+  scan_.resize(keep);
+  contested_[s] = contested;
+  Slice& sl = cs_[s];
+  bool same = std::int32_t(keep) == sl.count;
+  for (std::int32_t i = sl.first; i < sl.first + sl.count; ++i) {
+    const CellIndex c = cells_[std::size_t(i)].cell;
+    if (same && c != scan_[std::size_t(i - sl.first)].cell) same = false;
+    if (owner_[std::size_t(c)] == me) {
+      owner_[std::size_t(c)] = -2 - me;
+      released_.push_back(c);
+    }
+  }
+  for (const SolidCell& sc : scan_) owner_[std::size_t(sc.cell)] = me;
+  if (same) return;
+  dirty_[s] = 1;
+  ncells_ += keep;
+  ncells_ -= std::size_t(sl.count);
+  place(cells_, sl, std::int32_t(keep), cs_, cells_spare_, &eoff_);
+  for (std::size_t i = 0; i < keep; ++i) cells_[std::size_t(sl.first) + i] = scan_[i];
+  sl.count = std::int32_t(keep);
 }
 
 // A changed cell c alters the links of the solid cells y with c = y + c_q (the link's fluid
-// node) or c = y + 2 c_q (its second node): their particles are dirty. Called before the swap:
-// next_ holds the new set.
+// node) or c = y + 2 c_q (its second node) and whether y is exposed: their particles are dirty.
 template <class L, class T>
 void MovingBoundary<L, T>::mark_dirty(CellIndex changed) {
   const auto x = grid_.coords(changed);
@@ -271,99 +444,98 @@ void MovingBoundary<L, T>::mark_dirty(CellIndex changed) {
         inside = inside && y[a] >= 0;
       }
       if (!inside) continue;
-      const std::int32_t o = next_[std::size_t(grid_.index(y[0], y[1], y[2]))];
-      if (o >= 0) dirty_[std::size_t(new_cells_[std::size_t(o)].particle)] = 1;
+      const std::int32_t o = owner_[std::size_t(grid_.index(y[0], y[1], y[2]))];
+      if (o >= 0) dirty_[std::size_t(o)] = 1;
     }
 }
 
-// Wall point, fraction and velocity of a link from its solid cell's arm and the particle's motion.
+// Bouzidi fraction of a link from its solid cell and the particle's centre and radius.
 template <class L, class T>
-void MovingBoundary<L, T>::link_motion(MovingLink& k, const ParticleSet& p) const {
-  const int D = L::D;
+double MovingBoundary<L, T>::link_delta(const MovingLink& k, const Motion& m, double r) const {
+  if (scheme_ != ParticleScheme::InterpolatedBounceBack) return 0.5;
   const int q = k.q;
-  const std::size_t s = std::size_t(k.particle);
-  const double r = p.radius[s];
-  const Vec3 w = D == 3 ? p.omega[s] : Vec3(0, 0, p.omega[s][2]);
-  const Vec3 c(L::c[q][0], L::c[q][1], D == 3 ? L::c[q][2] : 0);
-  // x relative to the centre; the wall point x_w = x - delta c_q lies on the link towards the solid.
-  const Vec3 ax = cells_[std::size_t(k.solid)].arm + c;
-  double delta = 0.5;
-  if (scheme_ == ParticleScheme::InterpolatedBounceBack) {
-    // |ax - delta c|^2 = r^2: the smaller root (|ax| >= r at delta = 0, |arm| < r at delta = 1).
-    const double cc = c.squaredNorm(), b = ax.dot(c), e = ax.squaredNorm() - r * r;
-    const double disc = std::max(0.0, b * b - cc * e);
-    delta = std::clamp((b - std::sqrt(disc)) / cc, 0.0, 1.0);
-  }
-  k.delta = delta;
-  const Vec3 arm = ax - delta * c;  // x_w minus the particle centre (reduce() recomputes it)
-  const Vec3 uw = p.velocity[s] + w.cross(arm);
-  T u[3];
-  for (int a = 0; a < 3; ++a) u[a] = T(a < D ? uw[a] : 0.0);
-  const T cu = L::c[q][0] * u[0] + L::c[q][1] * u[1] + L::c[q][2] * u[2];
-  k.mw = T(6 * L::w[q]) * cu;
+  const Vec3 c(L::c[q][0], L::c[q][1], L::D == 3 ? L::c[q][2] : 0);
+  const Vec3 arm(k.xu[0] - m.x[0], k.xu[1] - m.x[1], L::D == 3 ? k.xu[2] - m.x[2] : 0.0);
+  // x relative to the centre; |ax - delta c|^2 = r^2: the smaller root (|ax| >= r at delta = 0,
+  // |arm| < r at delta = 1).
+  const Vec3 ax = arm + c;
+  const double cc = c.squaredNorm(), b = ax.dot(c), e = ax.squaredNorm() - r * r;
+  const double disc = std::max(0.0, b * b - cc * e);
+  return std::clamp((b - std::sqrt(disc)) / cc, 0.0, 1.0);
 }
 
+// The Bouzidi fractions of particle s's links at its current position and radius (once per move).
 template <class L, class T>
-void MovingBoundary<L, T>::add_links(std::int32_t solid, const ParticleSet& p) {
-  const SolidCell& sc = cells_[std::size_t(solid)];
-  for (int q = 1; q < Q; ++q) {
-    const CellIndex xc = grid_.neighbour(sc.x[0], sc.x[1], sc.x[2], L::c[q][0], L::c[q][1], L::c[q][2]);
-    if (!fluid_now(xc)) continue;
-    MovingLink k;
-    const auto xs = grid_.coords(xc);
-    const int kx[3] = {xs[0], xs[1], xs[2]};
-    k.q = std::uint8_t(q);
-    k.particle = sc.particle;
-    k.solid = solid;
-    const CellIndex second = grid_.neighbour(xs[0], xs[1], xs[2], L::c[q][0], L::c[q][1], L::c[q][2]);
-    k.has_second = fluid_now(second);
-    link_motion(k, p);
-    const int o = L::opp[q];
-    const int x2[3] = {grid_.step(kx[0], L::c[q][0], 0), grid_.step(kx[1], L::c[q][1], 1),
-                       grid_.step(kx[2], L::c[q][2], 2)};
-    for (int odd = 0; odd < 2; ++odd) {
-      k.slot[odd][0] = post(kx, o, odd);
-      k.slot[odd][1] = post(kx, q, odd);
-      k.slot[odd][2] = post(x2, o, odd);
-      k.slot[odd][3] = pre(kx, q, !odd);
-    }
-    new_links_.push_back(k);
-  }
+void MovingBoundary<L, T>::update_delta(std::size_t s) {
+  if (scheme_ != ParticleScheme::InterpolatedBounceBack) return;
+  if (mot_[s].x == delta_x_[s] && radius_[s] == delta_r_[s]) return;
+  const Slice& sl = ls_[s];
+  for (std::int32_t l = sl.first; l < sl.first + sl.count; ++l)
+    links_[std::size_t(l)].delta = link_delta(links_[std::size_t(l)], mot_[s], radius_[s]);
+  delta_x_[s] = mot_[s].x;
+  delta_r_[s] = radius_[s];
 }
 
-// Links from the fluid cells around every solid cell, in solid-cell order then direction order
-// (so grouped by particle). Incremental: a clean particle's links keep their nodes and slots and
-// only move with it (link_motion, the same arithmetic as a new link: results do not depend on
-// which particles were rebuilt); a dirty one's are built anew. Cost: a copy per link plus the
-// new links of the dirty particles.
+// Links from the fluid cells around every solid cell of particle s, in cell order then direction
+// order, and its exposed cells (a neighbour that is a static solid or off the lattice: what it
+// feeds the cell is not a particle's, so the cell is reset every step; what fluid neighbours feed
+// it the links replace).
 template <class L, class T>
-void MovingBoundary<L, T>::build_links(const ParticleSet& p, bool incremental) {
-  const std::size_t np = cfirst_.size();
+void MovingBoundary<L, T>::build_links(std::size_t s, const ParticleSet&) {
+  const int n[3] = {grid_.nx, grid_.ny, grid_.nz};
+  const Slice& cl = cs_[s];
   new_links_.clear();
-  nlfirst_.resize(np);
-  nlcount_.resize(np);
-  for (std::size_t s = 0; s < np; ++s) {
-    nlfirst_[s] = std::int32_t(new_links_.size());
-    if (incremental && !dirty_[s]) {
-      // Same cells in the same order: the solid index moves by the shift of the particle's range
-      // (nfirst_ holds the previous ranges after the swap in set_particles()).
-      const std::int32_t shift = cfirst_[s] - nfirst_[s];
-      for (std::int32_t l = lfirst_[s]; l < lfirst_[s] + lcount_[s]; ++l) {
-        new_links_.push_back(links_[std::size_t(l)]);
-        MovingLink& k = new_links_.back();
-        k.solid += shift;
-        link_motion(k, p);
-      }
-    } else {
-      for (std::int32_t i = cfirst_[s]; i < cfirst_[s] + ccount_[s]; ++i) add_links(i, p);
+  new_eoff_.clear();
+  for (std::int32_t i = 0; i < cl.count; ++i) {
+    const SolidCell& sc = cells_[std::size_t(cl.first + i)];
+    int x[3] = {0, 0, 0};  // the wrapped coordinates (a solid cell lies on the lattice)
+    for (int a = 0; a < L::D; ++a) x[a] = wrap_axis(sc.xu[a], n[a], grid_.periodic[a]);
+    bool exposed = false;
+    for (int q = 1; q < Q; ++q) {
+      int xs[3];
+      for (int a = 0; a < 3; ++a) xs[a] = grid_.step(x[a], L::c[q][a], a);
+      const CellIndex xc = grid_.index(xs[0], xs[1], xs[2]);
+      if (owner_[std::size_t(xc)] < 0 && !fluid_[std::size_t(xc)]) exposed = true;  // static solid or off the lattice
+      if (!fluid_now(xc)) continue;
+      MovingLink k;
+      k.node = xc;
+      for (int a = 0; a < 3; ++a) k.xu[a] = sc.xu[a];
+      k.q = std::uint8_t(q);
+      k.has_second = fluid_now(grid_.neighbour(xs[0], xs[1], xs[2], L::c[q][0], L::c[q][1], L::c[q][2]));
+      k.edge = false;
+      for (int a = 0; a < L::D; ++a) k.edge = k.edge || (grid_.periodic[a] && (xs[a] == 0 || xs[a] == n[a] - 1));
+      k.delta = link_delta(k, mot_[s], radius_[s]);
+      new_links_.push_back(k);
     }
-    nlcount_[s] = std::int32_t(new_links_.size()) - nlfirst_[s];
+    if (exposed) new_eoff_.push_back(i);
   }
-  links_.swap(new_links_);
-  lfirst_.swap(nlfirst_);
-  lcount_.swap(nlcount_);
-  links_valid_ = true;
-  link_force_.assign(3 * links_.size(), 0.0);
+  // Exposed cells: offsets into the cell slice, stored in eoff_ alongside it.
+  ecount_[s] = std::int32_t(new_eoff_.size());
+  std::copy(new_eoff_.begin(), new_eoff_.end(), eoff_.begin() + cl.first);
+  Slice& ll = ls_[s];
+  nlinks_ += new_links_.size();
+  nlinks_ -= std::size_t(ll.count);
+  place(links_, ll, std::int32_t(new_links_.size()), ls_, links_spare_, nullptr);
+  std::copy(new_links_.begin(), new_links_.end(), links_.begin() + ll.first);
+  ll.count = std::int32_t(new_links_.size());
+  delta_x_[s] = mot_[s].x;
+  delta_r_[s] = radius_[s];
+}
+
+// f^eq(1, u_s) into the slots a solid cell reads in the next step, u_s = v + omega x arm.
+template <class L, class T>
+void MovingBoundary<L, T>::reset_cell(T* f, CellIndex c, bool edge, const Vec3& arm, const Motion& m, bool next) const {
+  const Vec3 us = m.v + m.w.cross(arm);
+  const T u[3] = {T(us[0]), T(us[1]), T(L::D == 3 ? us[2] : 0.0)};
+  T geq[Q];
+  equilibrium<L, T>(T(1), u, geq, incompressible_);
+  if (edge) {
+    const auto x = grid_.coords(c);
+    const int xi[3] = {x[0], x[1], x[2]};
+    for (int q = 0; q < Q; ++q) f[pre(xi, q, next)] = geq[q];
+  } else {
+    for (int q = 0; q < Q; ++q) f[c + pre_off_[next][q]] = geq[q];
+  }
 }
 
 template <class L, class T>
@@ -371,59 +543,122 @@ void MovingBoundary<L, T>::apply(T* f, bool odd) {
   const bool next = !odd;
   const WallScheme ws =
       scheme_ == ParticleScheme::InterpolatedBounceBack ? WallScheme::Bouzidi : WallScheme::HalfwayBounceBack;
-  const std::int64_t nl = std::int64_t(links_.size());
+  const std::int64_t np = std::int64_t(np_);
   // Links first: they read the post-collision populations of step t, some of which lie in slots
-  // that the solid cells' reset below overwrites. Each link writes a slot its fluid cell owns.
+  // that the solid cells' reset below overwrites. Each link writes a slot its fluid cell owns; each
+  // particle sums its own links' loads (in link order: the same result on any thread count).
   // Parallel only above 8192 items (a link or a reset costs about a cell update): on a loaded
   // machine a parallel region per step made a 24^3 case with 3000 links 35 times slower.
-#pragma omp parallel for schedule(static) if (nl > 8192)
-  for (std::int64_t l = 0; l < nl; ++l) {
-    const MovingLink& k = links_[std::size_t(l)];
-    const int q = k.q, o = L::opp[q];
-    const CellIndex* sl = k.slot[odd];
-    const T A = f[sl[0]];  // g*_o(x, t), sent into the wall
-    T B = 0, C = 0;
-    if (ws == WallScheme::Bouzidi && k.has_second) {
-      B = f[sl[1]];  // g*_q(x, t)
-      C = f[sl[2]];  // g*_o(x + c_q, t)
+#pragma omp parallel for schedule(static) if (nlinks_ > 8192)
+  for (std::int64_t s = 0; s < np; ++s) {
+    update_delta(std::size_t(s));
+    const Motion& m = mot_[std::size_t(s)];
+    const bool at_rest = m.v == Vec3::Zero() && m.w == Vec3::Zero();
+    const Slice& sl = ls_[std::size_t(s)];
+    Vec3 F = Vec3::Zero(), M = Vec3::Zero();
+    const std::int32_t end = sl.first + sl.count;
+    for (std::int32_t l = sl.first; l < end; ++l) {
+      // The populations are far from cache (the sweep streamed the lattice since): fetch the two
+      // slots of a link some links ahead (they are the solid cell's and the fluid node's).
+      constexpr std::int32_t kAhead = 12;
+      if (l + kAhead < end) {
+        const MovingLink& a = links_[std::size_t(l + kAhead)];
+        if (!a.edge) {
+          __builtin_prefetch(f + a.node + post_off_[odd][L::opp[a.q]], 1);
+          __builtin_prefetch(f + a.node + pre_off_[next][a.q], 1);
+          if (ws == WallScheme::Bouzidi && a.has_second) {
+            __builtin_prefetch(f + a.node + post_off_[odd][a.q], 0);
+            __builtin_prefetch(f + a.node + cq_off_[a.q] + post_off_[odd][L::opp[a.q]], 0);
+          }
+        }
+      }
+      const MovingLink& k = links_[std::size_t(l)];
+      const int q = k.q, o = L::opp[q];
+      CellIndex sa, sb, sc, sd;
+      if (!k.edge) {
+        sa = k.node + post_off_[odd][o];
+        sb = k.node + post_off_[odd][q];
+        sc = k.node + cq_off_[q] + post_off_[odd][o];
+        sd = k.node + pre_off_[next][q];
+      } else {
+        const auto xs = grid_.coords(k.node);
+        const int kx[3] = {xs[0], xs[1], xs[2]};
+        const int x2[3] = {grid_.step(kx[0], L::c[q][0], 0), grid_.step(kx[1], L::c[q][1], 1),
+                           grid_.step(kx[2], L::c[q][2], 2)};
+        sa = post(kx, o, odd);
+        sb = post(kx, q, odd);
+        sc = post(x2, o, odd);
+        sd = pre(kx, q, next);
+      }
+      const T A = f[sa];  // g*_o(x, t), sent into the wall
+      T B = 0, C = 0;
+      if (ws == WallScheme::Bouzidi && k.has_second) {
+        B = f[sb];  // g*_q(x, t)
+        C = f[sc];  // g*_o(x + c_q, t)
+      }
+      // The wall point x_w - X and its velocity u_w = v + omega x (x_w - X).
+      const Vec3 c(L::c[q][0], L::c[q][1], L::D == 3 ? L::c[q][2] : 0);
+      const Vec3 ay(k.xu[0] - m.x[0], k.xu[1] - m.x[1], L::D == 3 ? k.xu[2] - m.x[2] : 0.0);
+      const Vec3 ax = ay + c;
+      const Vec3 arm = ax - k.delta * c;
+      T mw = 0, geq = 0;  // a particle at rest: no moving-wall term, g^eq_o(1, 0) = 0
+      if (!at_rest) {
+        const Vec3 uw = m.v + m.w.cross(arm);
+        const T cu = T(L::c[q][0]) * T(uw[0]) + T(L::c[q][1]) * T(uw[1]) + T(L::c[q][2]) * T(L::D == 3 ? uw[2] : 0.0);
+        mw = T(6 * L::w[q]) * cu;
+        const Vec3 us = m.v + m.w.cross(ay);
+        const T u0 = T(us[0]), u1 = T(us[1]), u2 = T(L::D == 3 ? us[2] : 0.0);
+        const T cuo = L::c[o][0] * u0 + L::c[o][1] * u1 + L::c[o][2] * u2;
+        geq = T(L::w[o]) * (T(0) + T(1) * (T(3) * cuo + T(4.5) * cuo * cuo - T(1.5) * (u0 * u0 + u1 * u1 + u2 * u2)));
+      }
+      const T g = reflect<T>(ws, T(k.delta), k.has_second, A, B, C, mw);
+      f[sd] = g;
+      // Slot A is also what the solid cell y = x - c_q reads from x next step (AA pattern): it
+      // gets g^eq_o(1, u_s(y)) instead of the fluid's population (equilibrium(), one direction).
+      f[sa] = geq;
+      const double ag = double(A) + double(g);
+      const Vec3 Fl(L::c[o][0] * ag, L::c[o][1] * ag, L::D == 3 ? L::c[o][2] * ag : 0.0);
+      F += Fl;
+      M += arm.cross(Fl);
     }
-    const T g = reflect<T>(ws, T(k.delta), k.has_second, A, B, C, k.mw);
-    f[sl[3]] = g;
-    for (int a = 0; a < 3; ++a) link_force_[3 * std::size_t(l) + std::size_t(a)] = double(L::c[o][a]) * (double(A) + double(g));
+    lforce_[std::size_t(s)] = F;
+    ltorque_[std::size_t(s)] = M;
   }
-  // Solid cells: f^eq(1, u_s) in the slots they read next step (finite values, sampled u = u_s).
-  const std::int64_t nc = std::int64_t(cells_.size());
-#pragma omp parallel for schedule(static) if (nc > 8192)
-  for (std::int64_t i = 0; i < nc; ++i) {
-    const SolidCell& sc = cells_[std::size_t(i)];
-    T geq[Q];
-    equilibrium<L, T>(T(1), sc.us, geq, incompressible_);
-    if (sc.edge) {
-      for (int q = 0; q < Q; ++q) f[pre(sc.x, q, next)] = geq[q];
-    } else {
-      for (int q = 0; q < Q; ++q) f[sc.cell + pre_off_[next][q]] = geq[q];
+  // Exposed solid cells: f^eq(1, u_s) in all the slots they read next step.
+#pragma omp parallel for schedule(static) if (ncells_ > 8192)
+  for (std::int64_t s = 0; s < np; ++s) {
+    const Slice& sl = cs_[std::size_t(s)];
+    const Motion& m = mot_[std::size_t(s)];
+    const std::int32_t ne = reset_all_ ? sl.count : ecount_[std::size_t(s)];
+    for (std::int32_t e = 0; e < ne; ++e) {
+      const SolidCell& sc = cells_[std::size_t(sl.first + (reset_all_ ? e : eoff_[std::size_t(sl.first + e)]))];
+      const Vec3 arm(sc.xu[0] - m.x[0], sc.xu[1] - m.x[1], L::D == 3 ? sc.xu[2] - m.x[2] : 0.0);
+      reset_cell(f, sc.cell, sc.edge, arm, m, next);
     }
   }
+  // Cells covered since the last step: once (they held fluid).
+  for (const CellIndex c : pending_) {
+    const std::int32_t o = owner_[std::size_t(c)];
+    if (o >= 0) reset_cell(f, c, on_edge(c), arm_of(c, std::size_t(o), mot_), mot_[std::size_t(o)], next);
+  }
+  pending_.clear();
+  applied_ = true;
 }
 
 template <class L, class T>
 void MovingBoundary<L, T>::reduce() {
   // The change of the set is counted once, with the first step after it.
-  force_ = impulse_;
-  torque_ = impulse_torque_;
+  for (std::size_t s = 0; s < force_.size(); ++s) {
+    force_[s] = impulse_[s];
+    torque_[s] = impulse_torque_[s];
+    if (applied_) {
+      force_[s] += lforce_[s];
+      torque_[s] += ltorque_[s];
+    }
+  }
   std::fill(impulse_.begin(), impulse_.end(), Vec3::Zero());
   std::fill(impulse_torque_.begin(), impulse_torque_.end(), Vec3::Zero());
-  for (std::size_t l = 0; l < links_.size(); ++l) {
-    const MovingLink& k = links_[l];
-    const Vec3 F(link_force_[3 * l], link_force_[3 * l + 1], link_force_[3 * l + 2]);
-    // The wall point x_w - X as link_motion() computed it.
-    const int q = k.q;
-    const Vec3 c(L::c[q][0], L::c[q][1], L::D == 3 ? L::c[q][2] : 0);
-    const Vec3 ax = cells_[std::size_t(k.solid)].arm + c;
-    const Vec3 arm = ax - k.delta * c;
-    force_[std::size_t(k.particle)] += F;
-    torque_[std::size_t(k.particle)] += arm.cross(F);
-  }
+  applied_ = false;
 }
 
 template class MovingBoundary<D2Q9, double>;

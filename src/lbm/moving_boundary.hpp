@@ -32,17 +32,28 @@
 //
 // Cost and the bulk kernel: nothing changes in the bulk sweep. Solid cells stay in their bulk span
 // and are streamed and collided like fluid (garbage in, garbage out), which keeps the kernel
-// branch-free; after the sweeps of a step a post-pass (cost proportional to links) writes each link's
-// reflected population into the slot its fluid cell reads in the next step, and then resets every
-// solid cell to f^eq(1, u_s) (cost proportional to covered cells), so solid cells hold finite values
-// and their sampled moments are the particle's velocity. This works because in the AA pattern
-// every slot a fluid cell reads at t+1 is written by the post-pass after every cell of step t has
-// run. set_particles() visits the rows of each particle's bounding box that it can cover and the
-// cells of the previous set: the cost is proportional to the covered cells, never to the lattice.
-// Links are rebuilt only for the particles whose solid cells changed or lie within two lattice
-// steps of a cell that changed; the others keep their nodes and slots and only move (new wall
-// fraction and velocity), with the same arithmetic, so the result does not depend on which
-// particles were rebuilt (benchmarks/coupled checks the populations against the full rebuild).
+// branch-free; after the sweeps of a step a post-pass writes each link's reflected population into
+// the slot its fluid cell reads in the next step and replaces the population the fluid cell sent
+// into the wall, which the solid cell reads next, by g^eq_o(1, u_s) (cost proportional to links);
+// the cells just covered, and those next to a static solid or the lattice's edge, get f^eq(1, u_s)
+// in every slot (with a body force, every solid cell: set_reset_all()). The other inputs of a
+// solid cell come from solid cells, near f^eq(1, u_s)
+// (exactly f^eq(1, 0) for particles at rest), so the solid cells hold finite values near the
+// particle's velocity without a reset of every covered cell; no fluid cell ever reads a solid cell
+// (the links overwrite those slots). This works because in the AA pattern every slot a fluid cell
+// reads at t+1 is written by the post-pass after every cell of step t has run.
+//
+// Incremental set (the particles move ~0.002 cells per step): each particle keeps its solid cells
+// and its links in its own slice of two arrays (with room to grow). set_particles() rescans a
+// particle only when it has moved more than `margin` since its last scan (margin: the smallest
+// distance of a lattice point from its surface then, so no cell can have crossed it), its radius
+// changed, it overlaps another particle, or a particle before it took one of its cells; a rescan
+// visits the rows of its bounding box (cost proportional to its covered cells, never to the
+// lattice). Links (and the exposed cells) are rebuilt only for the particles whose cells changed
+// or lie within two lattice steps of a cell that changed; the wall velocity is computed at use from
+// (v, omega), the Bouzidi fraction when the particle moved. Every cached value is the exact function
+// of the current set, and each particle's cells and links are in scan order, so the result does not
+// depend on which particles were rescanned (nor on a resume, which rebuilds everything).
 //
 // Resume: the solid cells of the last step are state (the refill of the next change depends on
 // them). A resumed run calls Solver::restore() and then Solver::restore_particles() with the set
@@ -91,66 +102,90 @@ class MovingBoundary {
   // then the solid cells' reset. Then reduce() sums the per-particle loads in a fixed order.
   void apply(T* f, bool odd);
   void reduce();
+  // With a body force the solid cells' own collision drives them: every solid cell is then reset
+  // each step (as the links alone keep them near f^eq(1, u_s) only without one). Set by the solver.
+  void set_reset_all(bool all) { reset_all_ = all; }
 
-  bool active() const { return !cells_.empty(); }
+  bool active() const { return ncells_ > 0; }
   bool solid(CellIndex cell) const { return !owner_.empty() && owner_[std::size_t(cell)] >= 0; }
   const std::vector<Vec3>& forces() const { return force_; }
   const std::vector<Vec3>& torques() const { return torque_; }
   const MovingBoundaryStats& stats() const { return stats_; }
-  std::size_t num_cells() const { return cells_.size(); }
-  std::size_t num_links() const { return links_.size(); }
+  std::size_t num_cells() const { return ncells_; }
+  std::size_t num_links() const { return nlinks_; }
 
  private:
+  // A solid cell: lattice index and unwrapped coordinates (arm = xu - X exactly as scanned).
   struct SolidCell {
     CellIndex cell;
-    int x[3];
-    std::int32_t particle;
-    std::uint64_t id;  // the particle's id (its index if the set has no ids), for refill attribution
-    Vec3 arm;          // cell centre minus particle centre (unwrapped)
-    T us[3];           // particle velocity at the cell centre
-    bool edge;         // on a periodic lattice edge: neighbours wrap (slow path)
+    std::int32_t xu[3];
+    bool edge;  // on a periodic lattice edge: neighbours wrap (slow path)
   };
-  // 96 bytes (double): apply(), the links' update and reduce() each stream the whole array, so
-  // what can be recomputed from the solid cell is not stored (the fluid node, the wall point).
+  // A link: fluid node x (solid cell + c_q) and direction q; slots from fixed offsets unless x lies on
+  // a periodic lattice edge (edge: wrapped neighbours, slow path). 32 bytes (double).
   struct MovingLink {
-    std::uint8_t q;    // incoming direction: the fluid node x = solid cell + c_q
-    bool has_second;   // x + c_q is fluid
-    std::int32_t particle;
-    std::int32_t solid;  // its solid cell (index into cells_)
-    double delta;      // wall fraction along the link from x (x_w = x - delta c_q)
-    T mw;              // moving-wall term 6 w_q c_q . u_w, u_w the wall velocity at x_w
-    // Slots per step parity: g*_o(x), g*_q(x), g*_o(x + c_q) of this step, g_q(x) of the next.
-    CellIndex slot[2][4];
+    CellIndex node;
+    std::int32_t xu[3];  // the solid cell's unwrapped coordinates
+    std::uint8_t q;
+    bool has_second;     // x + c_q is fluid
+    bool edge;
+    double delta;        // wall fraction along the link from x (x_w = x - delta c_q)
+  };
+  struct Slice {  // a particle's range in cells_ / links_: [first, first + count), room for cap
+    std::int32_t first = 0, count = 0, cap = 0;
+  };
+  struct Motion {
+    Vec3 x, v, w;  // centre, velocity, angular velocity (2D: z only)
   };
   CellIndex pre(const int* x, int q, bool odd) const;   // slot g_q is read from in a step of parity odd
   CellIndex post(const int* x, int q, bool odd) const;  // slot g*_q is written to
   bool fluid_now(CellIndex c) const { return fluid_[std::size_t(c)] && owner_[std::size_t(c)] < 0; }
-  void build_links(const ParticleSet& p, bool incremental);
-  void add_links(std::int32_t solid, const ParticleSet& p);  // the links of one solid cell
-  void link_motion(MovingLink& k, const ParticleSet& p) const;  // delta, arm, u_w of a link
+  bool on_edge(CellIndex c) const;  // on a periodic lattice edge
+  Vec3 arm_of(CellIndex c, std::size_t s, const std::vector<Motion>& m) const;  // minimum image
+  void release_all();
+  // Scans particle s into scan_ (cells inside it, static fluid), sets its margin; false if unchanged.
+  void scan(std::size_t s, const ParticleSet& p);
+  void claim(std::size_t s);  // ownership of scan_ for particle s; updates its slice when it changed
+  void build_links(std::size_t s, const ParticleSet& p);  // links and exposed cells of particle s
+  void update_delta(std::size_t s);  // in apply(): per particle, in parallel
+  double link_delta(const MovingLink& k, const Motion& m, double r) const;
   void mark_dirty(CellIndex changed);  // particles whose links may see a changed cell
+  template <class V>
+  void place(V& arr, Slice& sl, std::int32_t need, std::vector<Slice>& all, V& spare, std::vector<std::int32_t>* par);
+  void reset_cell(T* f, CellIndex c, bool edge, const Vec3& arm, const Motion& m, bool next) const;
 
   Grid grid_;
   ParticleScheme scheme_;
   bool incompressible_;
-  std::int64_t pre_off_[2][Q];        // pre() as an offset from the cell index where nothing wraps
+  std::int64_t pre_off_[2][Q], post_off_[2][Q], cq_off_[Q];
   std::vector<std::uint8_t> fluid_;   // per padded cell: static fluid
-  std::vector<std::int32_t> owner_;   // per padded cell: index into cells_ of the current set, -1 if fluid
-  std::vector<std::int32_t> next_;    // per padded cell: scratch for the new set
-  std::vector<SolidCell> cells_, new_cells_;
-  std::vector<MovingLink> links_, new_links_;
-  // Incremental links: per particle its range in cells_ (cfirst_/ccount_; nfirst_/ncount_ for
-  // new_cells_) and in links_; a particle is dirty when its cells or a cell within two lattice
-  // steps of them changed, and only dirty particles rebuild their links.
-  std::vector<std::int32_t> cfirst_, ccount_, nfirst_, ncount_, lfirst_, lcount_, nlfirst_, nlcount_;
-  std::vector<std::uint8_t> dirty_;
-  // The cell indices of cells_ / new_cells_ alone (the passes over every solid cell read only
-  // these), and the cells that turned solid (in new_cells_) and fluid (in cells_) in this set.
-  std::vector<CellIndex> cell_, new_cell_;
-  std::vector<std::int32_t> covered_, uncovered_;
-  bool links_valid_ = false;          // links_ belong to cells_ (false after set_fluid_mask())
-  std::vector<double> link_force_;    // 3 per link
+  // Per padded cell: the particle that owns it (-1: fluid; -2 - s: released by s in this set).
+  std::vector<std::int32_t> owner_;
+  std::size_t np_ = 0;
+  std::vector<Motion> mot_, prev_mot_;
+  std::vector<std::uint64_t> pid_, prev_pid_;
+  std::vector<double> radius_;
+  // Per particle: last scan (position, radius, margin), flags, slices.
+  std::vector<Vec3> scan_x_;
+  std::vector<double> scan_r_, margin_;
+  std::vector<std::uint8_t> rescan_, contested_, dirty_;
+  std::vector<Vec3> delta_x_;  // position and radius of the links' Bouzidi fractions
+  std::vector<double> delta_r_;
+  std::vector<Slice> cs_, ls_;
+  std::vector<std::int32_t> ecount_;          // exposed cells of the particle (offsets in eoff_)
+  std::vector<SolidCell> cells_, cells_spare_;
+  std::vector<std::int32_t> eoff_, eoff_spare_;  // parallel to cells_: offsets of exposed cells in the slice
+  std::vector<MovingLink> links_, links_spare_;
+  std::vector<SolidCell> scan_;               // scratch: one particle's scan
+  std::vector<MovingLink> new_links_;         // scratch: one particle's links
+  std::vector<std::int32_t> new_eoff_;
+  std::vector<CellIndex> covered_, released_, pending_;  // pending_: covered cells to reset once
+  std::size_t ncells_ = 0, nlinks_ = 0;
+  bool links_valid_ = false;          // the slices belong to owner_ (false after set_fluid_mask())
+  bool applied_ = false;
+  bool reset_all_ = false;
   std::vector<Vec3> impulse_, impulse_torque_;  // per particle, from covering and refill
+  std::vector<Vec3> lforce_, ltorque_;          // per particle, from the links of the last apply()
   std::vector<Vec3> force_, torque_;
   MovingBoundaryStats stats_;
 };

@@ -431,6 +431,7 @@ void Solver<L, T>::moving_particles(const ParticleSet& p, bool bookkeeping) {
     mb_->set_fluid_mask(std::move(fluid));
     psm_kinds_stale_ = false;
   }
+  mb_->set_reset_all(settings_.body_force.squaredNorm() > 0);
   mb_->set_particles(p, f_.data(), (time_ & 1) != 0, bookkeeping);
 }
 
