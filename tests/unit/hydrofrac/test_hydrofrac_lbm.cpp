@@ -16,40 +16,15 @@
 #include <vector>
 
 #include "../program_runner.hpp"
+#include "hydrofrac_scenario.hpp"
 #include "io/csv.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-// Coal-matrix micro-parameters of examples/ucs_2d.toml (the Brazilian tests' material).
-std::string material(double strength) {
-  return fmt::format(R"(
-[dem]
-dim = 2
-bond_law = "parallel"
-[dem.group.matrix]
-density = 1390
-[dem.contact.matrix-matrix]
-emod = 2.09e9
-kratio = 14.65
-friction = 0.4
-[dem.bond.matrix-matrix]
-emod = 2.09e9
-kratio = 14.65
-tensile_strength = {0}
-cohesion = {0}
-friction_angle = 4.0
-)",
-                     strength);
-}
-
-const std::string kOutput = R"(
-[output]
-vtk = false
-plots = false
-progress_interval = 0
-)";
+const std::string& kOutput = ff::test::kQuietOutput;
+std::string material(double strength) { return ff::test::coal_matrix_2d(strength); }
 
 // A 24 mm block, disks 0.4-0.6 mm (~560), a 2.5 mm borehole, sigma_H = 4 MPa along x.
 const std::string kBlock = "driver = \"hydrofrac\"\n" + material(17.4e6) + R"(

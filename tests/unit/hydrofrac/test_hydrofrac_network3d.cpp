@@ -13,18 +13,14 @@
 #include <vector>
 
 #include "../program_runner.hpp"
+#include "hydrofrac_scenario.hpp"
 #include "io/csv.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-const std::string kOutput = R"(
-[output]
-vtk = false
-plots = false
-progress_interval = 0
-)";
+const std::string& kOutput = ff::test::kQuietOutput;
 
 struct Scratch : ff::test::TestScratch {
   Scratch() : TestScratch("hydrofrac_network") {}
