@@ -185,20 +185,7 @@ void DemPorenetCoupling::carry_vapour(const porenet::Network2D& old_net, std::sp
 }
 
 void DemPorenetCoupling::add_forces(dem::DemSystem& sys) {
-  const auto p = flow_->pressure();
-  for (std::size_t i = 0; i < pg_.size(); ++i) pg_[i] = p[i] - prm_.ambient_pressure;
-  std::fill(fx_.begin(), fx_.end(), 0.0);
-  std::fill(fy_.begin(), fy_.end(), 0.0);
-  const porenet::Particles2D parts{x_, y_, r_, {}};
-  porenet::add_pressure_forces(*net_, parts, pg_, fx_, fy_);
-  if (prm_.shear_forces) porenet::add_shear_forces(*net_, parts, pg_, fx_, fy_);
-  // porenet applies both over the seed's height 2 r_j; every term of particle k carries it once.
-  if (prm_.force_height == ForceHeight::Thickness)
-    for (std::size_t k = 0; k < fx_.size(); ++k) {
-      const Real scale = prm_.network.thickness / (2 * r_[k]);
-      fx_[k] *= scale;
-      fy_[k] *= scale;
-    }
+  compute_fluid_forces(-std::numeric_limits<Real>::infinity());  // no floor: the pores' own pressures
   for (std::size_t k = 0; k < fx_.size(); ++k) {
     sys.particles.ext_force[k].x() += fx_[k];
     sys.particles.ext_force[k].y() += fy_[k];
@@ -208,18 +195,7 @@ void DemPorenetCoupling::add_forces(dem::DemSystem& sys) {
 void DemPorenetCoupling::step(dem::DemSystem& sys) {
   sys.update_neighbors();
   sys.compute_forces();
-  gather_positions(sys);
-  Real dmax2 = 0;
-  for (std::size_t k = 0; k < x_.size(); ++k)
-    dmax2 = std::max(dmax2, (x_[k] - ref_x_[k]) * (x_[k] - ref_x_[k]) + (y_[k] - ref_y_[k]) * (y_[k] - ref_y_[k]));
-  stats_.max_displacement = std::sqrt(dmax2);
-  fill_pair_state(sys);
-  if (stats_.max_displacement > prm_.retriangulation_tolerance * mean_radius_) {
-    retriangulate(sys);
-    stats_.max_displacement = 0;
-  } else {
-    porenet::update_network_2d(*net_, porenet::Particles2D{x_, y_, r_, {}}, pairs_);
-  }
+  (void)sync(sys);
   // Flow sub-steps inside the DEM step (the first one sees V^{n+1}: the compaction source). When the
   // stable step is below the DEM step, it is evaluated again before each sub-step: cavitation and
   // condensation reset pores between sub-steps, and a pore whose pressure jumped (a condensed bubble)
@@ -407,7 +383,6 @@ void DemPorenetCoupling::load(CheckpointReader& r, dem::DemSystem& sys, const Po
   stats_ = r.get_value<CouplingStats>("porenet.stats");
 }
 
-
 bool DemPorenetCoupling::sync(const dem::DemSystem& sys) {
   gather_positions(sys);
   Real dmax2 = 0;
@@ -432,6 +407,7 @@ void DemPorenetCoupling::compute_fluid_forces(Real p_floor) {
   const porenet::Particles2D parts{x_, y_, r_, {}};
   porenet::add_pressure_forces(*net_, parts, pg_, fx_, fy_);
   if (prm_.shear_forces) porenet::add_shear_forces(*net_, parts, pg_, fx_, fy_);
+  // porenet applies both over the seed's height 2 r_j; every term of particle k carries it once.
   if (prm_.force_height == ForceHeight::Thickness)
     for (std::size_t k = 0; k < fx_.size(); ++k) {
       const Real scale = prm_.network.thickness / (2 * r_[k]);
