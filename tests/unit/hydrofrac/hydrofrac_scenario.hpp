@@ -1,9 +1,14 @@
-// Scenario text shared by the hydrofrac tests: the coal-matrix material of examples/ucs_2d.toml
-// (the Brazilian tests' material) and an output section without VTK, plots or progress.
+// Shared by the hydrofrac tests: the coal-matrix material of examples/ucs_2d.toml (the Brazilian
+// tests' material), an output section without VTK, plots or progress, and where the first cracks lie.
 #pragma once
 #include <fmt/format.h>
 
+#include <cmath>
+#include <filesystem>
 #include <string>
+#include <vector>
+
+#include "io/csv.hpp"
 
 namespace ff::test {
 
@@ -35,5 +40,16 @@ vtk = false
 plots = false
 progress_interval = 0
 )";
+
+// Distances from the hole's axis of the first `n` cracks of cracks.csv (x_m, y_m columns).
+inline std::vector<double> first_crack_distances(const std::filesystem::path& csv, double cx, double cy,
+                                                 std::size_t n) {
+  const auto t = ff::read_csv(csv);
+  const auto& x = t.column("x_m");
+  const auto& y = t.column("y_m");
+  std::vector<double> d;
+  for (std::size_t r = 0; r < t.rows() && d.size() < n; ++r) d.push_back(std::hypot(x[r] - cx, y[r] - cy));
+  return d;
+}
 
 }  // namespace ff::test

@@ -77,16 +77,6 @@ std::string slurp(const fs::path& p) {
   return ss.str();
 }
 
-// Distances from the hole's axis of the first `n` cracks of cracks.csv (x_m, y_m columns).
-std::vector<double> first_crack_distances(const fs::path& csv, double cx, double cy, std::size_t n) {
-  const auto t = ff::read_csv(csv);
-  const auto& x = t.column("x_m");
-  const auto& y = t.column("y_m");
-  std::vector<double> d;
-  for (std::size_t r = 0; r < t.rows() && d.size() < n; ++r) d.push_back(std::hypot(x[r] - cx, y[r] - cy));
-  return d;
-}
-
 }  // namespace
 
 // 1. Kirsch through the network. A 30 mm block of unbreakable bonded disks (~1300), a = 4 mm,
@@ -181,7 +171,7 @@ TEST(HydrofracNetwork, TwoDimensionalBlockBreaksFromTheHole) {
   // Same rock, same in-situ stresses: breakdown within a factor of two of the sleeve's, not above it by more than 10%.
   EXPECT_LT(pn, 1.1 * ps);
   EXPECT_GT(pn, 0.5 * ps);
-  const auto d = first_crack_distances(s / "network" / "cracks.csv", 12e-3, 12e-3, 3);
+  const auto d = ff::test::first_crack_distances(s / "network" / "cracks.csv", 12e-3, 12e-3, 3);
   ASSERT_EQ(d.size(), 3u);
   const double a = j["borehole"]["effective_radius_m"].get<double>();
   for (double x : d) EXPECT_LT(x, a + 4 * 0.6e-3) << "a first crack away from the hole";

@@ -39,17 +39,6 @@ nlohmann::json run_scenario(const fs::path& file, const fs::path& out, const std
   return ff::test::read_json(out / "summary.json");
 }
 
-
-// Distances from the hole's axis of the first `n` cracks of cracks.csv (x_m, y_m columns).
-std::vector<double> first_crack_distances(const fs::path& csv, double cx, double cy, std::size_t n) {
-  const auto t = ff::read_csv(csv);
-  const auto& x = t.column("x_m");
-  const auto& y = t.column("y_m");
-  std::vector<double> d;
-  for (std::size_t r = 0; r < t.rows() && d.size() < n; ++r) d.push_back(std::hypot(x[r] - cx, y[r] - cy));
-  return d;
-}
-
 }  // namespace
 
 // examples/hydrofrac_3d.toml's rock in a 12 x 12 x 4 mm block (~550 spheres, sigma_H = 6, sigma_h = 3,
@@ -74,7 +63,7 @@ TEST(HydrofracNetwork, ThreeDimensionalBlockBreaksFromTheHole) {
   EXPECT_GT(j["fracture"]["connected_cracks"].get<long>(), 5);
   ASSERT_GE(ff::read_csv(s / "network" / "cracks.csv").rows(), 3u);
   const double a = j["borehole"]["effective_radius_m"].get<double>();
-  const auto d = first_crack_distances(s / "network" / "cracks.csv", 6e-3, 6e-3, 3);
+  const auto d = ff::test::first_crack_distances(s / "network" / "cracks.csv", 6e-3, 6e-3, 3);
   for (double x : d) EXPECT_LT(x, a + 4 * 0.6e-3) << "a first crack away from the hole";
 }
 
