@@ -51,13 +51,17 @@ void declare(ParamTable& t) {
            "pores held at the ambient pressure: sides (hull pores at the free lateral faces; platens impermeable) or "
            "closed (undrained sample)")
       .one_of({"sides", "closed"});
-  t.real("fluid.aperture_h0", 1e-6, "m", "2D: Eq. B1 contact/bond channel aperture at zero normal stress").positive();
-  t.real("fluid.aperture_hinf", 1e-7, "m", "2D: Eq. B1 aperture at infinite normal stress").positive();
-  t.real("fluid.aperture_gamma", 0.01, "-", "2D: Eq. B2 reduction factor of pore-to-pore channel apertures").positive();
+  t.real("fluid.aperture_h0", 1e-6, "m", "2D: Eq. B1 contact/bond channel aperture at zero normal stress").positive()
+      .fallback();
+  t.real("fluid.aperture_hinf", 1e-7, "m", "2D: Eq. B1 aperture at infinite normal stress").positive()
+      .fallback();
+  t.real("fluid.aperture_gamma", 0.01, "-", "2D: Eq. B2 reduction factor of pore-to-pore channel apertures").positive()
+      .fallback();
   t.real("fluid.pfv_factor", 1.0, "-",
          "3D: factor on the PFV throat conductance A_f R_h^2 / (2 mu L) (Chareyre et al. 2012; < 1: tighter, "
          "concrete-like throats)")
-      .positive();
+      .positive()
+      .fallback();
   t.string("fluid.flow_scheme", "auto",
            "time stepping of the pore flow: auto (2D explicit with sub-steps, 3D implicit), explicit or implicit "
            "(3D only: one backward-Euler step per DEM step)")
@@ -65,26 +69,32 @@ void declare(ParamTable& t) {
   t.real("fluid.cg_tolerance", 1e-12, "-",
          "3D implicit flow: relative residual of the conjugate-gradient pressure solve (porenet; the phase masses stay "
          "conserved at any value, the channel fluxes being antisymmetric)")
-      .open_range(0, 1);
+      .open_range(0, 1)
+      .fallback();
   t.real("fluid.min_void_relative", 0.05, "-",
          "floor of a pore's void volume as a fraction of the mean cell (slivers set the explicit flow step)")
       .open_range(0, 1);
   t.real("fluid.retriangulation_tolerance", 0.25, "-",
          "retriangulate when a particle has moved this fraction of the mean radius since the last triangulation")
       .positive();
-  t.boolean("fluid.shear_forces", true, "2D: add the channel shear forces (B25, B28) to the pressure forces (B26-B27)");
+  t.boolean("fluid.shear_forces", true, "2D: add the channel shear forces (B25, B28) to the pressure forces (B26-B27)")
+      .fallback();
   t.real("fluid.cavitation_pressure", 2.34e3, "Pa",
          "2D: absolute pressure below which a pore's liquid cavitates (vapour fills the rest of its void at this "
          "pressure; water at 20 C: 2.34e3); 0 = the liquid takes any tension")
-      .non_negative();
+      .non_negative()
+      .fallback();
   t.string("fluid.force_height", "auto",
            "2D: wetted height of a grain in B27/B28, to match the height its contacts and bonds act over: thickness (1 m "
            "discs: linear/parallel laws), diameter (the seed's 2 r_j: spheres in one layer, its cohesive law A1-A7), "
            "auto (diameter with dem.contact_law = cohesive, else thickness)")
-      .one_of({"auto", "thickness", "diameter"});
+      .one_of({"auto", "thickness", "diameter"})
+      .fallback();
 }
 
-// Keys of one dimension only: set in the other, they are an error (not silently ignored).
+// Keys of one dimension only: set in the other, they are an error (not silently ignored). They are
+// declared .fallback() so that the saved scenario of a run (read back by `fracflow resume`) leaves
+// them unset unless the user set them.
 const std::vector<std::string> k2DOnly = {"fluid.aperture_h0", "fluid.aperture_hinf", "fluid.aperture_gamma",
                                           "fluid.shear_forces", "fluid.cavitation_pressure", "fluid.force_height"};
 const std::vector<std::string> k3DOnly = {"fluid.pfv_factor", "fluid.cg_tolerance"};
