@@ -6,6 +6,10 @@
 #include <cmath>
 #include <vector>
 
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+
 namespace ff::dem {
 
 namespace {
@@ -139,7 +143,7 @@ Real pair_stiffness(const DemSystem& s, int pt, Real rA, Real rB, Real overlap) 
   return k;
 }
 
-Real critical_time_step(const DemSystem& s) {
+Real critical_time_step(const DemSystem& s, std::span<const Real> extra_stiffness) {
   const auto& particles = s.particles;
   const auto& materials = s.materials;
   const std::size_t n = particles.size();
@@ -190,6 +194,11 @@ Real critical_time_step(const DemSystem& s) {
       kr[cp[c]] += ck[c] * r[cp[c]] * r[cp[c]];
     }
   }
+  if (!extra_stiffness.empty()) {
+    if (extra_stiffness.size() != n)
+      throw Error(fmt::format("critical_time_step: {} extra stiffnesses for {} particles", extra_stiffness.size(), n));
+    for (std::size_t i = 0; i < n; ++i) kt[i] += extra_stiffness[i];
+  }
   Real dt = std::numeric_limits<Real>::infinity();
   for (std::size_t i = 0; i < n; ++i) {
     // A particle with no contact yet still meets one like itself (free particles otherwise
@@ -201,9 +210,9 @@ Real critical_time_step(const DemSystem& s) {
   return dt;
 }
 
-void scale_masses_for(DemSystem& s, Real dt, Real safety) {
+void scale_masses_for(DemSystem& s, Real dt, Real safety, std::span<const Real> extra_stiffness) {
   // m~ = max(m, (dt/s)^2 k_tran) (METHODS.md 1.6): done by scaling until the estimate allows dt.
-  const Real dt_now = critical_time_step(s) * safety;
+  const Real dt_now = critical_time_step(s, extra_stiffness) * safety;
   if (dt_now >= dt) return;
   const Real f = (dt / dt_now) * (dt / dt_now);
   for (std::size_t i = 0; i < s.particles.size(); ++i) {

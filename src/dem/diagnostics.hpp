@@ -2,6 +2,7 @@
 // Love-Weber average stress, critical time step, unbalanced force, contact and bond counts.
 #pragma once
 #include <limits>
+#include <span>
 
 #include "dem/dem_system.hpp"
 
@@ -18,10 +19,12 @@ Real max_unbalanced_force_ratio(const DemSystem& s, std::size_t particles = std:
 // `overlap`, at least 1% of the smaller radius (time-step estimates).
 Real pair_stiffness(const DemSystem& s, int pair_type, Real rA, Real rB, Real overlap);
 // Critical time step sqrt(m/k_tran), sqrt(I/k_rot) over all particles (METHODS.md 1.6), from the
-// current contacts, bonds, wall and boundary contacts.
-Real critical_time_step(const DemSystem& s);
+// current contacts, bonds, wall and boundary contacts. `extra_stiffness` (empty, or one entry per
+// particle [N/m]) adds what another physics module pushes on each particle with, e.g. the pore fluid
+// (coupling::DemPorenetCoupling::fluid_stiffness): central forces, so translational only.
+Real critical_time_step(const DemSystem& s, std::span<const Real> extra_stiffness = {});
 // Density scaling: inertial masses so that `dt` is `safety` times the critical step.
-void scale_masses_for(DemSystem& s, Real dt, Real safety);
+void scale_masses_for(DemSystem& s, Real dt, Real safety, std::span<const Real> extra_stiffness = {});
 
 // Energy bookkeeping (energy.hpp; settings.track_energy). start_energy_tracking() zeroes the
 // book and takes the present kinetic and strain energies as the reference.

@@ -416,4 +416,38 @@ void DemPorenetCoupling::compute_fluid_forces(Real p_floor) {
     }
 }
 
+std::vector<Real> DemPorenetCoupling::fluid_stiffness() const {
+  const auto& net = *net_;
+  const auto alpha = flow_->liquid_fraction(), rq = flow_->liquid_density(), rp = flow_->gas_density();
+  const auto np = static_cast<std::size_t>(net.n_pores());
+  std::vector<Real> K(np, 0.0);
+  for (std::size_t i = 0; i < np; ++i) {
+    if (bc_pore_.size() == np && bc_pore_[i]) continue;
+    // A phase with a non-positive modulus (PR's unstable branch) makes the pore soft: K = 0.
+    const Real Kq = alpha[i] > 0 ? prm_.fluid.liquid.bulk_modulus(rq[i]) : 1.0;
+    const Real Kp = alpha[i] < 1 ? prm_.fluid.gas.bulk_modulus(rp[i]) : 1.0;
+    if (!(Kq > 0 && Kp > 0)) continue;
+    const Real compliance = (alpha[i] > 0 ? alpha[i] / Kq : 0.0) + (alpha[i] < 1 ? (1 - alpha[i]) / Kp : 0.0);
+    K[i] = compliance > 0 ? 1 / compliance : 0;
+  }
+  const Real t = prm_.network.thickness;
+  std::vector<Real> k(static_cast<std::size_t>(net.n_particles), 0.0);
+  for (Index j = 0; j < net.n_particles; ++j) {
+    const Real h = prm_.force_height == ForceHeight::Diameter ? 2 * r_[j] : t;
+    Real sum = 0;
+    for (Index e = net.pp_start[j]; e < net.pp_start[j + 1]; ++e) {
+      const Index i = net.pp_pore[e];
+      const int c = net.pp_corner[e];
+      const Index b = net.pore_v[3 * i + (c + 1) % 3], d = net.pore_v[3 * i + (c + 2) % 3];
+      const Real l1 = std::hypot(x_[b] - x_[j], y_[b] - y_[j]), l2 = std::hypot(x_[d] - x_[j], y_[d] - y_[j]);
+      const Real chord = r_[j] * std::hypot((x_[d] - x_[j]) / l2 - (x_[b] - x_[j]) / l1,
+                                            (y_[d] - y_[j]) / l2 - (y_[b] - y_[j]) / l1);
+      const Real edge = std::hypot(x_[d] - x_[b], y_[d] - y_[b]);
+      sum += K[static_cast<std::size_t>(i)] * h * chord * t * edge / (2 * net.pore_void[i]);
+    }
+    k[static_cast<std::size_t>(j)] = sum;
+  }
+  return k;
+}
+
 }  // namespace ff::coupling

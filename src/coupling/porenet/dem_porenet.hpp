@@ -107,6 +107,15 @@ class DemPorenetCoupling {
   // Fluid force of the last step on particle k [N] (x, y).
   Real fluid_fx(Index k) const { return fx_[static_cast<std::size_t>(k)]; }
   Real fluid_fy(Index k) const { return fy_[static_cast<std::size_t>(k)]; }
+  // Stiffness the pore fluid adds to each grain [N/m], for the DEM's critical time step
+  // (dem::critical_time_step's extra_stiffness). Pore i of void V_i pushes on grain j with
+  // (p_i - p_a) h w_j (B27; w_j the chord of j's arc in the pore, h the force height), and moving j
+  // towards the pore by dx shrinks V_i by t e_j dx / 2 (e_j the triangle edge opposite j), so
+  // k_j = sum_i K_i h w_j t e_j / (2 V_i), K_i = rho dp/drho of the pore's liquid-gas mixture
+  // (1/K = alpha/K_q + (1 - alpha)/K_p) at its current state; pores at a prescribed pressure add
+  // none. A liquid-full pore of a dense packing adds about 2 Kn of seed 004's law per face: left
+  // out, it lets the explicit step blow up (docs/saturated.md).
+  std::vector<Real> fluid_stiffness() const;
   // Sets every pore's pressure and saturation (tests, initial states).
   void set_uniform_state(Real p, Real saturation);
 

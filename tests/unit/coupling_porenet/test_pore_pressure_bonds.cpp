@@ -196,3 +196,65 @@ TEST(PorePressureBonds, CompressedVapourCondensesBackToLiquid) {
 
 }  // namespace
 }  // namespace ff::coupling
+
+namespace ff::coupling {
+namespace {
+
+// The stiffness the pore fluid adds to a grain (DemPorenetCoupling::fluid_stiffness, used for the DEM's
+// critical step) against the force change it predicts: the top disc of the triangle is pushed into the
+// closed pore by delta = 1e-5 R; the pore's pressure follows the fluid's state equation at the new void
+// (one explicit flow step of 1e-15 s, no channel to anywhere), and the fluid's force on the disc along
+// +y grows by k delta. At gauge 0 the arc's change is second order, so k = K h R (t R) / V exactly to
+// first order (R the chord of the 60 degree arc, t R the void's change per unit move, equal radii keep
+// the sectors' area). Liquid (barotropic K 2.2 GPa) and half gas (ideal, isothermal K = p: the mixture's
+// 1/K = S/K_q + (1 - S)/K_p), either height; tolerance 1e-3 (finite difference of O(delta/R)).
+TEST(PorePressureBonds, FluidStiffnessIsTheUndrainedForceChangePerMove) {
+  for (const Real S : {1.0, 0.5})
+    for (const ForceHeight h : {ForceHeight::Thickness, ForceHeight::Diameter}) {
+      dem::DemSystem s = triangle();
+      DemPorenetCoupling c;
+      auto prm = gas(h);
+      prm.saturation = S;
+      prm.cavitation_pressure = 0;
+      c.init(s, prm);
+      c.set_uniform_state(1e5, S);  // ambient: gauge 0
+      const Real k = c.fluid_stiffness()[2];
+      c.compute_fluid_forces(0);
+      const Real f0 = c.fluid_fy(2);
+      const Real delta = 1e-5 * kR;
+      s.particles.pos[2].y() -= delta;
+      ASSERT_FALSE(c.sync(s));
+      c.flow().step_explicit(1e-15);
+      c.compute_fluid_forces(0);
+      const Real k_fd = (c.fluid_fy(2) - f0) / delta;
+      const Real V = c.network().pore_void[0] + kR * delta;  // before the move
+      const Real K = 1 / (S / 2.2e9 + (1 - S) / 1e5);
+      const Real hh = h == ForceHeight::Thickness ? 1.0 : 2 * kR;
+      std::printf("S %.1f, %s: k %.6g N/m, finite difference %.6g N/m, K h R^2 t / V %.6g N/m\n", S,
+                  h == ForceHeight::Diameter ? "diameter" : "thickness", k, k_fd, K * hh * kR * kR / V);
+      EXPECT_NEAR(k_fd, k, 1e-3 * k);
+      EXPECT_NEAR(k, K * hh * kR * kR / V, 1e-3 * k);
+    }
+}
+
+// The critical step with that stiffness: sqrt(m / (k_bonds + k_fluid)) for the stiffest grain, below
+// the dry one, and the size of the extra stiffness checked (one entry per particle).
+TEST(PorePressureBonds, CriticalStepCountsTheFluidStiffness) {
+  dem::DemSystem s = triangle();
+  DemPorenetCoupling c;
+  auto prm = gas(ForceHeight::Thickness);
+  prm.saturation = 1;
+  c.init(s, prm);
+  const auto k = c.fluid_stiffness();
+  const Real dry = dem::critical_time_step(s), wet = dem::critical_time_step(s, k);
+  Real kmax = 0;
+  for (Real x : k) kmax = std::max(kmax, x);
+  std::printf("critical step dry %.6g s, with the liquid %.6g s, fluid stiffness %.6g N/m\n", dry, wet, kmax);
+  EXPECT_LT(wet, dry);
+  EXPECT_GT(kmax, 0);
+  const std::vector<Real> wrong(2, 1.0);
+  EXPECT_THROW(dem::critical_time_step(s, wrong), Error);
+}
+
+}  // namespace
+}  // namespace ff::coupling
