@@ -36,6 +36,8 @@ struct Args {
   std::vector<double> saturations = {0.0, 0.5, 1.0};
   std::vector<double> viscosities = {1e-3, 1e-1};
   double width = 10e-3, height = 20e-3, radius_min = 0.4e-3, radius_max = 0.6e-3, velocity = 0.02;
+  double bond_gap = 0.5;  // x radius_min: neighbours this close are bonded (0.1: ~1.7 bonds per disc, brittle)
+  double safety = 0.3;    // dem.time_step_safety (of the critical step with the pore fluid's stiffness)
   int seed = 7, threads = 1, packings = 3;
   bool quick = false, overwrite = false;
 };
@@ -51,7 +53,7 @@ dim = 2
 contact_law = "cohesive"
 bond_law = "cohesive"
 local_damping = 0.08
-time_step_safety = 0.3
+time_step_safety = {}
 [dem.group.matrix]
 density = {}
 [dem.contact.matrix-matrix]
@@ -81,8 +83,8 @@ vtk = false
 plots = false
 progress_interval = 0
 )",
-                     2600 * 4 * 0.25 * (a.radius_min + a.radius_max) / 3, a.width, a.height, a.radius_min, a.radius_max,
-                     0.1 * a.radius_min, a.seed, a.velocity);
+                     a.safety, 2600 * 4 * 0.25 * (a.radius_min + a.radius_max) / 3, a.width, a.height, a.radius_min,
+                     a.radius_max, a.bond_gap * a.radius_min, a.seed, a.velocity);
 }
 
 void write_text(const fs::path& f, const std::string& t) {
@@ -288,20 +290,23 @@ int run_validate(Args a) {
   const Case& c0 = cases.front();
   md += fmt::format(
       "**Specimen.** {:.0f} x {:.0f} mm box of {} bonded discs (radii {:.2f}-{:.2f} mm, {} cohesive bonds), "
-      "{} packing(s) (sample.seed {}..{}). Seed 004's DEM law (Appendix A, A1-A7; `dem.contact_law = dem.bond_law = "
+      "{} packing(s) (sample.seed {}..{}), neighbours closer than {:.3f} mm bonded. Seed 004's DEM law (Appendix A, A1-A7; `dem.contact_law = dem.bond_law = "
       "\"cohesive\"`, src/dem/bond/cohesive_bond.hpp): Ec = 11.3 GPa, Ks/Kn = 0.2, tan(mu_c) = 0.325 (18 deg), "
       "C = 140 MPa, T = 25 MPa, alpha_d = 0.08. Platens {:g} m/s each (strain rate {:.2g} 1/s), lateral faces "
       "drained at 0.1 MPa, platens impermeable. Pore network of seed 004 (B1-B28): water as a barotropic liquid "
       "(K = 2.2 GPa), air as an ideal gas; B1 h0 = 1 um, h_inf = 0.1 um, B2 gamma = 0.01; pressure and channel-shear "
       "forces over the spheres' height 2 r (B27-B28, as the law's forces are those of spheres).\n\n",
       1e3 * a.width, 1e3 * a.height, c0.particles, 1e3 * a.radius_min, 1e3 * a.radius_max, c0.bonds, a.packings, a.seed,
-      a.seed + a.packings - 1, a.velocity, 2 * a.velocity / a.height);
-  md += "**Stress units.** The driver divides the platen force by width x 1 m (fracflow's discs are 1 m thick); the "
-        "seed's forces are those of spheres in one layer, so the strength per layer of mean thickness 2 r is also "
-        "given (column *UCS layer*). Ratios do not depend on this. The discs' density is the spheres' (2600 kg/m3) "
-        "per 1 m of disc, 2600 x 4 r/3, so that masses match the sphere forces. Time step 0.3 x critical: the pore "
-        "water stiffens the grains beyond the contacts (the saturated UCS moves 10 % between 0.8 and 0.2 x critical, "
-        "1 % between 0.4 and 0.2). Interpretation and the checks behind it: docs/saturated.md.\n\n";
+      a.seed + a.packings - 1, 1e3 * a.bond_gap * a.radius_min, a.velocity, 2 * a.velocity / a.height);
+  md += fmt::format(
+      "**Stress units.** The driver divides the platen force by width x 1 m (fracflow's discs are 1 m thick); the "
+      "seed's forces are those of spheres in one layer, so the strength per layer of mean thickness 2 r is also "
+      "given (column *UCS layer*). Ratios do not depend on this. The discs' density is the spheres' (2600 kg/m3) "
+      "per 1 m of disc, 2600 x 4 r/3, so that masses match the sphere forces. Time step {} x the critical step that "
+      "counts the pore fluid's stiffness on each grain (`fluid.stiffness_in_time_step`; a liquid-full pore adds "
+      "about two contact stiffnesses per face, so the saturated specimens' step is the shorter). Interpretation and "
+      "the checks behind it: docs/saturated.md.\n\n",
+      a.safety);
   md += "## Strength by saturation and viscosity\n\n";
   md += "| S | mu [Pa s] | UCS, 1 m discs [kPa] (range) | UCS layer [MPa] | vs dry (paired) | strain at peak [%] | max p before peak "
         "[MPa] | mean p at peak [MPa] | cracks at peak | cracks final (tensile/shear) | runs |\n";
@@ -420,6 +425,13 @@ const bool registered = ff::cli::register_command({"validate-saturated", [](CLI:
   sub->add_option("--height", a->height, "specimen height [m]")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--velocity", a->velocity, "platen velocity, each [m/s]")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--seed", a->seed, "first packing seed")->capture_default_str();
+  sub->add_option("--bond-gap", a->bond_gap, "neighbours closer than this x radius_min are bonded (sample.bond_gap)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  sub->add_option("--time-step-safety", a->safety,
+                  "dem.time_step_safety: fraction of the critical step (with the pore fluid's stiffness) used")
+      ->check(CLI::Range(1e-3, 1.0))
+      ->capture_default_str();
   sub->add_option("--packings", a->packings, "packings per case; the report gives their mean and range")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
