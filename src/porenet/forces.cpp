@@ -75,6 +75,35 @@ namespace ff::porenet {
 // area theta R^2 / 2) close a cone, so int_patch n dA = -sum_f n_f theta_f R^2 / 2 (n_f the face's
 // outward normal) and the force -p int_patch n dA = p sum_f n_f theta_f R^2 / 2. A face between two
 // pores gets opposite normals from them: an interior sphere at uniform pressure feels no net force.
+void unit_patch_force_3d(const Network2D& net, const Particles3D& p, Index j, Index e, Real out[3]) {
+  out[0] = out[1] = out[2] = 0;
+  const Real R = p.radius[j];
+  const Index k = net.pp_pore[e];
+  const int c = net.pp_corner[e];
+  const Index* v = &net.pore_v[4 * static_cast<std::size_t>(k)];
+  const Real o[3] = {p.x[j], p.y[j], p.z[j]};
+  Real u[3][3];  // edges from j to the other three corners
+  for (int q = 0; q < 3; ++q) {
+    const Index w = v[(c + 1 + q) % 4];
+    u[q][0] = p.x[w] - o[0];
+    u[q][1] = p.y[w] - o[1];
+    u[q][2] = p.z[w] - o[2];
+  }
+  for (int f = 0; f < 3; ++f) {  // face (j, a, b); the third edge d points to the opposite corner
+    const Real* a = u[f];
+    const Real* b = u[(f + 1) % 3];
+    const Real* d = u[(f + 2) % 3];
+    Real nn[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+    const Real len = std::sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
+    if (!(len > 0)) continue;
+    const Real sgn = (nn[0] * d[0] + nn[1] * d[1] + nn[2] * d[2]) > 0 ? -1.0 : 1.0;  // away from d
+    const Real ab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    const Real th = std::atan2(len, ab);
+    const Real w = sgn * 0.5 * th * R * R / len;
+    for (int q = 0; q < 3; ++q) out[q] += w * nn[q];
+  }
+}
+
 void add_pressure_forces_3d(const Network2D& net, const Particles3D& p, std::span<const Real> P, std::span<Real> fx,
                             std::span<Real> fy, std::span<Real> fz) {
   const auto n = static_cast<std::size_t>(net.n_particles);
@@ -86,32 +115,11 @@ void add_pressure_forces_3d(const Network2D& net, const Particles3D& p, std::spa
 #pragma omp parallel for schedule(static) if (net.n_particles > kParallelMin)
   for (Index j = 0; j < net.n_particles; ++j) {
     Real s[3] = {0, 0, 0};
-    const Real R = p.radius[j];
     for (Index e = net.pp_start[j]; e < net.pp_start[j + 1]; ++e) {
-      const Index k = net.pp_pore[e];
-      const int c = net.pp_corner[e];
-      const Index* v = &net.pore_v[4 * static_cast<std::size_t>(k)];
-      const Real o[3] = {p.x[j], p.y[j], p.z[j]};
-      Real u[3][3];  // edges from j to the other three corners
-      for (int q = 0; q < 3; ++q) {
-        const Index w = v[(c + 1 + q) % 4];
-        u[q][0] = p.x[w] - o[0];
-        u[q][1] = p.y[w] - o[1];
-        u[q][2] = p.z[w] - o[2];
-      }
-      for (int f = 0; f < 3; ++f) {  // face (j, a, b); the third edge d points to the opposite corner
-        const Real* a = u[f];
-        const Real* b = u[(f + 1) % 3];
-        const Real* d = u[(f + 2) % 3];
-        Real nn[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-        const Real len = std::sqrt(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
-        if (!(len > 0)) continue;
-        const Real sgn = (nn[0] * d[0] + nn[1] * d[1] + nn[2] * d[2]) > 0 ? -1.0 : 1.0;  // away from d
-        const Real ab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-        const Real th = std::atan2(len, ab);
-        const Real w = sgn * P[k] * 0.5 * th * R * R / len;
-        for (int q = 0; q < 3; ++q) s[q] += w * nn[q];
-      }
+      Real a[3];
+      unit_patch_force_3d(net, p, j, e, a);
+      const Real Pk = P[net.pp_pore[e]];
+      for (int q = 0; q < 3; ++q) s[q] += Pk * a[q];
     }
     fx[j] += s[0];
     fy[j] += s[1];

@@ -22,6 +22,9 @@ void add_shear_forces(const Network2D& net, const Particles2D& particles, std::s
 
 // 3D (PFV-style integration over the sphere surface; forces.cpp): pressure on the spherical patches of
 // each sphere inside its tetrahedra, added to fx, fy, fz [N].
+// The force on sphere j per unit pressure in the tetrahedron of its pore-corner entry e (net.pp_pore[e])
+// [m^2]: sum_f n_f theta_f R^2 / 2 (below); add_pressure_forces_3d sums P_k times it.
+void unit_patch_force_3d(const Network2D& net, const Particles3D& particles, Index j, Index e, Real out[3]);
 void add_pressure_forces_3d(const Network2D& net, const Particles3D& particles, std::span<const Real> pore_pressure,
                             std::span<Real> fx, std::span<Real> fy, std::span<Real> fz);
 

@@ -285,6 +285,7 @@ void update_network_2d(Network2D& net, const Particles2D& p, const PairList& pai
   for (Index k = 0; k < np; ++k) mean_cell += net.pore_cell[k];
   mean_cell /= static_cast<Real>(np);
   const Real floor_v = net.params.min_void_relative * mean_cell;
+  net.void_floor = floor_v;
   for (Index k = 0; k < np; ++k) net.pore_void[k] = std::max(net.pore_void[k], floor_v);
 #pragma omp parallel for schedule(static) if (nc > kParallelMin)
   for (Index c = 0; c < nc; ++c) channel_geometry(net, p, pairs, c);

@@ -112,8 +112,11 @@ struct Network2D {
   Index unmatched_pairs = 0;  // pairs of the list that are not Delaunay edges (no channel)
 
   Index hidden_particles = 0;  // 3D regular triangulation: spheres with an empty power cell (no pore)
+  // Floor of every pore's void [m^3] (min_void_relative x the mean cell; 2D: of the last update; a pore
+  // at the floor keeps its volume as its grains move). 3D: kept from the build for update_network_3d.
+  Real void_floor = 0;
   // 3D: kept from the build for update_network_3d
-  Real void_floor = 0, ch_cond_cap = 0, pfv_factor = 1;
+  Real ch_cond_cap = 0, pfv_factor = 1;
 
   Index n_pores() const { return static_cast<Index>(pore_area.size()); }
   Index n_channels() const { return static_cast<Index>(ch_length.size()); }

@@ -394,4 +394,14 @@ Real TwoPhaseFlow::saturation() {
   return lv / v;
 }
 
+Real TwoPhaseFlow::mixture_bulk_modulus(Index pore) const {
+  const auto i = static_cast<std::size_t>(pore);
+  const Real a = alpha_[i];
+  const Real Kq = a > 0 ? prm_.liquid.bulk_modulus(rq_[i]) : 1.0;
+  const Real Kp = a < 1 ? prm_.gas.bulk_modulus(rp_[i]) : 1.0;
+  if (!(Kq > 0 && Kp > 0)) return 0;
+  const Real compliance = (a > 0 ? a / Kq : 0.0) + (a < 1 ? (1 - a) / Kp : 0.0);
+  return compliance > 0 ? 1 / compliance : 0;
+}
+
 }  // namespace ff::porenet

@@ -124,6 +124,10 @@ class TwoPhaseFlow {
   }
 
   std::span<const Real> pressure() const { return p_; }
+  PoreBc bc(Index pore) const { return bc_[static_cast<std::size_t>(pore)]; }
+  // rho dp/drho of pore i's liquid-gas mixture at its state, 1/K = alpha/K_q + (1 - alpha)/K_p [Pa];
+  // 0 where a present phase has a non-positive modulus (Peng-Robinson's unstable branch).
+  Real mixture_bulk_modulus(Index pore) const;
   std::span<const Real> liquid_fraction() const { return alpha_; }
   std::span<const Real> liquid_mass() const { return mq_; }
   std::span<const Real> gas_mass() const { return mp_; }

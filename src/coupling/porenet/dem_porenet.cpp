@@ -418,18 +418,10 @@ void DemPorenetCoupling::compute_fluid_forces(Real p_floor) {
 
 std::vector<Real> DemPorenetCoupling::fluid_stiffness() const {
   const auto& net = *net_;
-  const auto alpha = flow_->liquid_fraction(), rq = flow_->liquid_density(), rp = flow_->gas_density();
-  const auto np = static_cast<std::size_t>(net.n_pores());
-  std::vector<Real> K(np, 0.0);
-  for (std::size_t i = 0; i < np; ++i) {
-    if (bc_pore_.size() == np && bc_pore_[i]) continue;
-    // A phase with a non-positive modulus (PR's unstable branch) makes the pore soft: K = 0.
-    const Real Kq = alpha[i] > 0 ? prm_.fluid.liquid.bulk_modulus(rq[i]) : 1.0;
-    const Real Kp = alpha[i] < 1 ? prm_.fluid.gas.bulk_modulus(rp[i]) : 1.0;
-    if (!(Kq > 0 && Kp > 0)) continue;
-    const Real compliance = (alpha[i] > 0 ? alpha[i] / Kq : 0.0) + (alpha[i] < 1 ? (1 - alpha[i]) / Kp : 0.0);
-    K[i] = compliance > 0 ? 1 / compliance : 0;
-  }
+  std::vector<Real> K(static_cast<std::size_t>(net.n_pores()), 0.0);
+  for (Index i = 0; i < net.n_pores(); ++i)
+    if (flow_->bc(i) != porenet::PoreBc::Pressure && net.pore_void[i] > net.void_floor)
+      K[static_cast<std::size_t>(i)] = flow_->mixture_bulk_modulus(i);
   const Real t = prm_.network.thickness;
   std::vector<Real> k(static_cast<std::size_t>(net.n_particles), 0.0);
   for (Index j = 0; j < net.n_particles; ++j) {
@@ -442,8 +434,10 @@ std::vector<Real> DemPorenetCoupling::fluid_stiffness() const {
       const Real l1 = std::hypot(x_[b] - x_[j], y_[b] - y_[j]), l2 = std::hypot(x_[d] - x_[j], y_[d] - y_[j]);
       const Real chord = r_[j] * std::hypot((x_[d] - x_[j]) / l2 - (x_[b] - x_[j]) / l1,
                                             (y_[d] - y_[j]) / l2 - (y_[b] - y_[j]) / l1);
+      // At the fraction floor (overlapping discs) the void is phi x the triangle: phi of its change.
       const Real edge = std::hypot(x_[d] - x_[b], y_[d] - y_[b]);
-      sum += K[static_cast<std::size_t>(i)] * h * chord * t * edge / (2 * net.pore_void[i]);
+      const Real phi = net.pore_void[i] <= net.params.min_void_fraction * net.pore_cell[i] ? net.params.min_void_fraction : 1.0;
+      sum += K[static_cast<std::size_t>(i)] * h * chord * t * phi * edge / (2 * net.pore_void[i]);
     }
     k[static_cast<std::size_t>(j)] = sum;
   }

@@ -112,9 +112,10 @@ class DemPorenetCoupling {
   // (p_i - p_a) h w_j (B27; w_j the chord of j's arc in the pore, h the force height), and moving j
   // towards the pore by dx shrinks V_i by t e_j dx / 2 (e_j the triangle edge opposite j), so
   // k_j = sum_i K_i h w_j t e_j / (2 V_i), K_i = rho dp/drho of the pore's liquid-gas mixture
-  // (1/K = alpha/K_q + (1 - alpha)/K_p) at its current state; pores at a prescribed pressure add
-  // none. A liquid-full pore of a dense packing adds about 2 Kn of seed 004's law per face: left
-  // out, it lets the explicit step blow up (docs/saturated.md).
+  // (1/K = alpha/K_q + (1 - alpha)/K_p) at its current state; pores at a prescribed pressure or at
+  // the void floor (whose volume does not follow the grains) add none. A liquid-full pore of a dense
+  // packing adds about 2 Kn of seed 004's law per face: left out, it lets the explicit step blow up
+  // (docs/saturated.md).
   std::vector<Real> fluid_stiffness() const;
   // Sets every pore's pressure and saturation (tests, initial states).
   void set_uniform_state(Real p, Real saturation);

@@ -222,4 +222,72 @@ void DemPorenet3D::load(CheckpointReader& r, const dem::DemSystem& sys, const Po
   stats_ = r.get_value<Porenet3DStats>("porenet3d.stats");
 }
 
+// dV_i/dx_j of tetrahedral pore i (corner entry e of sphere j) for V = V_tet - sum_k Omega_k R_k^3 / 3
+// (porenet/network3d.cpp), by Reynolds transport: a point of a face through j moves by lambda_j dx
+// (lambda_j its barycentric weight), sphere j's patch moves by dx. So
+// g = a + sum_{faces f through j} n_f [A_f / 3 - sum_{corners k of f} S_kf lambda_j(c_kf)],
+// with a the patch force per unit pressure (= -int_patch n dA, porenet::unit_patch_force_3d), n_f the
+// face's outward normal, S_kf = theta R_k^2 / 2 the sphere sector that corner k cuts from f and c_kf its
+// centroid (4 R sin(theta/2) / (3 theta) along the bisector). Without the sectors g would be the bare
+// tetrahedron's, tens of times too large where the spheres fill most of it.
+Vec3 DemPorenet3D::void_gradient(Index j, Index e, const Vec3& a) const {
+  const auto& net = *net_;
+  const Index i = net.pp_pore[e];
+  const int c = net.pp_corner[e];
+  const Index* v = &net.pore_v[4 * static_cast<std::size_t>(i)];
+  auto pos = [&](Index k) { return Vec3(x_[k], y_[k], z_[k]); };
+  // A pore at the fraction floor (overlapping spheres fill the tetrahedron) has V = phi V_tet:
+  // g = phi dV_tet/dx_j, no sectors, no patch.
+  const bool at_fraction = net.pore_void[i] <= net.params.min_void_fraction * net.pore_cell[i];
+  Vec3 g = at_fraction ? Vec3::Zero() : a;
+  for (int f = 0; f < 3; ++f) {  // face (j, b, d); the corner opposite it is o
+    const Index b = v[(c + 1 + f) % 4], d = v[(c + 1 + (f + 1) % 3) % 4], o = v[(c + 1 + (f + 2) % 3) % 4];
+    const Vec3 xj = pos(j), xb = pos(b), xd = pos(d);
+    const Vec3 N = (xb - xj).cross(xd - xj);
+    const Real N2 = N.squaredNorm();
+    if (!(N2 > 0)) continue;
+    const Vec3 n = (N.dot(pos(o) - xj) > 0 ? -1.0 : 1.0) * N / std::sqrt(N2);  // outward unit normal
+    // lambda_j at a point q of the face: the signed area of (q, b, d) over the face's.
+    auto lambda_j = [&](const Vec3& q) { return (xb - q).cross(xd - q).dot(N) / N2; };
+    Real w = 0.5 * std::sqrt(N2) / 3;
+    if (at_fraction) {
+      g += net.params.min_void_fraction * w * n;
+      continue;
+    }
+    const Index corner[3] = {j, b, d};
+    for (int m = 0; m < 3; ++m) {
+      const Vec3 xk = pos(corner[m]);
+      const Vec3 u1 = (pos(corner[(m + 1) % 3]) - xk).normalized(), u2 = (pos(corner[(m + 2) % 3]) - xk).normalized();
+      const Real th = std::atan2(u1.cross(u2).norm(), u1.dot(u2));
+      if (!(th > 0)) continue;
+      const Real R = r_[corner[m]];
+      const Vec3 centroid = xk + (u1 + u2).normalized() * (4 * R * std::sin(0.5 * th) / (3 * th));
+      w -= 0.5 * th * R * R * lambda_j(centroid);
+    }
+    g += w * n;
+  }
+  return g;
+}
+
+std::vector<Real> DemPorenet3D::fluid_stiffness() const {
+  const auto& net = *net_;
+  const porenet::Particles3D parts = view();
+  std::vector<Real> k(static_cast<std::size_t>(net.n_particles), 0.0);
+  for (Index j = 0; j < net.n_particles; ++j) {
+    Real sum = 0;
+    for (Index e = net.pp_start[j]; e < net.pp_start[j + 1]; ++e) {
+      const Index i = net.pp_pore[e];
+      if (flow_->bc(i) == porenet::PoreBc::Pressure || !(net.pore_void[i] > net.void_floor)) continue;
+      const Real K = flow_->mixture_bulk_modulus(i);
+      if (!(K > 0)) continue;
+      Real a[3];
+      porenet::unit_patch_force_3d(net, parts, j, e, a);
+      const Vec3 av(a[0], a[1], a[2]);
+      sum += K * av.norm() * void_gradient(j, e, av).norm() / net.pore_void[i];
+    }
+    k[static_cast<std::size_t>(j)] = sum;
+  }
+  return k;
+}
+
 }  // namespace ff::coupling

@@ -67,6 +67,16 @@ class DemPorenet3D {
   Real max_pressure() const;
   // Fluid force of the last step on particle k [N].
   Vec3 fluid_force(Index k) const { return {fx_[k], fy_[k], fz_[k]}; }
+  // Stiffness the pore fluid adds to each sphere [N/m], for the DEM's critical step (as
+  // DemPorenetCoupling::fluid_stiffness in 2D): tetrahedron i pushes on sphere j with p_i a_ij
+  // (a_ij = porenet::unit_patch_force_3d) and moving j by dx changes V_i by g_ij.dx (void_gradient), so
+  // pore i adds K_i a_ij g_ij^T / V_i to j's stiffness; k_j = sum_i K_i |a_ij| |g_ij| / V_i bounds its
+  // largest eigenvalue. K_i the mixture's modulus; pores at a
+  // prescribed pressure or at the void floor (whose volume does not follow the grains) add none.
+  std::vector<Real> fluid_stiffness() const;
+  // dV/dx_j [m^2] of the pore of sphere j's corner entry e (network().pp_pore[e]); a = its patch force
+  // per unit pressure (porenet::unit_patch_force_3d).
+  Vec3 void_gradient(Index j, Index e, const Vec3& a) const;
   // Sets every pore's pressure and saturation.
   void set_uniform_state(Real p, Real saturation);
   // Pressure (and saturation) at the pores whose centroid is within `radius` of `centre` (injection).

@@ -91,17 +91,15 @@ void declare(ParamTable& t) {
       .one_of({"auto", "thickness", "diameter"})
       .fallback();
   t.boolean("fluid.stiffness_in_time_step", true,
-            "2D: the DEM's critical time step counts the stiffness the pore fluid adds to each grain (a liquid-full "
-            "pore adds ~2 contact stiffnesses per face; false: contacts and bonds only, as before 2026-11-27)")
-      .fallback();
+            "the DEM's critical time step counts the stiffness the pore fluid adds to each grain (a liquid-full "
+            "pore adds ~2 contact stiffnesses per face; false: contacts and bonds only, as before 2026-11-27)");
 }
 
 // Keys of one dimension only: set in the other, they are an error (not silently ignored). They are
 // declared .fallback() so that the saved scenario of a run (read back by `fracflow resume`) leaves
 // them unset unless the user set them.
 const std::vector<std::string> k2DOnly = {"fluid.aperture_h0", "fluid.aperture_hinf", "fluid.aperture_gamma",
-                                          "fluid.shear_forces", "fluid.cavitation_pressure", "fluid.force_height",
-                                          "fluid.stiffness_in_time_step"};
+                                          "fluid.shear_forces", "fluid.cavitation_pressure", "fluid.force_height"};
 const std::vector<std::string> k3DOnly = {"fluid.pfv_factor", "fluid.cg_tolerance"};
 
 porenet::TwoPhaseParams fluid_params(const Config& cfg) {
@@ -154,7 +152,7 @@ struct SatExtra {
   Real max_pore_pressure = 0;  // largest pore pressure of any step [Pa]
   Real void0 = 0;              // the network's void volume at the start [m^3]
   Real liquid_mass0 = 0, gas_mass0 = 0;  // [kg] (2D: per m of depth)
-  Real critical_dry = 0, critical_wet = 0;  // DEM critical step without / with the pore fluid [s] (2D)
+  Real critical_dry = 0, critical_wet = 0;  // DEM critical step without / with the pore fluid [s]
 };
 
 }  // namespace
@@ -251,7 +249,7 @@ class SaturatedUcsRun final : public UcsRun {
  private:
   void after_set_up() override {
     fluid_.init(sys, cfg, info);
-    if (!fluid_.dim3()) include_fluid_stiffness();
+    include_fluid_stiffness();
     const auto& net = fluid_.network();
     if (fluid_.dim3())
       log::info("pore network (3D): {} pores, {} throats, {} drained; DEM step {:.3g} s, {} flow", net.n_pores(),
@@ -271,7 +269,7 @@ class SaturatedUcsRun final : public UcsRun {
   // pore liquid-stiff, the stiffest it gets; a gas cushion stiffens only as it is squeezed).
   void include_fluid_stiffness() {
     ex_.critical_dry = dem::critical_time_step(sys);
-    const auto k = fluid_.c2().fluid_stiffness();
+    const auto k = fluid_.dim3() ? fluid_.c3().fluid_stiffness() : fluid_.c2().fluid_stiffness();
     ex_.critical_wet = dem::critical_time_step(sys, k);
     log::info("critical DEM step {:.4g} s with the pore fluid's stiffness ({:.4g} s without){}", ex_.critical_wet,
               ex_.critical_dry, cfg.boolean("fluid.stiffness_in_time_step") ? "" : ": not used (fluid.stiffness_in_time_step = false)");
@@ -378,6 +376,9 @@ class SaturatedUcsRun final : public UcsRun {
     f["saturation_final"] = fluid_.flow().saturation();
     f["retriangulations"] = fluid_.retriangulations();
     f["dem_dt_s"] = sys.settings.dt;
+    f["dem_critical_dt_s"] = ex_.critical_wet;
+    f["dem_critical_dt_dry_s"] = ex_.critical_dry;
+    f["stiffness_in_time_step"] = cfg.boolean("fluid.stiffness_in_time_step");
     f["flow_substeps"] = fluid_.substeps();
     f["pores"] = fluid_.network().n_pores();
     Real pmean, v;
@@ -400,9 +401,7 @@ class SaturatedUcsRun final : public UcsRun {
     } else {
       const auto& st = fluid_.c2().stats();
       f["flow_stable_dt_s"] = st.last_stable_dt;
-      f["dem_critical_dt_s"] = ex_.critical_wet;
-      f["dem_critical_dt_dry_s"] = ex_.critical_dry;
-      f["stiffness_in_time_step"] = cfg.boolean("fluid.stiffness_in_time_step");
+
       f["cavitations"] = st.cavitations;
       f["vapour_mass_kg_per_m"] = st.vapour_mass;
       // With sphere forces (force_height = diameter) the sample is a layer of spheres ~2 r thick,

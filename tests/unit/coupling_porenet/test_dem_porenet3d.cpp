@@ -15,6 +15,7 @@
 #include "dem/sample_builder.hpp"
 #include "io/scenario.hpp"
 #include "porenet/eos.hpp"
+#include "porenet/forces.hpp"
 
 namespace ff::coupling {
 namespace {
@@ -208,6 +209,73 @@ TEST(CouplingPorenet3D, CheckpointResumeAndThreadsBitIdentical) {
   }
   std::filesystem::remove(path);
   omp_set_num_threads(2);
+}
+
+}  // namespace
+}  // namespace ff::coupling
+
+namespace ff::coupling {
+namespace {
+
+// The stiffness the pore fluid adds to a sphere (DemPorenet3D::fluid_stiffness, for the DEM's critical
+// step) against finite differences: an interior sphere of the closed saturated sample (barotropic
+// K 5e7 Pa, at ambient: gauge 0) moved by delta = 1e-6 R along x, y and z in turn; after one flow step
+// of 1e-15 s (no time to flow) its fluid force changes by -k_dd delta. Each tetrahedron contributes
+// K a g^T / V (a its patch force per unit pressure, g = dV/dx_j by Reynolds transport, void_gradient),
+// so the measured trace must equal sum_i K a.g / V (tolerance 1e-3: finite differences of O(delta/R)),
+// and fluid_stiffness, sum_i K |a| |g| / V, bounds it from above.
+TEST(CouplingPorenet3D, FluidStiffnessIsTheUndrainedForceChangePerMove) {
+  auto s0 = specimen(0);
+  DemPorenet3D c0;
+  c0.init(s0->sys, fluid(1.0));
+  const auto& net0 = c0.network();
+  std::vector<char> hull(s0->sys.particles.size(), 0);
+  for (Index i = 0; i < net0.n_pores(); ++i)
+    if (net0.pore_hull[i])
+      for (int k = 0; k < 4; ++k) hull[static_cast<std::size_t>(net0.pore_v[4 * i + k])] = 1;
+  const auto kest = c0.fluid_stiffness();
+  std::vector<Real> x, y, z, r;
+  for (const auto& q : s0->sys.particles.pos) {
+    x.push_back(q.x());
+    y.push_back(q.y());
+    z.push_back(q.z());
+  }
+  r.assign(s0->sys.particles.radius.begin(), s0->sys.particles.radius.end());
+  const porenet::Particles3D parts{x, y, z, r, {}};
+  int tested = 0;
+  for (std::size_t j = 0; j < hull.size() && tested < 4; ++j) {
+    if (hull[j]) continue;
+    ++tested;
+    Real trace_pred = 0;
+    for (Index e = net0.pp_start[j]; e < net0.pp_start[j + 1]; ++e) {
+      const Index i = net0.pp_pore[e];
+      if (!(net0.pore_void[i] > net0.void_floor)) continue;
+      Real a[3];
+      porenet::unit_patch_force_3d(net0, parts, static_cast<Index>(j), e, a);
+      const Vec3 av(a[0], a[1], a[2]);
+      trace_pred += 5e7 * av.dot(c0.void_gradient(static_cast<Index>(j), e, av)) / net0.pore_void[i];
+    }
+    const Real R = s0->sys.particles.radius[j], delta = 1e-6 * R;
+    Real trace = 0;
+    for (int d = 0; d < 3; ++d) {
+      auto s = specimen(0);
+      DemPorenet3D c;
+      c.init(s->sys, fluid(1.0));
+      c.set_uniform_state(1e5, 1.0);
+      c.compute_fluid_forces(0);
+      const Real f0 = c.fluid_force(static_cast<Index>(j))[d];
+      s->sys.particles.pos[j][d] += delta;
+      ASSERT_FALSE(c.sync(s->sys));
+      c.advance_flow(1e-15);
+      c.compute_fluid_forces(0);
+      trace += -(c.fluid_force(static_cast<Index>(j))[d] - f0) / delta;
+    }
+    std::printf("sphere %zu: measured trace %.6g N/m, sum K a.g/V %.6g N/m (ratio %.5f), fluid_stiffness %.6g N/m\n",
+                j, trace, trace_pred, trace / trace_pred, kest[j]);
+    EXPECT_NEAR(trace, trace_pred, 1e-3 * std::abs(trace_pred));
+    EXPECT_LE(trace, kest[j] * (1 + 1e-9));
+  }
+  EXPECT_EQ(tested, 4);
 }
 
 }  // namespace
