@@ -420,8 +420,7 @@ std::vector<Real> DemPorenetCoupling::fluid_stiffness() const {
   const auto& net = *net_;
   std::vector<Real> K(static_cast<std::size_t>(net.n_pores()), 0.0);
   for (Index i = 0; i < net.n_pores(); ++i)
-    if (flow_->bc(i) != porenet::PoreBc::Pressure && net.pore_void[i] > net.void_floor)
-      K[static_cast<std::size_t>(i)] = flow_->mixture_bulk_modulus(i);
+    if (flow_->bc(i) != porenet::PoreBc::Pressure) K[static_cast<std::size_t>(i)] = flow_->mixture_bulk_modulus(i);
   const Real t = prm_.network.thickness;
   std::vector<Real> k(static_cast<std::size_t>(net.n_particles), 0.0);
   for (Index j = 0; j < net.n_particles; ++j) {
@@ -434,7 +433,7 @@ std::vector<Real> DemPorenetCoupling::fluid_stiffness() const {
       const Real l1 = std::hypot(x_[b] - x_[j], y_[b] - y_[j]), l2 = std::hypot(x_[d] - x_[j], y_[d] - y_[j]);
       const Real chord = r_[j] * std::hypot((x_[d] - x_[j]) / l2 - (x_[b] - x_[j]) / l1,
                                             (y_[d] - y_[j]) / l2 - (y_[b] - y_[j]) / l1);
-      // At the fraction floor (overlapping discs) the void is phi x the triangle: phi of its change.
+      // At the fraction floor (overlapping discs, V = phi x the triangle) phi of the triangle's change.
       const Real edge = std::hypot(x_[d] - x_[b], y_[d] - y_[b]);
       const Real phi = net.pore_void[i] <= net.params.min_void_fraction * net.pore_cell[i] ? net.params.min_void_fraction : 1.0;
       sum += K[static_cast<std::size_t>(i)] * h * chord * t * phi * edge / (2 * net.pore_void[i]);

@@ -112,10 +112,13 @@ class DemPorenetCoupling {
   // (p_i - p_a) h w_j (B27; w_j the chord of j's arc in the pore, h the force height), and moving j
   // towards the pore by dx shrinks V_i by t e_j dx / 2 (e_j the triangle edge opposite j), so
   // k_j = sum_i K_i h w_j t e_j / (2 V_i), K_i = rho dp/drho of the pore's liquid-gas mixture
-  // (1/K = alpha/K_q + (1 - alpha)/K_p) at its current state; pores at a prescribed pressure or at
-  // the void floor (whose volume does not follow the grains) add none. A liquid-full pore of a dense
-  // packing adds about 2 Kn of seed 004's law per face: left out, it lets the explicit step blow up
-  // (docs/saturated.md).
+  // (1/K = alpha/K_q + (1 - alpha)/K_p) at its current state; pores at a prescribed pressure add
+  // none. A pore held at the void floor (min_void_relative: its volume does not follow the grains now)
+  // counts as if it had just come off it: the smallest pores are the stiffest springs once they open,
+  // and the step must hold for the whole run (with them left out, the blow-up below came back); one at
+  // the fraction floor (overlapping discs: V = phi x the triangle) with phi of its change. A liquid-full pore of a
+  // dense packing adds about 2 Kn of seed 004's law per face: left out, it lets the explicit step
+  // blow up (docs/saturated.md).
   std::vector<Real> fluid_stiffness() const;
   // Sets every pore's pressure and saturation (tests, initial states).
   void set_uniform_state(Real p, Real saturation);

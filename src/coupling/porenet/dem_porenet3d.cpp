@@ -230,7 +230,7 @@ void DemPorenet3D::load(CheckpointReader& r, const dem::DemSystem& sys, const Po
 // face's outward normal, S_kf = theta R_k^2 / 2 the sphere sector that corner k cuts from f and c_kf its
 // centroid (4 R sin(theta/2) / (3 theta) along the bisector). Without the sectors g would be the bare
 // tetrahedron's, tens of times too large where the spheres fill most of it.
-Vec3 DemPorenet3D::void_gradient(Index j, Index e, const Vec3& a) const {
+Vec3 DemPorenet3D::void_gradient(Index j, Index e, const Vec3& a, bool floored) const {
   const auto& net = *net_;
   const Index i = net.pp_pore[e];
   const int c = net.pp_corner[e];
@@ -238,6 +238,7 @@ Vec3 DemPorenet3D::void_gradient(Index j, Index e, const Vec3& a) const {
   auto pos = [&](Index k) { return Vec3(x_[k], y_[k], z_[k]); };
   // A pore at the fraction floor (overlapping spheres fill the tetrahedron) has V = phi V_tet:
   // g = phi dV_tet/dx_j, no sectors, no patch.
+  if (floored && !(net.pore_void[i] > net.void_floor)) return Vec3::Zero();
   const bool at_fraction = net.pore_void[i] <= net.params.min_void_fraction * net.pore_cell[i];
   Vec3 g = at_fraction ? Vec3::Zero() : a;
   for (int f = 0; f < 3; ++f) {  // face (j, b, d); the corner opposite it is o
@@ -269,7 +270,7 @@ Vec3 DemPorenet3D::void_gradient(Index j, Index e, const Vec3& a) const {
   return g;
 }
 
-std::vector<Real> DemPorenet3D::fluid_stiffness() const {
+std::vector<Real> DemPorenet3D::fluid_stiffness(bool open_floored) const {
   const auto& net = *net_;
   const porenet::Particles3D parts = view();
   std::vector<Real> k(static_cast<std::size_t>(net.n_particles), 0.0);
@@ -277,13 +278,13 @@ std::vector<Real> DemPorenet3D::fluid_stiffness() const {
     Real sum = 0;
     for (Index e = net.pp_start[j]; e < net.pp_start[j + 1]; ++e) {
       const Index i = net.pp_pore[e];
-      if (flow_->bc(i) == porenet::PoreBc::Pressure || !(net.pore_void[i] > net.void_floor)) continue;
+      if (flow_->bc(i) == porenet::PoreBc::Pressure) continue;
       const Real K = flow_->mixture_bulk_modulus(i);
       if (!(K > 0)) continue;
       Real a[3];
       porenet::unit_patch_force_3d(net, parts, j, e, a);
       const Vec3 av(a[0], a[1], a[2]);
-      sum += K * av.norm() * void_gradient(j, e, av).norm() / net.pore_void[i];
+      sum += K * av.norm() * void_gradient(j, e, av, !open_floored).norm() / net.pore_void[i];
     }
     k[static_cast<std::size_t>(j)] = sum;
   }

@@ -71,12 +71,19 @@ class DemPorenet3D {
   // DemPorenetCoupling::fluid_stiffness in 2D): tetrahedron i pushes on sphere j with p_i a_ij
   // (a_ij = porenet::unit_patch_force_3d) and moving j by dx changes V_i by g_ij.dx (void_gradient), so
   // pore i adds K_i a_ij g_ij^T / V_i to j's stiffness; k_j = sum_i K_i |a_ij| |g_ij| / V_i bounds its
-  // largest eigenvalue. K_i the mixture's modulus; pores at a
-  // prescribed pressure or at the void floor (whose volume does not follow the grains) add none.
-  std::vector<Real> fluid_stiffness() const;
+  // largest eigenvalue. K_i the mixture's modulus; pores at a prescribed pressure add none; one at
+  // the fraction floor (overlapping spheres, V = phi V_tet) phi of the tetrahedron's change. A pore held
+  // at void_floor adds none (its void does not move now), or with open_floored as if it had just come
+  // off it (the stiffest spring once it opens: what an explicit flow needs; the implicit flow evens a
+  // small pore out with its neighbours within the step, and the saturated example's step 7.6e-8 s,
+  // above even the instantaneous limit 6.3e-8 s, ran stable to 1.1 % strain, while open_floored gives
+  // 1.1e-8 s: docs/saturated.md).
+  std::vector<Real> fluid_stiffness(bool open_floored) const;
   // dV/dx_j [m^2] of the pore of sphere j's corner entry e (network().pp_pore[e]); a = its patch force
-  // per unit pressure (porenet::unit_patch_force_3d).
-  Vec3 void_gradient(Index j, Index e, const Vec3& a) const;
+  // per unit pressure (porenet::unit_patch_force_3d); phi of the tetrahedron's at the fraction floor
+  // (overlapping spheres: V = phi V_tet). floored = true: 0 at void_floor (the stored void does not
+  // move); false: as if the pore had just come off it.
+  Vec3 void_gradient(Index j, Index e, const Vec3& a, bool floored) const;
   // Sets every pore's pressure and saturation.
   void set_uniform_state(Real p, Real saturation);
   // Pressure (and saturation) at the pores whose centroid is within `radius` of `centre` (injection).

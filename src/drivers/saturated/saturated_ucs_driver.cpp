@@ -269,7 +269,7 @@ class SaturatedUcsRun final : public UcsRun {
   // pore liquid-stiff, the stiffest it gets; a gas cushion stiffens only as it is squeezed).
   void include_fluid_stiffness() {
     ex_.critical_dry = dem::critical_time_step(sys);
-    const auto k = fluid_.dim3() ? fluid_.c3().fluid_stiffness() : fluid_.c2().fluid_stiffness();
+    const auto k = fluid_.dim3() ? fluid_.c3().fluid_stiffness(!fluid_.c3().params().implicit) : fluid_.c2().fluid_stiffness();
     ex_.critical_wet = dem::critical_time_step(sys, k);
     log::info("critical DEM step {:.4g} s with the pore fluid's stiffness ({:.4g} s without){}", ex_.critical_wet,
               ex_.critical_dry, cfg.boolean("fluid.stiffness_in_time_step") ? "" : ": not used (fluid.stiffness_in_time_step = false)");
