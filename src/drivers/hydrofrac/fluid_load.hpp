@@ -36,6 +36,30 @@ struct BoreholeGeometry {
   int dim = 2;
 };
 
+// BoreholeGeometry as a checkpoint section (plain data, written as raw bytes): the driver's and
+// the network fluid's checkpoints hold one each.
+struct BoreholeRecord {
+  Real cx = 0, cy = 0, radius = 0, plen = 0, pwid = 0, paz = 0, z_lo = 0, z_hi = 0;
+  long sides = 2, dim = 2;
+};
+inline BoreholeRecord to_record(const BoreholeGeometry& g) {
+  return {g.centre.x(), g.centre.y(), g.radius, g.perforation_length, g.perforation_width, g.perforation_azimuth,
+          g.z_lo,       g.z_hi,       g.perforation_sides, g.dim};
+}
+inline BoreholeGeometry from_record(const BoreholeRecord& h) {
+  BoreholeGeometry g;
+  g.centre = Vec3(h.cx, h.cy, 0);
+  g.radius = h.radius;
+  g.perforation_length = h.plen;
+  g.perforation_width = h.pwid;
+  g.perforation_azimuth = h.paz;
+  g.z_lo = h.z_lo;
+  g.z_hi = h.z_hi;
+  g.perforation_sides = static_cast<int>(h.sides);
+  g.dim = static_cast<int>(h.dim);
+  return g;
+}
+
 // A bond cut by a natural fracture (zero strength): its two particles' global ids and the bond
 // face area [m^2] (2D: 2 r_bond x 1 m; 3D: pi r_bond^2).
 struct JointPair {

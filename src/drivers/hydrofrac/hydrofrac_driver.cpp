@@ -288,11 +288,6 @@ struct CircleRecord {
   Real xx = 0, yy = 0, xy = 0, zz = 0, k_xx = 0, k_yy = 0, k_xy = 0, pressure = 0;
 };
 
-struct HoleRecord {  // BoreholeGeometry
-  Real cx = 0, cy = 0, radius = 0, plen = 0, pwid = 0, paz = 0, z_lo = 0, z_hi = 0;
-  long sides = 2, dim = 2;
-};
-
 }  // namespace
 }  // namespace ff::drivers
 
@@ -672,9 +667,7 @@ void HydrofracRun::save(const fs::path& dir) {
   dem::save_dem(w, sys);
   w.put_value("hydrofrac.state", st_);
   w.put_value("hydrofrac.sample", sample_record(info));
-  const HoleRecord h{hole_.centre.x(), hole_.centre.y(), hole_.radius, hole_.perforation_length, hole_.perforation_width,
-                     hole_.perforation_azimuth, hole_.z_lo, hole_.z_hi, hole_.perforation_sides, hole_.dim};
-  w.put_value("hydrofrac.hole", h);
+  w.put_value("hydrofrac.hole", hydrofrac::to_record(hole_));
   w.put("hydrofrac.joints", joints_);
   w.put("hydrofrac.insitu", insitu_);
   w.put("hydrofrac.probe", probe_);
@@ -687,16 +680,7 @@ void HydrofracRun::load() {
   dem::load_dem(r, sys);
   st_ = r.get_value<HfState>("hydrofrac.state");
   info = sample_info(r.get_value<SampleRecord>("hydrofrac.sample"));
-  const auto h = r.get_value<HoleRecord>("hydrofrac.hole");
-  hole_.centre = Vec3(h.cx, h.cy, 0);
-  hole_.radius = h.radius;
-  hole_.perforation_length = h.plen;
-  hole_.perforation_width = h.pwid;
-  hole_.perforation_azimuth = h.paz;
-  hole_.z_lo = h.z_lo;
-  hole_.z_hi = h.z_hi;
-  hole_.perforation_sides = static_cast<int>(h.sides);
-  hole_.dim = static_cast<int>(h.dim);
+  hole_ = hydrofrac::from_record(r.get_value<hydrofrac::BoreholeRecord>("hydrofrac.hole"));
   r.get("hydrofrac.joints", joints_);
   r.get("hydrofrac.insitu", insitu_);
   r.get("hydrofrac.probe", probe_);

@@ -23,11 +23,6 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 }
 
 // The borehole geometry as plain numbers (a checkpoint section).
-struct HoleRec {
-  Real cx, cy, radius, plen, pwid, paz, z_lo, z_hi;
-  long sides, dim;
-};
-
 porenet::TwoPhaseParams fluid_params(const NetworkSettings& s) {
   porenet::TwoPhaseParams f;
   f.liquid = porenet::Eos::barotropic(s.density, s.pore_pressure, s.bulk_modulus);
@@ -350,9 +345,7 @@ NetworkBudget NetworkLoad::budget() const {
 void NetworkLoad::save(CheckpointWriter& w) const {
   w.put_value("network.state", st_);
   w.put_value("network.info", info_);
-  const HoleRec h{hole_.centre.x(), hole_.centre.y(), hole_.radius, hole_.perforation_length, hole_.perforation_width,
-                  hole_.perforation_azimuth, hole_.z_lo, hole_.z_hi, hole_.perforation_sides, hole_.dim};
-  w.put_value("network.hole", h);
+  w.put_value("network.hole", to_record(hole_));
   w.put("network.wall", wall_);
   w.put("network.force", force_);
   if (c2_) {
@@ -367,16 +360,7 @@ void NetworkLoad::save(CheckpointWriter& w) const {
 void NetworkLoad::load(CheckpointReader& r, const dem::DemSystem& sys) {
   st_ = r.get_value<State>("network.state");
   info_ = r.get_value<NetworkInfo>("network.info");
-  const auto h = r.get_value<HoleRec>("network.hole");
-  hole_.centre = Vec3(h.cx, h.cy, 0);
-  hole_.radius = h.radius;
-  hole_.perforation_length = h.plen;
-  hole_.perforation_width = h.pwid;
-  hole_.perforation_azimuth = h.paz;
-  hole_.z_lo = h.z_lo;
-  hole_.z_hi = h.z_hi;
-  hole_.perforation_sides = static_cast<int>(h.sides);
-  hole_.dim = static_cast<int>(h.dim);
+  hole_ = from_record(r.get_value<BoreholeRecord>("network.hole"));
   r.get("network.wall", wall_);
   r.get("network.force", force_);
   is_wall_.assign(sys.particles.size(), 0);
