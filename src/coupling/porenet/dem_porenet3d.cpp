@@ -123,8 +123,18 @@ void DemPorenet3D::compute_fluid_forces(Real p_floor) {
 }
 
 void DemPorenet3D::add_forces(dem::DemSystem& sys) {
-  compute_fluid_forces(-std::numeric_limits<Real>::infinity());
   for (std::size_t k = 0; k < fx_.size(); ++k) sys.particles.ext_force[k] += Vec3(fx_[k], fy_[k], fz_[k]);
+}
+
+long DemPorenet3D::choose_flow_every(const dem::DemSystem& sys) const {
+  if (prm_.flow_every > 0) return prm_.flow_every;
+  const auto k = fluid_stiffness(!prm_.implicit);
+  Real t = std::numeric_limits<Real>::infinity();
+  for (std::size_t j = 0; j < k.size(); ++j)
+    if (k[j] > 0) t = std::min(t, std::sqrt(1 / (sys.particles.inv_mass[j] * k[j])));
+  const Real n = std::floor(prm_.flow_safety * t / sys.settings.dt);
+  return std::clamp<long>(std::isfinite(n) ? static_cast<long>(std::min<Real>(n, 1e9)) : prm_.max_flow_every, 1,
+                          std::max<long>(prm_.max_flow_every, 1));
 }
 
 void DemPorenet3D::advance_flow(Real dt) {
@@ -155,12 +165,23 @@ bool DemPorenet3D::sync(const dem::DemSystem& sys) {
 void DemPorenet3D::step(dem::DemSystem& sys) {
   sys.update_neighbors();
   sys.compute_forces();
-  (void)sync(sys);
-  advance_flow(sys.settings.dt);
+  if (stats_.cycle_left <= 0) {  // a flow step for the next N DEM steps
+    (void)sync(sys);
+    if (prm_.flow_every > 0 || stats_.until_choice <= 0) {
+      stats_.flow_every = choose_flow_every(sys);
+      stats_.until_choice = prm_.choose_every;
+    }
+    stats_.until_choice -= stats_.flow_every;
+    stats_.cycle_left = stats_.flow_every;
+    advance_flow(static_cast<Real>(stats_.flow_every) * sys.settings.dt);
+    const auto t1 = std::chrono::steady_clock::now();
+    compute_fluid_forces(-std::numeric_limits<Real>::infinity());
+    stats_.t_forces += seconds_since(t1);
+    ++stats_.flow_steps;
+  }
+  --stats_.cycle_left;
   sys.add_external_loads();
-  const auto t1 = std::chrono::steady_clock::now();
   add_forces(sys);
-  stats_.t_forces += seconds_since(t1);
   sys.integrate();
 }
 
@@ -183,6 +204,9 @@ void DemPorenet3D::save(CheckpointWriter& w) const {
   w.put("porenet3d.rp", vec(flow_->gas_density()));
   w.put("porenet3d.guess", prm_.implicit ? vec(flow_->implicit_guess()) : std::vector<Real>{});
   w.put_value("porenet3d.stats", stats_);
+  w.put("porenet3d.fx", fx_);  // the forces held until the next flow step
+  w.put("porenet3d.fy", fy_);
+  w.put("porenet3d.fz", fz_);
 }
 
 void DemPorenet3D::load(CheckpointReader& r, const dem::DemSystem& sys, const Porenet3DParams& params) {
@@ -220,6 +244,11 @@ void DemPorenet3D::load(CheckpointReader& r, const dem::DemSystem& sys, const Po
   flow_->restore_state(p, a, mq, mp, rq, rp);
   if (prm_.implicit) flow_->restore_implicit_guess(g);
   stats_ = r.get_value<Porenet3DStats>("porenet3d.stats");
+  r.get("porenet3d.fx", fx_);
+  r.get("porenet3d.fy", fy_);
+  r.get("porenet3d.fz", fz_);
+  if (fx_.size() != n || fy_.size() != n || fz_.size() != n)
+    throw InputError(fmt::format("checkpoint: porenet3d forces for {} spheres; the sample has {}", fx_.size(), n));
 }
 
 // dV_i/dx_j of tetrahedral pore i (corner entry e of sphere j) for V = V_tet - sum_k Omega_k R_k^3 / 3

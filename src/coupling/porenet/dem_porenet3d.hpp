@@ -3,11 +3,13 @@
 //
 // One coupled step (DemPorenet3D::step), with the DemSystem's public stages:
 //   update_neighbors(); compute_forces();
+//   every N-th step (Porenet3DParams::flow_every; N = 1 by default), the rest of this list, the
+//   forces then held for N steps:
 //   retriangulate when the largest displacement since the last triangulation exceeds
 //     `retriangulation_tolerance` x the mean radius (phase masses carried over by porenet's remap,
 //     conserving each phase), else update the pore volumes and throats for the moved spheres: the new
 //     void volumes drive the pressure (undrained compaction);
-//   flow over the DEM step: implicit two-phase (one backward-Euler step of dt_dem; default: stiff
+//   flow over the N DEM steps: implicit two-phase (one backward-Euler step of N dt_dem; default: stiff
 //     liquids need no sub-steps) or explicit with n = ceil(dt_dem / (safety dt_stable)) sub-steps;
 //   add_external_loads(); grain forces from the gauge pressure p - p_ambient (pressure integrated over
 //     each sphere's patches inside its tetrahedra, porenet::add_pressure_forces_3d); integrate().
@@ -42,6 +44,17 @@ struct Porenet3DParams {
   Real dt_safety = 0.9;       // explicit: flow sub-step <= safety x stable step
   long max_substeps = 100000;
   bool drained = false;       // true: hull pores held at the ambient pressure (saturation kept)
+  // Sub-cycling (step()): one flow step (network update, flow over N dt_dem, pressure forces) every
+  // N DEM steps, the forces held in between. N = flow_every; 0 = chosen from the fluid's stiffness
+  // (fluid_stiffness, as costly as ~20 DEM steps of a 1000-sphere sample: again at the first flow step
+  // after every `choose_every` DEM steps): N = floor(flow_safety min_j sqrt(m_j / k_j) / dt_dem),
+  // 1 <= N <= max_flow_every (a held force is an explicit spring: stable while N dt <= ~0.3 of the
+  // grain-fluid period, as the hydrofrac network's striding; gas-filled pores are soft, so partly
+  // saturated samples stride far, liquid-full ones hardly).
+  long flow_every = 1;
+  Real flow_safety = 0.3;
+  long max_flow_every = 20;
+  long choose_every = 200;
 };
 
 struct Porenet3DStats {
@@ -49,6 +62,10 @@ struct Porenet3DStats {
   long last_substeps = 0;
   Real max_displacement = 0;  // since the last triangulation [m]
   double t_triangulation = 0, t_update = 0, t_flow = 0, t_forces = 0;  // cumulative wall seconds
+  long flow_every = 1;   // N of the current cycle
+  long cycle_left = 0;   // DEM steps left before the next flow step
+  long flow_steps = 0;   // flow steps so far
+  long until_choice = 0;  // DEM steps before N is chosen again (flow_every = 0)
 };
 
 class DemPorenet3D {
@@ -112,6 +129,7 @@ class DemPorenet3D {
   void retriangulate();
   void flow_step(Real dt);
   void add_forces(dem::DemSystem& sys);
+  long choose_flow_every(const dem::DemSystem& sys) const;
   porenet::Particles3D view() const { return {x_, y_, z_, r_, {}}; }
 
   Porenet3DParams prm_;

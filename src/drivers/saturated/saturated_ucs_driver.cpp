@@ -66,6 +66,12 @@ void declare(ParamTable& t) {
            "time stepping of the pore flow: auto (2D explicit with sub-steps, 3D implicit), explicit or implicit "
            "(3D only: one backward-Euler step per DEM step)")
       .one_of({"auto", "explicit", "implicit"});
+  t.integer("fluid.flow_every", 0, "-",
+            "3D: one flow step (network update, flow, pressure forces) every this many DEM steps, the forces held in "
+            "between; 0 = automatic, re-chosen at each flow step from the fluid's stiffness (0.3 of the stiffest "
+            "grain-fluid period, at most 20: partly saturated samples stride far, saturated ones hardly)")
+      .non_negative()
+      .fallback();
   t.real("fluid.cg_tolerance", 1e-12, "-",
          "3D implicit flow: relative residual of the conjugate-gradient pressure solve (porenet; the phase masses stay "
          "conserved at any value, the channel fluxes being antisymmetric)")
@@ -100,7 +106,7 @@ void declare(ParamTable& t) {
 // them unset unless the user set them.
 const std::vector<std::string> k2DOnly = {"fluid.aperture_h0", "fluid.aperture_hinf", "fluid.aperture_gamma",
                                           "fluid.shear_forces", "fluid.cavitation_pressure", "fluid.force_height"};
-const std::vector<std::string> k3DOnly = {"fluid.pfv_factor", "fluid.cg_tolerance"};
+const std::vector<std::string> k3DOnly = {"fluid.pfv_factor", "fluid.cg_tolerance", "fluid.flow_every"};
 
 porenet::TwoPhaseParams fluid_params(const Config& cfg) {
   porenet::TwoPhaseParams f;
@@ -143,6 +149,7 @@ coupling::Porenet3DParams params_3d(const Config& cfg) {
   p.fluid.cg_tolerance = cfg.real("fluid.cg_tolerance");
   p.retriangulation_tolerance = cfg.real("fluid.retriangulation_tolerance");
   p.implicit = cfg.string("fluid.flow_scheme") != "explicit";
+  p.flow_every = cfg.integer("fluid.flow_every");
   p.drained = false;  // the lateral hull pores only: set by SaturatedUcsRun's on_network
   return p;
 }
@@ -393,6 +400,8 @@ class SaturatedUcsRun final : public UcsRun {
     if (fluid_.dim3()) {
       const auto& c = fluid_.c3();
       f["flow_scheme"] = c.params().implicit ? "implicit" : "explicit";
+      f["flow_steps"] = c.stats().flow_steps;
+      f["flow_every_last"] = c.stats().flow_every;
       f["throats"] = fluid_.network().n_channels();
       f["drained_pores"] = fluid_.drained_pores();
       const auto& s = c.stats();
