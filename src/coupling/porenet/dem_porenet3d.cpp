@@ -167,11 +167,20 @@ void DemPorenet3D::step(dem::DemSystem& sys) {
   sys.compute_forces();
   if (stats_.cycle_left <= 0) {  // a flow step for the next N DEM steps
     (void)sync(sys);
-    if (prm_.flow_every > 0 || stats_.until_choice <= 0) {
-      stats_.flow_every = choose_flow_every(sys);
-      stats_.until_choice = prm_.choose_every;
+    if (prm_.flow_every > 0) {
+      stats_.flow_every = prm_.flow_every;
+    } else {
+      if (stats_.until_choice <= 0) {
+        stats_.stiffness_every = choose_flow_every(sys);
+        stats_.until_choice = prm_.choose_every;
+      }
+      // The flow's own transport limit: a flow step that had to halve itself (s transport sub-steps)
+      // shrinks the next stride by s; one that did not lets it double, up to the stiffness bound.
+      const long s = stats_.flow_steps > 0 ? std::max<long>(stats_.last_substeps, 1) : 1;
+      stats_.flow_every = s > 1 ? std::max<long>(stats_.flow_every / s, 1)
+                                : std::min(stats_.stiffness_every, std::max<long>(2 * stats_.flow_every, 1));
+      stats_.until_choice -= stats_.flow_every;
     }
-    stats_.until_choice -= stats_.flow_every;
     stats_.cycle_left = stats_.flow_every;
     advance_flow(static_cast<Real>(stats_.flow_every) * sys.settings.dt);
     const auto t1 = std::chrono::steady_clock::now();

@@ -50,7 +50,10 @@ struct Porenet3DParams {
   // after every `choose_every` DEM steps): N = floor(flow_safety min_j sqrt(m_j / k_j) / dt_dem),
   // 1 <= N <= max_flow_every (a held force is an explicit spring: stable while N dt <= ~0.3 of the
   // grain-fluid period, as the hydrofrac network's striding; gas-filled pores are soft, so partly
-  // saturated samples stride far, liquid-full ones hardly).
+  // saturated samples stride far, liquid-full ones hardly). Within that bound N starts at 2 and
+  // doubles after each flow step that needed no transport halving; one that needed s sub-steps
+  // divides the next N by s (wide PFV throats: the phases' transport limit is below the DEM step
+  // already, and a 20-fold implicit step exhausted the halvings: "phase masses (0, 0)").
   long flow_every = 1;
   Real flow_safety = 0.3;
   long max_flow_every = 20;
@@ -65,7 +68,8 @@ struct Porenet3DStats {
   long flow_every = 1;   // N of the current cycle
   long cycle_left = 0;   // DEM steps left before the next flow step
   long flow_steps = 0;   // flow steps so far
-  long until_choice = 0;  // DEM steps before N is chosen again (flow_every = 0)
+  long until_choice = 0;  // DEM steps before the stiffness bound is evaluated again (flow_every = 0)
+  long stiffness_every = 1;  // N allowed by the fluid's stiffness (flow_every = 0)
 };
 
 class DemPorenet3D {
