@@ -70,7 +70,7 @@ double psm_cell_fraction(int dim, const Vec3& d, double r) {
 }
 
 template <class L, class T>
-Psm<L, T>::Psm(const Grid& grid, double tau) : grid_(grid), tau_(tau) {
+Psm<L, T>::Psm(const Grid& grid, double tau, PsmWeighting weighting) : grid_(grid), tau_(tau), weighting_(weighting) {
   const CellIndex N = grid_.padded_size();
   for (int q = 0; q < Q; ++q) {
     const int o = L::opp[q];
@@ -237,7 +237,7 @@ void Psm<L, T>::set_particles(const ParticleSet& p) {
 #pragma omp parallel for schedule(static) if (ncell > 16384)
   for (std::int64_t i = 0; i < ncell; ++i) {
     Cell& c = cells_[std::size_t(i)];
-    const double B = psm_weight(std::min(1.0, c.eps), tau_);
+    const double B = psm_weight(std::min(1.0, c.eps), tau_, weighting_);
     c.B = T(B);
     if (c.count == 1) entries_[std::size_t(c.first)].Bs = T(B);  // (most cells: no division)
     else

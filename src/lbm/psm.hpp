@@ -69,8 +69,17 @@ struct ParticleSet {
   }
 };
 
-// Noble & Torczynski's weighting B(eps, tau).
+// Noble & Torczynski's (1998) two weightings of a cell's solid operator: the tau-dependent
+// B(eps, tau) = eps (tau - 1/2) / ((1 - eps) + (tau - 1/2)) (their preferred one, the default), and the
+// linear B = eps. The tau-dependent one is below eps in partly covered cells: narrow throats resist too
+// little and the body force pushes sum (1 - B) > V_f, so a dense packing's permeability comes out 2-3x
+// Kozeny-Carman at 4 cells per radius; the linear one gives -3..+32 % there at tau 0.6 (both grow with
+// tau: docs/coupling.md, "Permeability").
+enum class PsmWeighting : std::uint8_t { TauDependent = 0, Linear = 1 };
 inline double psm_weight(double eps, double tau) { return eps * (tau - 0.5) / ((1.0 - eps) + (tau - 0.5)); }
+inline double psm_weight(double eps, double tau, PsmWeighting w) {
+  return w == PsmWeighting::Linear ? eps : psm_weight(eps, tau);
+}
 
 // Covered fraction of the unit cell centred at `d` (cell centre minus particle centre) by a disk
 // (dim 2, d[2] ignored) or sphere of radius r (plane approximation above).
@@ -80,7 +89,7 @@ template <class L, class T>
 class Psm {
  public:
   static constexpr int Q = L::Q;
-  Psm(const Grid& grid, double tau);
+  Psm(const Grid& grid, double tau, PsmWeighting weighting = PsmWeighting::TauDependent);
 
   // Which cells may be covered, set by the solver once per geometry: per padded cell the bulk span
   // that updates it (>= 0), kBoundaryCell, or kNotFluid (solid or ghost, never covered).
@@ -132,6 +141,7 @@ class Psm {
   };
   Grid grid_;
   double tau_;
+  PsmWeighting weighting_ = PsmWeighting::TauDependent;
   std::vector<std::int32_t> span_of_;    // per padded cell (set_cell_spans)
   std::vector<std::int32_t> span_first_, span_count_;  // per span: its covered cells in bulk_
   std::vector<std::int32_t> touched_;    // spans with covered cells (cleared by the next set)

@@ -443,7 +443,7 @@ void Solver<L, T>::restore_particles(const ParticleSet& last) {
 template <class L, class T>
 void Solver<L, T>::set_particles(const ParticleSet& p) {
   if (settings_.particle_scheme != ParticleScheme::Psm) return moving_particles(p, true);
-  if (!psm_) psm_ = std::make_unique<Psm<L, T>>(grid_, settings_.tau);
+  if (!psm_) psm_ = std::make_unique<Psm<L, T>>(grid_, settings_.tau, settings_.psm_weighting);
   if (psm_kinds_stale_) {
     std::vector<std::int32_t> span_of(std::size_t(n_()), Psm<L, T>::kNotFluid);
     for (std::size_t s = 0; s < spans_.size(); ++s)

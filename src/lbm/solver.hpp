@@ -72,6 +72,7 @@ struct SolverSettings {
   bool incompressible = false;
   // How set_particles() puts moving particles into the fluid (lbm/moving_boundary.hpp), fixed per solver.
   ParticleScheme particle_scheme = ParticleScheme::Psm;
+  PsmWeighting psm_weighting = PsmWeighting::TauDependent;  // the PSM's B (lbm/psm.hpp)
 };
 
 // A solid body (or a wall of the box) and the hydrodynamic load on it.

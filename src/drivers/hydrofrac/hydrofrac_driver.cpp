@@ -125,6 +125,11 @@ void declare(ParamTable& t) {
            "lbm: particles in the fluid: interpolated (Bouzidi bounce-back, solid cells), stairwise (half-way "
            "bounce-back), psm (partially saturated cells: intact rock leaks, docs/coupling.md)")
       .one_of({"interpolated", "stairwise", "psm"});
+  t.string("fluid.psm_weighting", "tau",
+           "lbm, scheme psm: Noble & Torczynski's weighting of a partly covered cell, tau (B(eps, tau), their "
+           "preferred one) or linear (B = eps: tighter throats; at tau 0.6 a sphere packing's permeability within "
+           "-3..+32 % of Kozeny-Carman at 4 cells per radius, where tau gives +97..+181 %; docs/coupling.md)")
+      .one_of({"tau", "linear"});
   t.boolean("fluid.moving_walls", false,
             "lbm: the particles' velocities enter the fluid's wall condition (false: quasi-static walls; true diverged "
             "on the test block, docs/hydrofrac.md)");
@@ -421,6 +426,7 @@ void HydrofracRun::make_fluid() {
   l.scheme = scheme == "psm"         ? lbm::ParticleScheme::Psm
              : scheme == "stairwise" ? lbm::ParticleScheme::StairwiseBounceBack
                                      : lbm::ParticleScheme::InterpolatedBounceBack;
+  l.psm_weighting = cfg.string("fluid.psm_weighting") == "linear" ? lbm::PsmWeighting::Linear : lbm::PsmWeighting::TauDependent;
   l.moving_walls = cfg.boolean("fluid.moving_walls");
   l.rate_mode = s.rate_mode;
   l.ramp_rate = s.ramp_rate;

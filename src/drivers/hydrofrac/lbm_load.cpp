@@ -284,6 +284,7 @@ class LbmLoad final : public LbmLoadBase {
     ss.collision = lbm::CollisionModel::Trt;
     ss.tau = info_.scales.units.tau();
     ss.particle_scheme = s_.scheme;
+    ss.psm_weighting = s_.psm_weighting;
     lbm::Grid g(L::D, info_.n[0], info_.n[1], info_.n[2], {false, false, false});
     fluid_ = std::make_unique<Solver>(g, ss);
     fluid_->finalize();

@@ -37,6 +37,7 @@ namespace ff::drivers::hydrofrac {
 struct LbmSettings {
   coupling::FluidSpec fluid;  // dx and one of bulk_modulus / sound_speed / time_step / tau set
   lbm::ParticleScheme scheme = lbm::ParticleScheme::InterpolatedBounceBack;
+  lbm::PsmWeighting psm_weighting = lbm::PsmWeighting::TauDependent;
   bool rate_mode = false;
   Real ramp_rate = 0, initial_pressure = 0, flow_rate = 0;  // [Pa/s], [Pa], [m^3/s] (2D: per metre)
   Real cell = 0, inflate = 0, reach = 0;                    // wall particles (hole_surface)
