@@ -38,10 +38,12 @@ inline void add_particle(dem::DemSystem& s, const Vec3& x, double r, const Vec3&
 }
 
 template <class L>
-lbm::Solver<L, double> make_fluid(const FluidScales& sc, int nx, int ny, int nz, std::array<bool, 3> periodic) {
+lbm::Solver<L, double> make_fluid(const FluidScales& sc, int nx, int ny, int nz, std::array<bool, 3> periodic,
+                                  lbm::PsmWeighting w = lbm::PsmWeighting::TauDependent) {
   lbm::Grid g(L::D, nx, ny, nz, periodic);
   lbm::SolverSettings st;
   st.tau = sc.units.tau();
+  st.psm_weighting = w;
   return lbm::Solver<L, double>(g, st);
 }
 
