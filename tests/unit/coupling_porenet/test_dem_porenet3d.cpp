@@ -161,6 +161,27 @@ std::vector<Real> state_of(const dem::DemSystem& sys, DemPorenet3D& c) {
   return v;
 }
 
+// Checkpoints (DEM + coupling) `sys` and `c`, loads both into a fresh specimen, runs it `steps` more
+// steps and returns its state.
+std::vector<Real> resumed_state(const dem::DemSystem& sys, const DemPorenet3D& c, const Porenet3DParams& prm,
+                                int steps, const std::string& file) {
+  const auto path = std::filesystem::temp_directory_path() / file;
+  {
+    CheckpointWriter w(path);
+    dem::save_dem(w, sys);
+    c.save(w);
+    w.commit();
+  }
+  auto resumed = specimen(0, 1);
+  CheckpointReader r(path);
+  dem::load_dem(r, resumed->sys);
+  DemPorenet3D c2;
+  c2.load(r, resumed->sys, prm);
+  c2.run(resumed->sys, steps);
+  std::filesystem::remove(path);
+  return state_of(resumed->sys, c2);
+}
+
 // Sub-cycling (Porenet3DParams::flow_every = 0: N from the fluid's stiffness, growing 2, 4, 8, 16, 20
 // while the flow needs no transport halving). Closed sample compacted at 0.05 m/s for 400 DEM steps.
 // Half gas (ideal, soft): N reaches the cap (20) and the mean pressure rise stays within 1 % of the
@@ -232,21 +253,8 @@ TEST(CouplingPorenet3D, SubCyclingFromTheFluidStiffness) {
   c1.init(one->sys, prm);
   c1.run(one->sys, 215);
   EXPECT_GT(c1.stats().cycle_left, 0);  // mid-cycle
-  const auto path = std::filesystem::temp_directory_path() / "ff_coupling_porenet3d_cycle.ckpt";
-  {
-    CheckpointWriter w(path);
-    dem::save_dem(w, one->sys);
-    c1.save(w);
-    w.commit();
-  }
-  auto resumed = specimen(0, 1);
-  CheckpointReader r(path);
-  dem::load_dem(r, resumed->sys);
-  DemPorenet3D c2;
-  c2.load(r, resumed->sys, prm);
-  c2.run(resumed->sys, 185);
-  EXPECT_EQ(state_of(resumed->sys, c2), state_of(ref->sys, cref)) << "resumed mid-cycle vs uninterrupted";
-  std::filesystem::remove(path);
+  EXPECT_EQ(resumed_state(one->sys, c1, prm, 185, "ff_coupling_porenet3d_cycle.ckpt"), state_of(ref->sys, cref))
+      << "resumed mid-cycle vs uninterrupted";
 }
 
 // Resume from a checkpoint (DEM + network + fluid) continues bit-for-bit; 1 and 2 threads agree.
@@ -267,22 +275,10 @@ TEST(CouplingPorenet3D, CheckpointResumeAndThreadsBitIdentical) {
   DemPorenet3D c1;
   c1.init(one->sys, prm);
   c1.run(one->sys, n1);
-  const auto path = std::filesystem::temp_directory_path() / "ff_coupling_porenet3d_test.ckpt";
   {
-    CheckpointWriter w(path);
-    dem::save_dem(w, one->sys);
-    c1.save(w);
-    w.commit();
-  }
-  auto resumed = specimen(0, 1);
-  {
-    CheckpointReader r(path);
-    dem::load_dem(r, resumed->sys);
-    DemPorenet3D c2;
-    c2.load(r, resumed->sys, prm);
-    c2.run(resumed->sys, n2);
+    const auto b = resumed_state(one->sys, c1, prm, n2, "ff_coupling_porenet3d_test.ckpt");
     c1.run(one->sys, n2);
-    const auto b = state_of(resumed->sys, c2), d = state_of(one->sys, c1);
+    const auto d = state_of(one->sys, c1);
     ASSERT_EQ(a.size(), d.size());
     ASSERT_EQ(b.size(), d.size());
     long diff_resume = 0, diff_threads = 0;
@@ -295,7 +291,6 @@ TEST(CouplingPorenet3D, CheckpointResumeAndThreadsBitIdentical) {
     EXPECT_EQ(diff_resume, 0) << "resumed vs uninterrupted";
     EXPECT_EQ(diff_threads, 0) << "2 threads vs 1 thread";
   }
-  std::filesystem::remove(path);
   omp_set_num_threads(2);
 }
 
