@@ -290,7 +290,8 @@ int run_validate(Args a) {
   const Case& c0 = cases.front();
   md += fmt::format(
       "**Specimen.** {:.0f} x {:.0f} mm box of {} bonded discs (radii {:.2f}-{:.2f} mm, {} cohesive bonds), "
-      "{} packing(s) (sample.seed {}..{}), neighbours closer than {:.3f} mm bonded. Seed 004's DEM law (Appendix A, A1-A7; `dem.contact_law = dem.bond_law = "
+      "{} packing(s) (sample.seed {}..{}), neighbours closer than {:.3f} mm bonded. Seed 004's DEM law (Appendix A, "
+      "A1-A7; `dem.contact_law = dem.bond_law = "
       "\"cohesive\"`, src/dem/bond/cohesive_bond.hpp): Ec = 11.3 GPa, Ks/Kn = 0.2, tan(mu_c) = 0.325 (18 deg), "
       "C = 140 MPa, T = 25 MPa, alpha_d = 0.08. Platens {:g} m/s each (strain rate {:.2g} 1/s), lateral faces "
       "drained at 0.1 MPa, platens impermeable. Pore network of seed 004 (B1-B28): water as a barotropic liquid "

@@ -173,24 +173,25 @@ DemSettings build_settings(const Config& cfg) {
   return s;
 }
 
-void choose_time_step(const Config& cfg, DemSystem& sys) {
+void choose_time_step(const Config& cfg, DemSystem& sys, std::span<const Real> extra_stiffness) {
   const Real safety = cfg.real("dem.time_step_safety");
   const Real dt_user = cfg.real("dem.time_step");
-  const Real crit = critical_time_step(sys);
+  const Real crit = critical_time_step(sys, extra_stiffness);
+  const char* with = extra_stiffness.empty() ? "" : " with the coupled fluid's stiffness";
   if (dt_user <= 0) {
     sys.settings.dt = safety * crit;
   } else if (cfg.boolean("dem.mass_scaling")) {
-    scale_masses_for(sys, dt_user, safety);
+    scale_masses_for(sys, dt_user, safety, extra_stiffness);
     sys.settings.dt = dt_user;
   } else {
     if (dt_user > safety * crit)
       cfg.fail("dem.time_step",
-               fmt::format("{:.4g} s is above the stable limit {:.4g} s ({} x critical time step {:.4g} s of this sample); "
-                           "set dem.time_step = 0 for automatic, a value <= {:.4g}, or dem.mass_scaling = true",
-                           dt_user, safety * crit, safety, crit, safety * crit));
+               fmt::format("{:.4g} s is above the stable limit {:.4g} s ({} x critical time step {:.4g} s of this "
+                           "sample{}); set dem.time_step = 0 for automatic, a value <= {:.4g}, or dem.mass_scaling = true",
+                           dt_user, safety * crit, safety, crit, with, safety * crit));
     sys.settings.dt = dt_user;
   }
-  log::info("time step {:.4g} s (critical {:.4g} s{})", sys.settings.dt, crit,
+  log::info("time step {:.4g} s (critical {:.4g} s{}{})", sys.settings.dt, crit, with,
             cfg.boolean("dem.mass_scaling") && dt_user > 0 ? ", inertial masses scaled" : "");
 }
 

@@ -19,6 +19,18 @@ void check(const Network2D& net, const Particles2D& p, std::span<const Real> pp,
 }
 }  // namespace
 
+void arc_span_2d(const Network2D& net, const Particles2D& p, Index j, Index e, Real& dx, Real& dy) {
+  const Index k = net.pp_pore[e];
+  const int c = net.pp_corner[e];
+  const Index b = net.pore_v[3 * k + (c + 1) % 3], d = net.pore_v[3 * k + (c + 2) % 3];
+  Real u1x = p.x[b] - p.x[j], u1y = p.y[b] - p.y[j];
+  Real u2x = p.x[d] - p.x[j], u2y = p.y[d] - p.y[j];
+  const Real l1 = std::hypot(u1x, u1y), l2 = std::hypot(u2x, u2y);
+  u1x /= l1, u1y /= l1, u2x /= l2, u2y /= l2;
+  dx = u2x - u1x;
+  dy = u2y - u1y;
+}
+
 void add_pressure_forces(const Network2D& net, const Particles2D& p, std::span<const Real> P, std::span<Real> fx,
                          std::span<Real> fy) {
   check(net, p, P, fx, fy);
@@ -26,17 +38,12 @@ void add_pressure_forces(const Network2D& net, const Particles2D& p, std::span<c
   for (Index j = 0; j < net.n_particles; ++j) {
     Real sx = 0, sy = 0;
     for (Index e = net.pp_start[j]; e < net.pp_start[j + 1]; ++e) {
-      const Index k = net.pp_pore[e];
-      const int c = net.pp_corner[e];
-      const Index b = net.pore_v[3 * k + (c + 1) % 3], d = net.pore_v[3 * k + (c + 2) % 3];
-      Real u1x = p.x[b] - p.x[j], u1y = p.y[b] - p.y[j];
-      Real u2x = p.x[d] - p.x[j], u2y = p.y[d] - p.y[j];
-      const Real l1 = std::hypot(u1x, u1y), l2 = std::hypot(u2x, u2y);
-      u1x /= l1, u1y /= l1, u2x /= l2, u2y /= l2;
+      Real dx, dy;
+      arc_span_2d(net, p, j, e, dx, dy);
       // B26–B27: -P * 2 r * int_arc n dl.
-      const Real w = -P[k] * 2 * p.radius[j] * p.radius[j];
-      sx += w * (u2y - u1y);
-      sy += w * (u1x - u2x);
+      const Real w = -P[net.pp_pore[e]] * 2 * p.radius[j] * p.radius[j];
+      sx += w * dy;
+      sy += w * -dx;
     }
     fx[j] += sx;
     fy[j] += sy;

@@ -17,6 +17,10 @@ namespace ff::porenet {
 
 void add_pressure_forces(const Network2D& net, const Particles2D& particles, std::span<const Real> pore_pressure,
                          std::span<Real> fx, std::span<Real> fy);
+// u2 - u1 for disc j's pore-corner entry e (net.pp_pore[e]): u1, u2 the unit vectors from j's centre to
+// the triangle's other two corners (counter-clockwise). int_arc n dl = R rot(-90 deg)(u2 - u1), so the
+// arc's chord is R |u2 - u1| (add_pressure_forces; the coupling's fluid stiffness).
+void arc_span_2d(const Network2D& net, const Particles2D& particles, Index j, Index e, Real& dx, Real& dy);
 void add_shear_forces(const Network2D& net, const Particles2D& particles, std::span<const Real> pore_pressure,
                       std::span<Real> fx, std::span<Real> fy);
 

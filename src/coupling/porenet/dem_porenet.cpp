@@ -422,6 +422,7 @@ std::vector<Real> DemPorenetCoupling::fluid_stiffness() const {
   for (Index i = 0; i < net.n_pores(); ++i)
     if (flow_->bc(i) != porenet::PoreBc::Pressure) K[static_cast<std::size_t>(i)] = flow_->mixture_bulk_modulus(i);
   const Real t = prm_.network.thickness;
+  const porenet::Particles2D parts{x_, y_, r_, {}};
   std::vector<Real> k(static_cast<std::size_t>(net.n_particles), 0.0);
   for (Index j = 0; j < net.n_particles; ++j) {
     const Real h = prm_.force_height == ForceHeight::Diameter ? 2 * r_[j] : t;
@@ -430,12 +431,13 @@ std::vector<Real> DemPorenetCoupling::fluid_stiffness() const {
       const Index i = net.pp_pore[e];
       const int c = net.pp_corner[e];
       const Index b = net.pore_v[3 * i + (c + 1) % 3], d = net.pore_v[3 * i + (c + 2) % 3];
-      const Real l1 = std::hypot(x_[b] - x_[j], y_[b] - y_[j]), l2 = std::hypot(x_[d] - x_[j], y_[d] - y_[j]);
-      const Real chord = r_[j] * std::hypot((x_[d] - x_[j]) / l2 - (x_[b] - x_[j]) / l1,
-                                            (y_[d] - y_[j]) / l2 - (y_[b] - y_[j]) / l1);
+      Real dx, dy;
+      porenet::arc_span_2d(net, parts, j, e, dx, dy);
+      const Real chord = r_[j] * std::hypot(dx, dy);
       // At the fraction floor (overlapping discs, V = phi x the triangle) phi of the triangle's change.
       const Real edge = std::hypot(x_[d] - x_[b], y_[d] - y_[b]);
-      const Real phi = net.pore_void[i] <= net.params.min_void_fraction * net.pore_cell[i] ? net.params.min_void_fraction : 1.0;
+      const Real phi =
+          net.pore_void[i] <= net.params.min_void_fraction * net.pore_cell[i] ? net.params.min_void_fraction : 1.0;
       sum += K[static_cast<std::size_t>(i)] * h * chord * t * phi * edge / (2 * net.pore_void[i]);
     }
     k[static_cast<std::size_t>(j)] = sum;

@@ -127,7 +127,6 @@ void DemPorenet3D::add_forces(dem::DemSystem& sys) {
 }
 
 long DemPorenet3D::choose_flow_every(const dem::DemSystem& sys) const {
-  if (prm_.flow_every > 0) return prm_.flow_every;
   const auto k = fluid_stiffness(!prm_.implicit);
   Real t = std::numeric_limits<Real>::infinity();
   for (std::size_t j = 0; j < k.size(); ++j)

@@ -133,7 +133,7 @@ class DemPorenet3D {
   void retriangulate();
   void flow_step(Real dt);
   void add_forces(dem::DemSystem& sys);
-  long choose_flow_every(const dem::DemSystem& sys) const;
+  long choose_flow_every(const dem::DemSystem& sys) const;  // the stiffness bound on N (flow_every = 0)
   porenet::Particles3D view() const { return {x_, y_, z_, r_, {}}; }
 
   Porenet3DParams prm_;

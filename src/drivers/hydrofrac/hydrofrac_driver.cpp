@@ -426,7 +426,8 @@ void HydrofracRun::make_fluid() {
   l.scheme = scheme == "psm"         ? lbm::ParticleScheme::Psm
              : scheme == "stairwise" ? lbm::ParticleScheme::StairwiseBounceBack
                                      : lbm::ParticleScheme::InterpolatedBounceBack;
-  l.psm_weighting = cfg.string("fluid.psm_weighting") == "linear" ? lbm::PsmWeighting::Linear : lbm::PsmWeighting::TauDependent;
+  l.psm_weighting =
+      cfg.string("fluid.psm_weighting") == "linear" ? lbm::PsmWeighting::Linear : lbm::PsmWeighting::TauDependent;
   l.moving_walls = cfg.boolean("fluid.moving_walls");
   l.rate_mode = s.rate_mode;
   l.ramp_rate = s.ramp_rate;

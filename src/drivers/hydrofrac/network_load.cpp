@@ -22,7 +22,6 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// The borehole geometry as plain numbers (a checkpoint section).
 porenet::TwoPhaseParams fluid_params(const NetworkSettings& s) {
   porenet::TwoPhaseParams f;
   f.liquid = porenet::Eos::barotropic(s.density, s.pore_pressure, s.bulk_modulus);

@@ -68,8 +68,9 @@ void declare(ParamTable& t) {
       .one_of({"auto", "explicit", "implicit"});
   t.integer("fluid.flow_every", 0, "-",
             "3D: one flow step (network update, flow, pressure forces) every this many DEM steps, the forces held in "
-            "between; 0 = automatic, re-chosen at each flow step from the fluid's stiffness (0.3 of the stiffest "
-            "grain-fluid period, at most 20: partly saturated samples stride far, saturated ones hardly)")
+            "between; 0 = automatic: at most 0.3 of the stiffest grain-fluid period (re-evaluated every 200 DEM "
+            "steps) and 20, doubling from 2 while the flow needs no transport halving, divided by its halvings "
+            "otherwise (partly saturated samples stride far, saturated ones hardly)")
       .non_negative()
       .fallback();
   t.real("fluid.cg_tolerance", 1e-12, "-",
@@ -276,25 +277,13 @@ class SaturatedUcsRun final : public UcsRun {
   // pore liquid-stiff, the stiffest it gets; a gas cushion stiffens only as it is squeezed).
   void include_fluid_stiffness() {
     ex_.critical_dry = dem::critical_time_step(sys);
-    const auto k = fluid_.dim3() ? fluid_.c3().fluid_stiffness(!fluid_.c3().params().implicit) : fluid_.c2().fluid_stiffness();
+    const auto k =
+        fluid_.dim3() ? fluid_.c3().fluid_stiffness(!fluid_.c3().params().implicit) : fluid_.c2().fluid_stiffness();
     ex_.critical_wet = dem::critical_time_step(sys, k);
+    const bool use = cfg.boolean("fluid.stiffness_in_time_step");
     log::info("critical DEM step {:.4g} s with the pore fluid's stiffness ({:.4g} s without){}", ex_.critical_wet,
-              ex_.critical_dry, cfg.boolean("fluid.stiffness_in_time_step") ? "" : ": not used (fluid.stiffness_in_time_step = false)");
-    if (!cfg.boolean("fluid.stiffness_in_time_step")) return;
-    const Real safety = cfg.real("dem.time_step_safety"), dt_user = cfg.real("dem.time_step");
-    if (dt_user <= 0) {
-      sys.settings.dt = safety * ex_.critical_wet;
-    } else if (cfg.boolean("dem.mass_scaling")) {
-      dem::scale_masses_for(sys, dt_user, safety, k);
-    } else if (dt_user > safety * ex_.critical_wet) {
-      cfg.fail("dem.time_step",
-               fmt::format("{:.4g} s is above the stable limit {:.4g} s of the saturated sample ({} x critical step {:.4g} s "
-                           "with the pore fluid's stiffness; {:.4g} s dry); set dem.time_step = 0 for automatic, a value "
-                           "<= {:.4g}, or dem.mass_scaling = true",
-                           dt_user, safety * ex_.critical_wet, safety, ex_.critical_wet, ex_.critical_dry,
-                           safety * ex_.critical_wet));
-    }
-    log::info("DEM time step {:.4g} s", sys.settings.dt);
+              ex_.critical_dry, use ? "" : ": not used (fluid.stiffness_in_time_step = false)");
+    if (use) dem::choose_time_step(cfg, sys, k);
   }
   void dem_step() override { fluid_.step(sys); }
   void after_step() override {

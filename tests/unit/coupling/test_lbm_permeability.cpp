@@ -169,8 +169,8 @@ std::vector<double> check(ParticleScheme scheme, const std::vector<Case>& cases,
     errs.push_back(err);
     std::printf("%s%s n = %d, %d spheres, d = %.0f, tau = %.2f: porosity %.4f, k = %.5g, k_KC = %.5g (%+.1f%%), "
                 "sum F / (g V_f) = %.4f, Re = %.2g, %ld steps, %.1f s (set-up and packing %.1f s)\n",
-                particle_scheme_name(scheme), w == PsmWeighting::Linear ? " (B = eps)" : "", c.n, c.N, c.d, tau, r.porosity, r.k, r.k_kc, 100 * err, r.force_balance,
-                r.re, r.steps, r.seconds, r.packing_seconds);
+                particle_scheme_name(scheme), w == PsmWeighting::Linear ? " (B = eps)" : "", c.n, c.N, c.d, tau,
+                r.porosity, r.k, r.k_kc, 100 * err, r.force_balance, r.re, r.steps, r.seconds, r.packing_seconds);
     EXPECT_GT(r.steps, 0) << "not steady";
     EXPECT_LT(r.re, 0.1);
     // Bounce-back pushes the fluid cells only: the particles take g times their volume (digitised).
