@@ -9,6 +9,7 @@
 // Forces are added to fx, fy [N] (one entry per particle); each particle sums its own pores and
 // channels in CSR order, so the result is independent of the thread count.
 #pragma once
+#include <cmath>
 #include <span>
 
 #include "porenet/network.hpp"
@@ -20,16 +21,27 @@ void add_pressure_forces(const Network2D& net, const Particles2D& particles, std
 // u2 - u1 for disc j's pore-corner entry e (net.pp_pore[e]): u1, u2 the unit vectors from j's centre to
 // the triangle's other two corners (counter-clockwise). int_arc n dl = R rot(-90 deg)(u2 - u1), so the
 // arc's chord is R |u2 - u1| (add_pressure_forces; the coupling's fluid stiffness).
-void arc_span_2d(const Network2D& net, const Particles2D& particles, Index j, Index e, Real& dx, Real& dy);
+inline void arc_span_2d(const Network2D& net, const Particles2D& p, Index j, Index e, Real& dx, Real& dy) {
+  const Index k = net.pp_pore[e];
+  const int c = net.pp_corner[e];
+  const Index b = net.pore_v[3 * k + (c + 1) % 3], d = net.pore_v[3 * k + (c + 2) % 3];
+  Real u1x = p.x[b] - p.x[j], u1y = p.y[b] - p.y[j];
+  Real u2x = p.x[d] - p.x[j], u2y = p.y[d] - p.y[j];
+  const Real l1 = std::hypot(u1x, u1y), l2 = std::hypot(u2x, u2y);
+  u1x /= l1, u1y /= l1, u2x /= l2, u2y /= l2;
+  dx = u2x - u1x;
+  dy = u2y - u1y;
+}
+
 void add_shear_forces(const Network2D& net, const Particles2D& particles, std::span<const Real> pore_pressure,
                       std::span<Real> fx, std::span<Real> fy);
 
 // 3D (PFV-style integration over the sphere surface; forces.cpp): pressure on the spherical patches of
 // each sphere inside its tetrahedra, added to fx, fy, fz [N].
-// The force on sphere j per unit pressure in the tetrahedron of its pore-corner entry e (net.pp_pore[e])
-// [m^2]: sum_f n_f theta_f R^2 / 2 (below); add_pressure_forces_3d sums P_k times it.
-void unit_patch_force_3d(const Network2D& net, const Particles3D& particles, Index j, Index e, Real out[3]);
 void add_pressure_forces_3d(const Network2D& net, const Particles3D& particles, std::span<const Real> pore_pressure,
                             std::span<Real> fx, std::span<Real> fy, std::span<Real> fz);
+// The force on sphere j per unit pressure in the tetrahedron of its pore-corner entry e (net.pp_pore[e])
+// [m^2]: sum_f n_f theta_f R^2 / 2 (forces.cpp); add_pressure_forces_3d sums P_k times it.
+void unit_patch_force_3d(const Network2D& net, const Particles3D& particles, Index j, Index e, Real out[3]);
 
 }  // namespace ff::porenet
