@@ -66,9 +66,9 @@ void declare(ParamTable& t) {
            "time stepping of the pore flow: auto (2D explicit with sub-steps, 3D implicit), explicit or implicit "
            "(3D only: one backward-Euler step per DEM step)")
       .one_of({"auto", "explicit", "implicit"});
-  t.integer("fluid.flow_every", 0, "-",
+  t.integer("fluid.flow_every", 1, "-",
             "3D: one flow step (network update, flow, pressure forces) every this many DEM steps, the forces held in "
-            "between; 0 = automatic: at most 0.3 of the stiffest grain-fluid period (re-evaluated every 200 DEM "
+            "between (1: every step, the default: a run resumed mid-cycle with 0 is not yet bit-for-bit); 0 = automatic: at most 0.3 of the stiffest grain-fluid period (re-evaluated every 200 DEM "
             "steps) and 20, doubling from 2 while the flow needs no transport halving, divided by its halvings "
             "otherwise (partly saturated samples stride far, saturated ones hardly)")
       .non_negative()
