@@ -66,11 +66,11 @@ void declare(ParamTable& t) {
            "time stepping of the pore flow: auto (2D explicit with sub-steps, 3D implicit), explicit or implicit "
            "(3D only: one backward-Euler step per DEM step)")
       .one_of({"auto", "explicit", "implicit"});
-  t.integer("fluid.flow_every", 1, "-",
+  t.integer("fluid.flow_every", 0, "-",
             "3D: one flow step (network update, flow, pressure forces) every this many DEM steps, the forces held in "
-            "between (1: every step, the default: a run resumed mid-cycle with 0 is not yet bit-for-bit); 0 = automatic: at most 0.3 of the stiffest grain-fluid period (re-evaluated every 200 DEM "
-            "steps) and 20, doubling from 2 while the flow needs no transport halving, divided by its halvings "
-            "otherwise (partly saturated samples stride far, saturated ones hardly)")
+            "between (1: every step); 0 = automatic: at most 0.3 of the stiffest grain-fluid period (re-evaluated "
+            "every 200 DEM steps) and 20, doubling from 2 while the flow needs no transport halving, divided by its "
+            "halvings otherwise (partly saturated samples stride far, saturated ones hardly)")
       .non_negative()
       .fallback();
   t.real("fluid.cg_tolerance", 1e-12, "-",
@@ -163,11 +163,19 @@ struct SatExtra {
   Real critical_dry = 0, critical_wet = 0;  // DEM critical step without / with the pore fluid [s]
 };
 
+// 3D, drained sides: the sample's extent along the loading axis at the start and its largest radius.
+// Fixed for the run (every rebuild of the network drains the same band) and checkpointed: taken
+// again from the positions at a resume, it would drain other pores than the uninterrupted run.
+struct DrainBand {
+  Real lo = 0, hi = 0, rmax = 0;  // [m]
+};
+
 }  // namespace
 }  // namespace ff::drivers
 
 namespace ff {
 template <> struct is_checkpoint_pod<drivers::SatExtra> : std::true_type {};
+template <> struct is_checkpoint_pod<drivers::DrainBand> : std::true_type {};
 }  // namespace ff
 
 namespace ff::drivers {
@@ -177,18 +185,26 @@ namespace {
 class PoreFluid {
  public:
   void init(dem::DemSystem& sys, const Config& cfg, const dem::SampleInfo& info) {
-    setup(sys, cfg, info);
+    dim3_ = info.dim == 3;
+    if (dim3_) band_ = drain_band(sys, info.axis);
+    setup(cfg, info);
     if (dim3_) c3_.init(sys, params_3d(cfg));
     else c2_.init(sys, coupling_params(cfg));
   }
   void load(CheckpointReader& r, dem::DemSystem& sys, const Config& cfg, const dem::SampleInfo& info) {
-    setup(sys, cfg, info);
+    dim3_ = info.dim == 3;
+    if (dim3_) band_ = r.get_value<DrainBand>("saturated.drain_band");
+    setup(cfg, info);
     if (dim3_) c3_.load(r, sys, params_3d(cfg));
     else c2_.load(r, sys, coupling_params(cfg));
   }
   void save(CheckpointWriter& w) const {
-    if (dim3_) c3_.save(w);
-    else c2_.save(w);
+    if (dim3_) {
+      w.put_value("saturated.drain_band", band_);
+      c3_.save(w);
+    } else {
+      c2_.save(w);
+    }
   }
   void step(dem::DemSystem& sys) {
     if (dim3_) c3_.step(sys);
@@ -218,26 +234,29 @@ class PoreFluid {
   }
 
  private:
-  void setup(const dem::DemSystem& sys, const Config& cfg, const dem::SampleInfo& info) {
-    dim3_ = info.dim == 3;
+  static DrainBand drain_band(const dem::DemSystem& sys, int axis) {
+    DrainBand b{std::numeric_limits<Real>::infinity(), -std::numeric_limits<Real>::infinity(), 0};
+    for (std::size_t k = 0; k < sys.particles.size(); ++k) {
+      b.rmax = std::max(b.rmax, sys.particles.radius[k]);
+      b.lo = std::min(b.lo, sys.particles.pos[k][axis]);
+      b.hi = std::max(b.hi, sys.particles.pos[k][axis]);
+    }
+    return b;
+  }
+  void setup(const Config& cfg, const dem::SampleInfo& info) {
     if (!dim3_) return;
     // Sides drained: hull pores whose centroid is more than two max radii from both ends of the
     // sample along the loading axis (the platens are impermeable), at every (re)build.
-    Real rmax = 0, lo = std::numeric_limits<Real>::infinity(), hi = -lo;
-    for (std::size_t k = 0; k < sys.particles.size(); ++k) {
-      rmax = std::max(rmax, sys.particles.radius[k]);
-      lo = std::min(lo, sys.particles.pos[k][info.axis]);
-      hi = std::max(hi, sys.particles.pos[k][info.axis]);
-    }
     if (cfg.string("fluid.drainage") != "sides") return;
     const Real p_out = cfg.real("fluid.initial_pressure"), s_out = cfg.real("fluid.saturation");
     const int axis = info.axis;
-    c3_.on_network = [this, rmax, lo, hi, p_out, s_out, axis](porenet::TwoPhaseFlow& f, const porenet::Network2D& net) {
+    const DrainBand b = band_;
+    c3_.on_network = [this, b, p_out, s_out, axis](porenet::TwoPhaseFlow& f, const porenet::Network2D& net) {
       drained_ = 0;
       for (Index i = 0; i < net.n_pores(); ++i) {
         if (!net.pore_hull[i]) continue;
         const Real c = axis == 0 ? net.pore_cx[i] : axis == 1 ? net.pore_cy[i] : net.pore_cz[i];
-        if (c - lo < 2 * rmax || hi - c < 2 * rmax) continue;
+        if (c - b.lo < 2 * b.rmax || b.hi - c < 2 * b.rmax) continue;
         f.set_bc(i, porenet::PoreBc::Pressure, p_out, s_out);
         ++drained_;
       }
@@ -245,6 +264,7 @@ class PoreFluid {
   }
 
   bool dim3_ = false;
+  DrainBand band_;
   Index drained_ = 0;
   coupling::DemPorenetCoupling c2_;
   coupling::DemPorenet3D c3_;

@@ -175,6 +175,25 @@ TEST(SaturatedUcs3D, ResumeAndThreadsBitIdentical) {
   for (const auto& d : {whole, parts, one}) std::filesystem::remove_all(d);
 }
 
+// Drained sides with automatic sub-cycling (fluid.flow_every = 0), interrupted at 4 % strain (bonds
+// made unbreakable so the sample gets there): the drained band (hull pores more than two radii from
+// the platens) is the one chosen at the start, not one taken again from the shortened sample at the
+// resume (that drained other pores: before the fix this test failed), and the held forces and stride
+// carry over: series, cracks, summary byte for byte.
+TEST(SaturatedUcs3D, ResumeWithDrainedSidesAndSubCyclingBitIdentical) {
+  const std::string text = scenario_3d("saturation = 0.8\ndrainage = \"sides\"\nflow_every = 0\n");
+  const std::vector<std::string> sets = {"ucs.max_strain=0.05", "ucs.platen_velocity=1.0",
+                                         "dem.bond.matrix-matrix.tensile_strength=1e11",
+                                         "dem.bond.matrix-matrix.cohesion=1e11"};
+  const auto whole = test::scratch("sat3d_drained_whole"), parts = test::scratch("sat3d_drained_parts");
+  ASSERT_EQ(test::run_scenario(text, sets, whole, 1), RunStatus::Finished);
+  ASSERT_EQ(test::run_scenario(text, sets, parts, 1, 1000), RunStatus::Interrupted);
+  ASSERT_EQ(test::run_scenario(text, sets, parts, 1, 0, true), RunStatus::Finished);
+  test::expect_same_results(whole, parts, "3D saturated UCS, drained sides, flow_every = 0, resumed at step 1000 (4 % strain)");
+  std::filesystem::remove_all(whole);
+  std::filesystem::remove_all(parts);
+}
+
 // The 2D driver (seed 004 network, explicit flow, cavitation) through the same hooks: resumed = whole.
 TEST(SaturatedUcs2D, ResumeBitIdentical) {
   std::ifstream f(std::string(FRACFLOW_SOURCE_DIR) + "/examples/saturated_ucs_2d.toml");
