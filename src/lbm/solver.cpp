@@ -438,6 +438,7 @@ void Solver<L, T>::moving_particles(const ParticleSet& p, bool bookkeeping) {
 template <class L, class T>
 void Solver<L, T>::restore_particles(const ParticleSet& last) {
   if (settings_.particle_scheme != ParticleScheme::Psm) moving_particles(last, false);
+  else set_particles(last);
 }
 
 template <class L, class T>

@@ -150,9 +150,9 @@ class Solver {
   const std::vector<Vec3>& particle_torques() const;
   const Psm<L, T>* psm() const { return psm_.get(); }
   const MovingBoundary<L, T>* moving_boundary() const { return mb_.get(); }
-  // Resume with a bounce-back scheme: after restore(), the set of the last step before the
-  // checkpoint (its solid cells are state: the next set_particles() refills the cells it uncovers).
-  // Nothing to do for the PSM.
+  // Resume: after restore(), the set of the last step before the checkpoint. Bounce-back schemes:
+  // its solid cells are state (the next set_particles() refills the cells it uncovers). PSM: its
+  // fractions (a function of the set alone), for a caller that steps on before handing a new set.
   void restore_particles(const ParticleSet& last);
 
   // ---- fluid state between steps (the populations the next step reads; the AA parity is handled here),
