@@ -126,13 +126,24 @@ void Psm<L, T>::set_particles(const ParticleSet& p) {
                                    s, p.id.empty() ? s : p.id[s], r, X[0], X[1], X[2]));
   }
   if (slot_.empty()) {
-    slot_.assign(std::size_t(grid_.padded_size()), -1);
+    const std::size_t N = std::size_t(grid_.padded_size());
+    slot_.assign(N, -1);
     row_lo_.assign(std::size_t(n[1]) * std::size_t(n[2]), INT32_MAX);
     row_hi_.assign(row_lo_.size(), -1);
+    single_B_.assign(N, T(0));
+    for (int a = 0; a < D; ++a) {
+      single_us_[a].assign(N, T(0));
+      single_F_[a].assign(N, 0.0);
+    }
   }
-  for (const Cell& c : cells_) slot_[std::size_t(c.cell)] = -1;
+  for (const Cell& c : cells_) {
+    slot_[std::size_t(c.cell)] = -1;
+    single_B_[std::size_t(c.cell)] = T(0);
+  }
   for (const std::int32_t sp : touched_) span_count_[std::size_t(sp)] = 0;
   touched_.clear();
+  for (const std::int32_t sp : single_spans_) span_single_[std::size_t(sp)] = 0;
+  single_spans_.clear();
   cells_.clear();
   kin_.resize(np);
   for (std::size_t s = 0; s < np; ++s) kin_[s] = Kinematics{p.velocity[s], D == 3 ? p.omega[s] : Vec3(0, 0, p.omega[s][2])};
@@ -212,7 +223,8 @@ void Psm<L, T>::set_particles(const ParticleSet& p) {
       sl = std::int32_t(cells_.size());
       // On a periodic lattice edge the neighbours wrap (slow path of the slots).
       const bool edge = edge_yz || (grid_.periodic[0] && (x == 0 || x == n[0] - 1));
-      cells_.push_back(Cell{ci, off, 0, 0.0, T(0), span_of_[std::size_t(ci)] == kBoundaryCell, edge});
+      const bool boundary = span_of_[std::size_t(ci)] == kBoundaryCell;
+      cells_.push_back(Cell{ci, off, 0, 0.0, T(0), boundary, edge, count == 1 && !boundary});
       off += count;
     }
     row_lo_[row] = INT32_MAX;
@@ -228,7 +240,7 @@ void Psm<L, T>::set_particles(const ParticleSet& p) {
     for (const Candidate& cd : chunk_[ch]) {
       Cell& c = cells_[std::size_t(slot_[std::size_t(cd.cell)])];
       const std::int32_t k = c.first + c.count++;
-      entries_[std::size_t(k)] = Entry{cd.particle, T(0), cd.eps, cd.arm};
+      entries_[std::size_t(k)] = Entry{cd.particle, T(0), cd.eps, cd.arm, cd.cell, c.single};
       pentry_[run++] = k;
       c.eps += cd.eps;
     }
@@ -242,10 +254,26 @@ void Psm<L, T>::set_particles(const ParticleSet& p) {
     if (c.count == 1) entries_[std::size_t(c.first)].Bs = T(B);  // (most cells: no division)
     else
       for (std::int32_t k = c.first; k < c.first + c.count; ++k) entries_[std::size_t(k)].Bs = T(B * entries_[std::size_t(k)].eps / c.eps);
+    if (c.single) {  // the fused kernel's per-cell B and u_s (as apply_span computes them)
+      const Entry& e = entries_[std::size_t(c.first)];
+      const Kinematics& m = kin_[std::size_t(e.particle)];
+      const Vec3 us = m.v + m.w.cross(e.arm);
+      single_B_[std::size_t(c.cell)] = T(B);
+      for (int a = 0; a < D; ++a) single_us_[a][std::size_t(c.cell)] = T(us[a]);
+    }
   }
-  // Bulk cells grouped by the span that updates them (offsets in order of first touch).
+  // Spans that run the fused kernel; the other bulk cells grouped by the span that updates them
+  // (offsets in order of first touch).
   for (const Cell& c : cells_) {
     if (c.boundary) continue;
+    if (c.single) {
+      const std::int32_t sp = span_of_[std::size_t(c.cell)];
+      if (!span_single_[std::size_t(sp)]) {
+        span_single_[std::size_t(sp)] = 1;
+        single_spans_.push_back(sp);
+      }
+      continue;
+    }
     const std::int32_t sp = span_of_[std::size_t(c.cell)];
     if (span_count_[std::size_t(sp)]++ == 0) touched_.push_back(sp);
   }
@@ -258,7 +286,7 @@ void Psm<L, T>::set_particles(const ParticleSet& p) {
   bulk_.resize(std::size_t(nbulk));
   for (std::size_t i = 0; i < cells_.size(); ++i) {
     const Cell& c = cells_[i];
-    if (c.boundary) continue;
+    if (c.boundary || c.single) continue;
     const std::int32_t sp = span_of_[std::size_t(c.cell)];
     bulk_[std::size_t(span_first_[std::size_t(sp)] + span_count_[std::size_t(sp)]++)] = BulkCell{c.cell, std::int32_t(i), c.edge};
   }
@@ -271,7 +299,12 @@ void Psm<L, T>::set_particles(const ParticleSet& p) {
 
 template <class L, class T>
 void Psm<L, T>::set_cell_spans(std::vector<std::int32_t> span_of_cell, std::size_t num_spans) {
-  for (const Cell& c : cells_) slot_[std::size_t(c.cell)] = -1;
+  for (const Cell& c : cells_) {
+    slot_[std::size_t(c.cell)] = -1;
+    single_B_[std::size_t(c.cell)] = T(0);
+  }
+  span_single_.assign(num_spans, 0);
+  single_spans_.clear();
   cells_.clear();
   entries_.clear();
   bulk_.clear();
@@ -510,14 +543,32 @@ void Psm<L, T>::reduce() {
     Vec3 F = Vec3::Zero(), M = Vec3::Zero();
     for (std::int32_t i = pfirst_[std::size_t(s)]; i < pfirst_[std::size_t(s) + 1]; ++i) {
       const std::size_t k = std::size_t(pentry_[std::size_t(i)]);
-      const Vec3 Fk(entry_force_[3 * k], entry_force_[3 * k + 1], entry_force_[3 * k + 2]);
+      const Entry& e = entries_[k];
+      Vec3 Fk;
+      if (e.single) {
+        const std::size_t c = std::size_t(e.cell);
+        Fk = Vec3(single_F_[0][c], single_F_[1][c], L::D == 3 ? single_F_[2][c] : 0.0);
+      } else {
+        Fk = Vec3(entry_force_[3 * k], entry_force_[3 * k + 1], entry_force_[3 * k + 2]);
+      }
       F += Fk;
-      M += entries_[k].arm.cross(Fk);
+      M += e.arm.cross(Fk);
     }
     force_[std::size_t(s)] = F;
     torque_[std::size_t(s)] = M;
     wall_force_[std::size_t(s)] = Vec3::Zero();
   }
+}
+
+template <class L, class T>
+PsmCells<T> Psm<L, T>::single_cells() {
+  PsmCells<T> c;
+  c.B = single_B_.data();
+  for (int a = 0; a < L::D; ++a) {
+    c.us[a] = single_us_[a].data();
+    c.F[a] = single_F_[a].data();
+  }
+  return c;
 }
 
 template <class L, class T>

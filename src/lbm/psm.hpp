@@ -34,13 +34,16 @@
 // sweeps the lattice. The fractions are computed in parallel over fixed chunks of particles and
 // gathered in particle order; the covered cells are then listed in lattice order (x fastest), so
 // the cells and entries are the same on any thread count and the sweep reads them in order. Bulk
-// cells that a particle covers keep the bulk kernel (untouched, so cells with B = 0 keep its
-// speed): inside the bulk sweep, a span's covered cells save their pre-collision populations right
-// before the kernel runs the span, and the PSM update is applied to the kernel's result right
-// after, g_new = (1 - B) g* + B g + sum_s B_s Omega^s, while the rows are in the cache, in batches
-// of cells (structure of arrays, vectorised). Boundary cells apply the same update inside their
-// own path. Every cell owns its slots (AA pattern), so cells are independent; each particle's
-// force is summed over its own entries in a fixed order: results are the same on any thread count.
+// cells covered by one particle (most of them in dense rock) are run by a fused kernel
+// (psm_sweep.cpp): the span's collision and the PSM update in one pass, B and u_s read from
+// per-cell arrays, the cell's force written to one. Spans without such cells keep the bulk kernel
+// (so cells away from particles keep its speed). Bulk cells covered by several particles keep a
+// second path: right before the kernel runs their span their pre-collision populations are
+// saved, and right after, the update g_new = (1 - B) g* + B g + sum_s B_s Omega^s is applied to
+// the kernel's result, in batches of cells (structure of arrays, vectorised). Boundary cells apply
+// the same update inside their own path. Every cell owns its slots (AA pattern), so cells are
+// independent; each particle's force is summed over its own entries in a fixed order: results are
+// the same on any thread count.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -85,6 +88,23 @@ inline double psm_weight(double eps, double tau, PsmWeighting w) {
 // (dim 2, d[2] ignored) or sphere of radius r (plane approximation above).
 double psm_cell_fraction(int dim, const Vec3& d, double r);
 
+// Per padded cell, the cells covered by exactly one particle (Psm::single_cells): B (= B_s; 0 for any
+// other cell), the particle's velocity u_s at the cell centre and, written by the fused kernel, the
+// cell's solid force -B sum_q c_q Omega^s_q (lattice units). Components beyond D are null.
+template <class T>
+struct PsmCells {
+  const T* B = nullptr;
+  const T* us[3] = {nullptr, nullptr, nullptr};
+  double* F[3] = {nullptr, nullptr, nullptr};
+};
+// The fused stream-collide + PSM kernel of one bulk span (psm_sweep.cpp), the bulk kernel's
+// signature plus the cells: g = (1 - B) g* + B g + B Omega^s where B > 0, g* elsewhere.
+template <class T>
+using PsmSpanFn = void (*)(const Grid&, T*, CellIndex, int, int, int, int, bool, const Relax<T>&, T*, T* const*,
+                           const PsmCells<T>&);
+template <class L, class T>
+PsmSpanFn<T> psm_span_kernel(CollisionModel model, bool force, bool moments, bool incomp);
+
 template <class L, class T>
 class Psm {
  public:
@@ -101,8 +121,12 @@ class Psm {
   // ---- hooks of Solver::step()
   bool active() const { return !cells_.empty(); }
   std::int32_t slot(CellIndex cell) const { return slot_[std::size_t(cell)]; }
-  // Bulk cells, one span at a time inside the bulk sweep (while its rows are in the cache):
-  // save_span before the kernel runs the span, apply_span after it.
+  // Bulk cells covered by one particle: the span runs the fused kernel (psm_span_kernel) on
+  // single_cells() instead of the bulk kernel.
+  bool span_single(std::int64_t span) const { return span_single_[std::size_t(span)] != 0; }
+  PsmCells<T> single_cells();
+  // Bulk cells covered by several particles, one span at a time inside the bulk sweep (while its
+  // rows are in the cache): save_span before the kernel runs the span, apply_span after it.
   bool span_covered(std::int64_t span) const { return span_count_[std::size_t(span)] > 0; }
   void save_span(std::int64_t span, const T* f, bool odd);
   void apply_span(std::int64_t span, T* f, bool odd, const Relax<T>& r, bool force, bool incomp);
@@ -132,12 +156,15 @@ class Psm {
     T B = 0;
     bool boundary = false;
     bool edge = false;  // on a periodic lattice edge
+    bool single = false;  // a bulk cell covered by one particle: the fused kernel's (single_cells)
   };
   struct Entry {
     std::int32_t particle;
     T Bs;                   // B_s
     double eps;
     Vec3 arm;               // cell centre minus particle centre (unwrapped)
+    CellIndex cell = 0;     // its cell; single: the force is in single_F_ there, else in entry_force_
+    bool single = false;
   };
   Grid grid_;
   double tau_;
@@ -145,6 +172,11 @@ class Psm {
   std::vector<std::int32_t> span_of_;    // per padded cell (set_cell_spans)
   std::vector<std::int32_t> span_first_, span_count_;  // per span: its covered cells in bulk_
   std::vector<std::int32_t> touched_;    // spans with covered cells (cleared by the next set)
+  std::vector<std::uint8_t> span_single_;  // per span: has cells covered by one particle
+  std::vector<std::int32_t> single_spans_;  // those spans (cleared by the next set)
+  // Per padded cell (single_cells): B, u_s and the solid force of single-particle bulk cells.
+  std::vector<T> single_B_, single_us_[3];
+  std::vector<double> single_F_[3];
   // Per padded cell: index into cells_, -1 if uncovered; while set_particles() counts the
   // entries of a cell, -1 - count.
   std::vector<std::int32_t> slot_;
