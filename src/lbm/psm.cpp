@@ -125,6 +125,65 @@ void Psm<L, T>::set_particles(const ParticleSet& p) {
                                    "(and below half the lattice along a periodic axis), position finite",
                                    s, p.id.empty() ? s : p.id[s], r, X[0], X[1], X[2]));
   }
+  // Fractions kept: every particle within refresh_ cells of where they were computed.
+  if (refresh_ > 0 && !ref_radius_.empty() && ref_radius_.size() == np) {
+    const double lim2 = refresh_ * refresh_;
+    bool keep = true;
+    for (std::size_t s = 0; s < np && keep; ++s) {
+      Vec3 d = p.position[s] - ref_pos_[s];
+      if (D == 2) d[2] = 0;
+      keep = p.radius[s] == ref_radius_[s] && d.squaredNorm() <= lim2;
+    }
+    if (keep) {
+      take_kinematics(p);
+      return;
+    }
+  }
+  build(p);
+}
+
+template <class L, class T>
+void Psm<L, T>::take_kinematics(const ParticleSet& p) {
+  const std::size_t np = p.size();
+  const int D = L::D;
+  bool same = true;
+  for (std::size_t s = 0; s < np; ++s) {
+    const Kinematics k{p.velocity[s], D == 3 ? p.omega[s] : Vec3(0, 0, p.omega[s][2])};
+    same = same && k.v == kin_[s].v && k.w == kin_[s].w;
+    kin_[s] = k;
+  }
+  if (same) return;  // (quasi-static walls: nothing moves)
+  const std::int64_t ncell = std::int64_t(cells_.size());
+#pragma omp parallel for schedule(static) if (ncell > 16384)
+  for (std::int64_t i = 0; i < ncell; ++i) {
+    const Cell& c = cells_[std::size_t(i)];
+    if (!c.single) continue;
+    const Entry& e = entries_[std::size_t(c.first)];
+    const Kinematics& m = kin_[std::size_t(e.particle)];
+    const Vec3 us = m.v + m.w.cross(e.arm);
+    for (int a = 0; a < D; ++a) single_us_[a][std::size_t(c.cell)] = T(us[a]);
+  }
+}
+
+template <class L, class T>
+void Psm<L, T>::restore_geometry(const std::vector<Vec3>& positions, const std::vector<double>& radii) {
+  ParticleSet g;
+  g.resize(radii.size());
+  g.position = positions;
+  g.radius = radii;
+  if (g.position.size() != g.radius.size())
+    throw InputError(fmt::format("PSM geometry: {} positions for {} radii", g.position.size(), g.radius.size()));
+  build(g);
+}
+
+template <class L, class T>
+void Psm<L, T>::build(const ParticleSet& p) {
+  const std::size_t np = p.size();
+  const int D = L::D;
+  const int n[3] = {grid_.nx, grid_.ny, grid_.nz};
+  ++rebuilds_;
+  ref_pos_ = p.position;
+  ref_radius_ = p.radius;
   if (slot_.empty()) {
     const std::size_t N = std::size_t(grid_.padded_size());
     slot_.assign(N, -1);
@@ -240,8 +299,8 @@ void Psm<L, T>::set_particles(const ParticleSet& p) {
     for (const Candidate& cd : chunk_[ch]) {
       Cell& c = cells_[std::size_t(slot_[std::size_t(cd.cell)])];
       const std::int32_t k = c.first + c.count++;
-      entries_[std::size_t(k)] = Entry{cd.particle, T(0), cd.eps, cd.arm, cd.cell, c.single};
-      pentry_[run++] = k;
+      entries_[std::size_t(k)] = Entry{cd.particle, T(0), cd.eps, cd.arm};
+      pentry_[run++] = ParticleEntry{cd.arm, cd.cell, k, c.single};
       c.eps += cd.eps;
     }
   // The weights B and B_s, cell by cell (each cell writes its own entries).
@@ -542,13 +601,13 @@ void Psm<L, T>::reduce() {
   for (std::int64_t s = 0; s < np; ++s) {
     Vec3 F = Vec3::Zero(), M = Vec3::Zero();
     for (std::int32_t i = pfirst_[std::size_t(s)]; i < pfirst_[std::size_t(s) + 1]; ++i) {
-      const std::size_t k = std::size_t(pentry_[std::size_t(i)]);
-      const Entry& e = entries_[k];
+      const ParticleEntry& e = pentry_[std::size_t(i)];
       Vec3 Fk;
       if (e.single) {
         const std::size_t c = std::size_t(e.cell);
         Fk = Vec3(single_F_[0][c], single_F_[1][c], L::D == 3 ? single_F_[2][c] : 0.0);
       } else {
+        const std::size_t k = std::size_t(e.k);
         Fk = Vec3(entry_force_[3 * k], entry_force_[3 * k + 1], entry_force_[3 * k + 2]);
       }
       F += Fk;

@@ -116,7 +116,21 @@ class Psm {
   static constexpr std::int32_t kBoundaryCell = -2, kNotFluid = -1;
   void set_cell_spans(std::vector<std::int32_t> span_of_cell, std::size_t num_spans);
   // Clears the previous set's cells and covers those of `p`; throws InputError on bad input.
+  // With a refresh distance d > 0 (set_refresh) the fractions are kept while every particle lies
+  // within d cells of where they were computed (same count and radii): then only the particles'
+  // velocities are taken (u_s of every covered cell), at a cost of one pass over the covered cells
+  // instead of a rebuild. The fractions then lag the particles by at most d cells (psm_cell_fraction
+  // itself is within 0.02 of the sub-cell integral), and the forces' arms by as much.
   void set_particles(const ParticleSet& p);
+  void set_refresh(double cells) { refresh_ = cells; }
+  double refresh() const { return refresh_; }
+  // The positions and radii the current fractions were computed from (a checkpoint keeps them:
+  // with a refresh distance they are state), and a rebuild from them (resume; velocities zero
+  // until the next set_particles).
+  const std::vector<Vec3>& geometry_positions() const { return ref_pos_; }
+  const std::vector<double>& geometry_radii() const { return ref_radius_; }
+  void restore_geometry(const std::vector<Vec3>& positions, const std::vector<double>& radii);
+  long rebuilds() const { return rebuilds_; }  // full rebuilds so far (set_particles that moved the cells)
 
   // ---- hooks of Solver::step()
   bool active() const { return !cells_.empty(); }
@@ -163,11 +177,15 @@ class Psm {
     T Bs;                   // B_s
     double eps;
     Vec3 arm;               // cell centre minus particle centre (unwrapped)
-    CellIndex cell = 0;     // its cell; single: the force is in single_F_ there, else in entry_force_
-    bool single = false;
   };
+  void build(const ParticleSet& p);          // the fractions, entries and spans of `p`
+  void take_kinematics(const ParticleSet& p);  // kin_ and the single cells' u_s, cells kept
   Grid grid_;
   double tau_;
+  double refresh_ = 0;
+  long rebuilds_ = 0;
+  std::vector<Vec3> ref_pos_;
+  std::vector<double> ref_radius_;
   PsmWeighting weighting_ = PsmWeighting::TauDependent;
   std::vector<std::int32_t> span_of_;    // per padded cell (set_cell_spans)
   std::vector<std::int32_t> span_first_, span_count_;  // per span: its covered cells in bulk_
@@ -196,8 +214,17 @@ class Psm {
   };
   std::vector<Kinematics> kin_;
   // Per particle: its entries, pentry_[pfirst_[s] .. pfirst_[s + 1]) (in the order its cells were
-  // visited), so that reduce() sums each particle's force alone, in parallel and in a fixed order.
-  std::vector<std::int32_t> pfirst_, pentry_;      // per particle: velocity and angular velocity (u_s = v + w x arm)
+  // visited), so that reduce() sums each particle's force alone, in parallel and in a fixed order;
+  // stored in that order with what reduce() reads (read through the entries, scattered over the
+  // lattice, the sum cost a third of the fused sweep).
+  struct ParticleEntry {
+    Vec3 arm;
+    CellIndex cell;   // single: the force is single_F_ there
+    std::int32_t k;   // else entry_force_ of entry k
+    bool single;
+  };
+  std::vector<std::int32_t> pfirst_;
+  std::vector<ParticleEntry> pentry_;
   struct BulkCell {
     CellIndex cell;
     std::int32_t slot;

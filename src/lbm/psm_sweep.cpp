@@ -5,10 +5,9 @@
 // with B and u_s read from Psm's per-cell arrays, and the cell's force -B sum_q c_q Omega^s_q
 // written to its own slot of the per-cell force arrays (Psm::reduce sums them per particle).
 // Cells of the span with B = 0 (uncovered, or covered by several particles: those keep the
-// save/apply path of Psm) get g* unchanged. The arithmetic per cell is that of the batched path
-// (psm.cpp, psm_batch_solid and psm_batch_combine) in the same order, so either path gives the
-// same bits; fused, the covered cells cost a bulk cell plus the solid term, instead of the bulk
-// cell, a copy out, a copy back and the term (the coupled benchmark: c/L from 24 down, docs/coupling.md).
+// save/apply path of Psm) get g* unchanged. The same update as the batched path (psm.cpp), with
+// the solid term arranged by opposite pairs (below; equal to round-off); fused, a covered cell costs
+// a bulk cell plus the solid term, instead of the bulk cell, a copy out, a copy back and the term.
 // Compiled like the bulk kernel: one clone per vector width, -ffp-contract=off.
 #include "lbm/psm.hpp"
 #include "lbm/span_slots.hpp"
@@ -24,10 +23,18 @@ namespace ff::lbm {
 
 namespace {
 
+// Omega^s by opposite pairs (q, o = -q): the (rho - 1) parts of the two equilibria cancel, so with
+// cu = c_q.u, cs = c_q.u_s, E = 4.5 (cs^2 - cu^2) - 1.5 (u_s^2 - u^2) and O = 3 (cs + cu),
+//   f^eq_q(u_s) - f^eq_o(u) = w rho (E + O),   f^eq_o(u_s) - f^eq_q(u) = w rho (E - O),
+// Omega^s_0 = -w_0 rho 1.5 (u_s^2 - u^2) (the rest population: the E parts' balance, so the term
+// moves no mass), and -c_q Omega^s_q - c_o Omega^s_o = -c_q (Omega^s_q - Omega^s_o) for the force. rho and u
+// are the collision's own moments (Guo's half force included; rho_0 = 1 in the momentum terms
+// when incompressible), so the term costs about one more equilibrium per cell.
 template <class L, class T, CollisionModel M, bool kForce, bool kMoments, bool kIncomp>
 FF_LBM_INLINE void psm_cells(T* const* p, std::int64_t i0, std::int64_t i1, const Relax<T>& r, const MomentOut<T>& m,
                              const T* Bc, const T* const* usc, double* const* Fc) {
   constexpr int Q = L::Q;
+  constexpr int P = (Q - 1) / 2;  // opposite pairs (2p+1, 2p+2), as in collide()
 #pragma GCC ivdep
   for (std::int64_t i = i0; i < i1; ++i) {
     T g[Q], pre[Q];
@@ -35,52 +42,38 @@ FF_LBM_INLINE void psm_cells(T* const* p, std::int64_t i0, std::int64_t i1, cons
       g[q] = p[q][i];
       pre[q] = g[q];
     });
-    // Fluid moments of the pre-collision state (Guo's half force), f^eq(rho, u) and f^eq(rho, u_s).
-    T drho_s = 0, j[3] = {0, 0, 0};
-    static_for<Q>([&](auto q) FF_LBM_LAMBDA_INLINE {
-      drho_s += pre[q];
-      static_for<L::D>([&](auto a) FF_LBM_LAMBDA_INLINE {
-        if constexpr (L::c[q][a] > 0) j[a] += pre[q];
-        if constexpr (L::c[q][a] < 0) j[a] -= pre[q];
-      });
-    });
-    if constexpr (kForce)
-      static_for<L::D>([&](auto a) FF_LBM_LAMBDA_INLINE { j[a] += T(0.5) * r.force[a]; });
-    const T rho = T(1) + drho_s;
-    const T rho_u = kIncomp ? T(1) : rho;
-    const T inv = kIncomp ? T(1) : T(1) / rho;
-    const T u[3] = {j[0] * inv, j[1] * inv, j[2] * inv};
-    const T usq15 = T(1.5) * (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    T drho, u[3];
+    collide<L, T, M, kForce, kIncomp>(g, r, drho, u);  // g = g*
+    const T rho_u = kIncomp ? T(1) : T(1) + drho;
     const T us[3] = {usc[0][i], usc[1][i], L::D == 3 ? usc[2][i] : T(0)};
-    const T ssq15 = T(1.5) * (us[0] * us[0] + us[1] * us[1] + us[2] * us[2]);
-    T geqf[Q], geqs[Q];
-    static_for<Q>([&](auto q) FF_LBM_LAMBDA_INLINE {
-      const T cu = cdot<L::c[q][0], L::c[q][1], L::c[q][2]>(u[0], u[1], u[2]);
-      geqf[q] = T(L::w[q]) * ((rho - T(1)) + rho_u * (T(3) * cu + T(4.5) * cu * cu - usq15));
-      const T cs = cdot<L::c[q][0], L::c[q][1], L::c[q][2]>(us[0], us[1], us[2]);
-      geqs[q] = T(L::w[q]) * ((rho - T(1)) + rho_u * (T(3) * cs + T(4.5) * cs * cs - ssq15));
-    });
-    T drho, uo[3];
-    collide<L, T, M, kForce, kIncomp>(g, r, drho, uo);  // g = g*
+    const T dsq15 = T(1.5) * ((us[0] * us[0] + us[1] * us[1] + us[2] * us[2]) - (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]));
     const T B = Bc[i], fluid = T(1) - B;
     const bool covered = B != T(0);
-    double F[3] = {0, 0, 0};
-    static_for<Q>([&](auto q) FF_LBM_LAMBDA_INLINE {
-      constexpr int o = L::opp[q];
-      const T om = B * ((pre[o] - pre[q]) + (geqs[q] - geqf[o]));
+    T F[3] = {0, 0, 0};
+    const T om_0 = B * (-(T(L::w[0]) * rho_u) * dsq15);  // Omega^s_0 = f^eq_0(u_s) - f^eq_0(u)
+    p[0][i] = covered ? fluid * g[0] + B * pre[0] + om_0 : g[0];
+    static_for<P>([&](auto k) FF_LBM_LAMBDA_INLINE {
+      constexpr int q = 2 * k + 1, o = q + 1;
+      const T cu = cdot<L::c[q][0], L::c[q][1], L::c[q][2]>(u[0], u[1], u[2]);
+      const T cs = cdot<L::c[q][0], L::c[q][1], L::c[q][2]>(us[0], us[1], us[2]);
+      const T wr = T(L::w[q]) * rho_u;
+      const T E = wr * (T(4.5) * (cs * cs - cu * cu) - dsq15), O = wr * (T(3) * (cs + cu));
+      const T d = pre[o] - pre[q];
+      const T om_q = B * (d + (E + O)), om_o = B * ((E - O) - d);
+      p[o][i] = covered ? fluid * g[q] + B * pre[q] + om_q : g[q];
+      p[q][i] = covered ? fluid * g[o] + B * pre[o] + om_o : g[o];
+      const T f2 = om_q - om_o;  // the pair's -c_q-weighted share: F -= c_q (om_q - om_o)
       static_for<L::D>([&](auto a) FF_LBM_LAMBDA_INLINE {
-        if constexpr (L::c[q][a] > 0) F[a] -= double(om);
-        if constexpr (L::c[q][a] < 0) F[a] += double(om);
+        if constexpr (L::c[q][a] > 0) F[a] -= f2;
+        if constexpr (L::c[q][a] < 0) F[a] += f2;
       });
-      const T out = fluid * g[q] + B * pre[q] + (T(0) + om);
-      p[o][i] = covered ? out : g[q];
     });
-    static_for<L::D>([&](auto a) FF_LBM_LAMBDA_INLINE { Fc[a][i] = F[a]; });
+    static_for<L::D>([&](auto a) FF_LBM_LAMBDA_INLINE { Fc[a][i] = double(F[a]); });
     if constexpr (kMoments) {
       m.drho[i] = drho;
-      m.u[0][i] = uo[0];
-      m.u[1][i] = uo[1];
-      if constexpr (L::D == 3) m.u[2][i] = uo[2];
+      m.u[0][i] = u[0];
+      m.u[1][i] = u[1];
+      if constexpr (L::D == 3) m.u[2][i] = u[2];
     }
   }
 }

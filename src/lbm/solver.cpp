@@ -17,6 +17,9 @@ Solver<L, T>::Solver(const Grid& grid, const SolverSettings& settings) : grid_(g
     throw Error(fmt::format("internal: a {} solver needs a {}-dimensional grid", L::name, L::D));
   if (!(settings.tau > 0.5))
     throw InputError(fmt::format("LBM relaxation time tau = {} must be above 1/2", settings.tau));
+  if (!(settings.psm_refresh >= 0 && settings.psm_refresh <= 0.5))
+    throw InputError(fmt::format("LBM PSM refresh distance {} cells must lie in [0, 0.5] (0: recompute the solid "
+                                 "fractions every step)", settings.psm_refresh));
   set_body_force(settings.body_force);
   const CellIndex N = n_();
   f_.assign(std::size_t(Q) * N, T(0));
@@ -442,9 +445,25 @@ void Solver<L, T>::restore_particles(const ParticleSet& last) {
 }
 
 template <class L, class T>
+void Solver<L, T>::restore_psm_geometry(const std::vector<Vec3>& positions, const std::vector<double>& radii) {
+  if (settings_.particle_scheme != ParticleScheme::Psm) return;
+  ParticleSet g;
+  g.resize(radii.size());
+  if (positions.size() != radii.size())
+    throw InputError(fmt::format("PSM geometry: {} positions for {} radii", positions.size(), radii.size()));
+  g.position = positions;
+  g.radius = radii;
+  set_particles(g);                              // the cell classification, as a first set would
+  psm_->restore_geometry(positions, radii);      // and the fractions from exactly these
+}
+
+template <class L, class T>
 void Solver<L, T>::set_particles(const ParticleSet& p) {
   if (settings_.particle_scheme != ParticleScheme::Psm) return moving_particles(p, true);
-  if (!psm_) psm_ = std::make_unique<Psm<L, T>>(grid_, settings_.tau, settings_.psm_weighting);
+  if (!psm_) {
+    psm_ = std::make_unique<Psm<L, T>>(grid_, settings_.tau, settings_.psm_weighting);
+    psm_->set_refresh(settings_.psm_refresh);
+  }
   if (psm_kinds_stale_) {
     std::vector<std::int32_t> span_of(std::size_t(n_()), Psm<L, T>::kNotFluid);
     for (std::size_t s = 0; s < spans_.size(); ++s)

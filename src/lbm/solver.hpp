@@ -73,6 +73,9 @@ struct SolverSettings {
   // How set_particles() puts moving particles into the fluid (lbm/moving_boundary.hpp), fixed per solver.
   ParticleScheme particle_scheme = ParticleScheme::Psm;
   PsmWeighting psm_weighting = PsmWeighting::TauDependent;  // the PSM's B (lbm/psm.hpp)
+  // PSM: keep the solid fractions while every particle stays within this many cells of where they
+  // were computed (0: recompute at every set_particles; Psm::set_particles).
+  double psm_refresh = 0;
 };
 
 // A solid body (or a wall of the box) and the hydrodynamic load on it.
@@ -149,6 +152,9 @@ class Solver {
   const std::vector<Vec3>& particle_forces() const;
   const std::vector<Vec3>& particle_torques() const;
   const Psm<L, T>* psm() const { return psm_.get(); }
+  // Resume with psm_refresh > 0: the fractions from the positions and radii they were computed from
+  // before the checkpoint (psm()->geometry_positions(), geometry_radii()), then set_particles as usual.
+  void restore_psm_geometry(const std::vector<Vec3>& positions, const std::vector<double>& radii);
   const MovingBoundary<L, T>* moving_boundary() const { return mb_.get(); }
   // Resume: after restore(), the set of the last step before the checkpoint. Bounce-back schemes:
   // its solid cells are state (the next set_particles() refills the cells it uncovers). PSM: its
