@@ -60,22 +60,17 @@ void Solver<L, T>::bulk_sweep(bool odd, bool sample) {
   const std::int64_t ns = std::int64_t(spans_.size());
   const Span* spans = spans_.data();
   const Grid& g = grid_;
-  // Cells covered by particles (lbm/psm.hpp): spans with cells under one particle run the fused
-  // PSM kernel; the update of cells under several wraps the kernel of their span.
+  // Cells covered by particles (lbm/psm.hpp): their spans run the fused PSM kernel.
   Psm<L, T>* psm = psm_ && psm_->active() ? psm_.get() : nullptr;
-  const bool force_psm = force;
-  const bool incomp = settings_.incompressible;
-  const PsmSpanFn<T> fn_psm = psm ? psm_span_kernel<L, T>(settings_.collision, force, sample, incomp) : nullptr;
-  const PsmCells<T> single = psm ? psm->single_cells() : PsmCells<T>{};
+  const PsmSpanFn<T> fn_psm =
+      psm ? psm_span_kernel<L, T>(settings_.collision, force, sample, settings_.incompressible) : nullptr;
+  const PsmCells<T> cells = psm ? psm->bulk_cells() : PsmCells<T>{};
   // Small lattices run serially: a parallel region costs more than it saves there.
 #pragma omp parallel for schedule(static) if (num_bulk_cells_ > kParallelMinCells)
   for (std::int64_t s = 0; s < ns; ++s) {
     const Span& sp = spans[s];
-    const bool covered = psm && psm->span_covered(s);
-    if (covered) psm->save_span(s, f, odd);
-    if (psm && psm->span_single(s)) fn_psm(g, f, N, sp.x0, sp.y, sp.z, sp.n, odd, r, drho, u, single);
+    if (psm && psm->span_covered(s)) fn_psm(g, f, N, sp.x0, sp.y, sp.z, sp.n, odd, r, drho, u, cells);
     else fn(g, f, N, sp.x0, sp.y, sp.z, sp.n, odd, r, drho, u);
-    if (covered) psm->apply_span(s, f, odd, r, force_psm, incomp);
   }
 }
 

@@ -70,39 +70,7 @@ double psm_cell_fraction(int dim, const Vec3& d, double r) {
 }
 
 template <class L, class T>
-Psm<L, T>::Psm(const Grid& grid, double tau, PsmWeighting weighting) : grid_(grid), tau_(tau), weighting_(weighting) {
-  const CellIndex N = grid_.padded_size();
-  for (int q = 0; q < Q; ++q) {
-    const int o = L::opp[q];
-    const std::int64_t cq = L::c[q][0] + grid_.px * (L::c[q][1] + grid_.py * L::c[q][2]);
-    pre_[0][q] = q * N;
-    pre_[1][q] = q == 0 ? 0 : o * N - cq;
-    post_[0][q] = o * N;
-    post_[1][q] = q == 0 ? 0 : q * N + cq;
-  }
-}
-
-// AA pattern: g_q before the step is in f[q][x] (even) or f[opp q][x - c_q] (odd); the kernel
-// writes g*_q to f[opp q][x] (even) or f[q][x + c_q] (odd).
-template <class L, class T>
-FF_LBM_INLINE void Psm<L, T>::slots(const BulkCell& b, bool odd, CellIndex* pre, CellIndex* post) const {
-  if (!b.edge) {
-    for (int q = 0; q < Q; ++q) {
-      pre[q] = b.cell + pre_[odd][q];
-      post[q] = b.cell + post_[odd][q];
-    }
-    return;
-  }
-  const CellIndex N = grid_.padded_size();
-  const auto x = grid_.coords(b.cell);
-  pre[0] = post[0] = b.cell;
-  for (int q = 1; q < Q; ++q) {
-    const int o = L::opp[q];
-    const auto& c = L::c[q];
-    pre[q] = odd ? o * N + grid_.neighbour(x[0], x[1], x[2], -c[0], -c[1], -c[2]) : q * N + b.cell;
-    post[q] = odd ? q * N + grid_.neighbour(x[0], x[1], x[2], c[0], c[1], c[2]) : o * N + b.cell;
-  }
-}
+Psm<L, T>::Psm(const Grid& grid, double tau, PsmWeighting weighting) : grid_(grid), tau_(tau), weighting_(weighting) {}
 
 template <class L, class T>
 void Psm<L, T>::set_particles(const ParticleSet& p) {
@@ -145,10 +113,9 @@ void Psm<L, T>::set_particles(const ParticleSet& p) {
 template <class L, class T>
 void Psm<L, T>::take_kinematics(const ParticleSet& p) {
   const std::size_t np = p.size();
-  const int D = L::D;
   bool same = true;
   for (std::size_t s = 0; s < np; ++s) {
-    const Kinematics k{p.velocity[s], D == 3 ? p.omega[s] : Vec3(0, 0, p.omega[s][2])};
+    const Kinematics k = kinematics(p, s);
     same = same && k.v == kin_[s].v && k.w == kin_[s].w;
     kin_[s] = k;
   }
@@ -157,12 +124,29 @@ void Psm<L, T>::take_kinematics(const ParticleSet& p) {
 #pragma omp parallel for schedule(static) if (ncell > 16384)
   for (std::int64_t i = 0; i < ncell; ++i) {
     const Cell& c = cells_[std::size_t(i)];
-    if (!c.single) continue;
-    const Entry& e = entries_[std::size_t(c.first)];
+    if (!c.boundary) cell_velocity_sums(c);
+  }
+}
+
+// V = sum_s B_s u_s and S = sum_s B_s u_s u_s^T of a bulk cell, u_s = v + w x arm at its centre.
+template <class L, class T>
+void Psm<L, T>::cell_velocity_sums(const Cell& c) {
+  constexpr int D = L::D;
+  double V[3] = {0, 0, 0}, S[6] = {0, 0, 0, 0, 0, 0};
+  for (std::int32_t k = c.first; k < c.first + c.count; ++k) {
+    const Entry& e = entries_[std::size_t(k)];
     const Kinematics& m = kin_[std::size_t(e.particle)];
     const Vec3 us = m.v + m.w.cross(e.arm);
-    for (int a = 0; a < D; ++a) single_us_[a][std::size_t(c.cell)] = T(us[a]);
+    const double Bs = double(e.Bs);
+    int n = 0;
+    for (int a = 0; a < D; ++a) {
+      V[a] += Bs * us[a];
+      for (int b = a; b < D; ++b) S[n++] += Bs * us[a] * us[b];
+    }
   }
+  const std::size_t x = std::size_t(c.cell);
+  for (int a = 0; a < D; ++a) cell_V_[a][x] = T(V[a]);
+  for (int n = 0; n < kS; ++n) cell_S_[n][x] = T(S[n]);
 }
 
 template <class L, class T>
@@ -189,23 +173,23 @@ void Psm<L, T>::build(const ParticleSet& p) {
     slot_.assign(N, -1);
     row_lo_.assign(std::size_t(n[1]) * std::size_t(n[2]), INT32_MAX);
     row_hi_.assign(row_lo_.size(), -1);
-    single_B_.assign(N, T(0));
+    cell_B_.assign(N, T(0));
+    cell_rho_.assign(N, T(0));
     for (int a = 0; a < D; ++a) {
-      single_us_[a].assign(N, T(0));
-      single_F_[a].assign(N, 0.0);
+      cell_V_[a].assign(N, T(0));
+      cell_u_[a].assign(N, T(0));
     }
+    for (int k = 0; k < kS; ++k) cell_S_[k].assign(N, T(0));
   }
   for (const Cell& c : cells_) {
     slot_[std::size_t(c.cell)] = -1;
-    single_B_[std::size_t(c.cell)] = T(0);
+    cell_B_[std::size_t(c.cell)] = T(0);
   }
-  for (const std::int32_t sp : touched_) span_count_[std::size_t(sp)] = 0;
-  touched_.clear();
-  for (const std::int32_t sp : single_spans_) span_single_[std::size_t(sp)] = 0;
-  single_spans_.clear();
+  for (const std::int32_t sp : fused_spans_) span_fused_[std::size_t(sp)] = 0;
+  fused_spans_.clear();
   cells_.clear();
   kin_.resize(np);
-  for (std::size_t s = 0; s < np; ++s) kin_[s] = Kinematics{p.velocity[s], D == 3 ? p.omega[s] : Vec3(0, 0, p.omega[s][2])};
+  for (std::size_t s = 0; s < np; ++s) kin_[s] = kinematics(p, s);
   // 1. The covered fractions, particle by particle, in parallel: fixed chunks of consecutive
   //    particles (independent of the thread count), each into its own buffer, which step 2 reads
   //    in chunk order, i.e. in particle order as a serial loop would.
@@ -283,7 +267,7 @@ void Psm<L, T>::build(const ParticleSet& p) {
       // On a periodic lattice edge the neighbours wrap (slow path of the slots).
       const bool edge = edge_yz || (grid_.periodic[0] && (x == 0 || x == n[0] - 1));
       const bool boundary = span_of_[std::size_t(ci)] == kBoundaryCell;
-      cells_.push_back(Cell{ci, off, 0, 0.0, T(0), boundary, edge, count == 1 && !boundary});
+      cells_.push_back(Cell{ci, off, 0, 0.0, T(0), boundary, edge});
       off += count;
     }
     row_lo_[row] = INT32_MAX;
@@ -300,7 +284,7 @@ void Psm<L, T>::build(const ParticleSet& p) {
       Cell& c = cells_[std::size_t(slot_[std::size_t(cd.cell)])];
       const std::int32_t k = c.first + c.count++;
       entries_[std::size_t(k)] = Entry{cd.particle, T(0), cd.eps, cd.arm};
-      pentry_[run++] = ParticleEntry{cd.arm, cd.cell, k, c.single};
+      pentry_[run++] = ParticleEntry{cd.arm, cd.cell, k, T(0), !c.boundary};
       c.eps += cd.eps;
     }
   // The weights B and B_s, cell by cell (each cell writes its own entries).
@@ -313,44 +297,27 @@ void Psm<L, T>::build(const ParticleSet& p) {
     if (c.count == 1) entries_[std::size_t(c.first)].Bs = T(B);  // (most cells: no division)
     else
       for (std::int32_t k = c.first; k < c.first + c.count; ++k) entries_[std::size_t(k)].Bs = T(B * entries_[std::size_t(k)].eps / c.eps);
-    if (c.single) {  // the fused kernel's per-cell B and u_s (as apply_span computes them)
-      const Entry& e = entries_[std::size_t(c.first)];
-      const Kinematics& m = kin_[std::size_t(e.particle)];
-      const Vec3 us = m.v + m.w.cross(e.arm);
-      single_B_[std::size_t(c.cell)] = T(B);
-      for (int a = 0; a < D; ++a) single_us_[a][std::size_t(c.cell)] = T(us[a]);
+    if (!c.boundary) {  // the fused kernel's per-cell B, V and S
+      cell_B_[std::size_t(c.cell)] = T(B);
+      cell_velocity_sums(c);
     }
   }
-  // Spans that run the fused kernel; the other bulk cells grouped by the span that updates them
-  // (offsets in order of first touch).
+  // Each particle's B_s in its own list (read by reduce()).
+  const std::int64_t npart = std::int64_t(np);
+#pragma omp parallel for schedule(static) if (npart > 2048)
+  for (std::int64_t s = 0; s < npart; ++s)
+    for (std::int32_t i = pfirst_[std::size_t(s)]; i < pfirst_[std::size_t(s) + 1]; ++i)
+      pentry_[std::size_t(i)].Bs = entries_[std::size_t(pentry_[std::size_t(i)].k)].Bs;
+  // Spans that run the fused kernel.
   for (const Cell& c : cells_) {
     if (c.boundary) continue;
-    if (c.single) {
-      const std::int32_t sp = span_of_[std::size_t(c.cell)];
-      if (!span_single_[std::size_t(sp)]) {
-        span_single_[std::size_t(sp)] = 1;
-        single_spans_.push_back(sp);
-      }
-      continue;
+    const std::int32_t sp = span_of_[std::size_t(c.cell)];
+    if (!span_fused_[std::size_t(sp)]) {
+      span_fused_[std::size_t(sp)] = 1;
+      fused_spans_.push_back(sp);
     }
-    const std::int32_t sp = span_of_[std::size_t(c.cell)];
-    if (span_count_[std::size_t(sp)]++ == 0) touched_.push_back(sp);
   }
-  std::int32_t nbulk = 0;
-  for (const std::int32_t sp : touched_) {
-    span_first_[std::size_t(sp)] = nbulk;
-    nbulk += span_count_[std::size_t(sp)];
-    span_count_[std::size_t(sp)] = 0;
-  }
-  bulk_.resize(std::size_t(nbulk));
-  for (std::size_t i = 0; i < cells_.size(); ++i) {
-    const Cell& c = cells_[i];
-    if (c.boundary || c.single) continue;
-    const std::int32_t sp = span_of_[std::size_t(c.cell)];
-    bulk_[std::size_t(span_first_[std::size_t(sp)] + span_count_[std::size_t(sp)]++)] = BulkCell{c.cell, std::int32_t(i), c.edge};
-  }
-  gpre_.resize(std::size_t(Q) * bulk_.size());
-  entry_force_.resize(3 * entries_.size());  // every entry is written by its cell's update
+  entry_force_.resize(3 * entries_.size());  // every boundary entry is written by its cell's update
   force_.assign(np, Vec3::Zero());
   torque_.assign(np, Vec3::Zero());
   wall_force_.assign(np, Vec3::Zero());
@@ -360,28 +327,13 @@ template <class L, class T>
 void Psm<L, T>::set_cell_spans(std::vector<std::int32_t> span_of_cell, std::size_t num_spans) {
   for (const Cell& c : cells_) {
     slot_[std::size_t(c.cell)] = -1;
-    single_B_[std::size_t(c.cell)] = T(0);
+    cell_B_[std::size_t(c.cell)] = T(0);
   }
-  span_single_.assign(num_spans, 0);
-  single_spans_.clear();
+  span_fused_.assign(num_spans, 0);
+  fused_spans_.clear();
   cells_.clear();
   entries_.clear();
-  bulk_.clear();
-  touched_.clear();
   span_of_ = std::move(span_of_cell);
-  span_first_.assign(num_spans, 0);
-  span_count_.assign(num_spans, 0);
-}
-
-template <class L, class T>
-void Psm<L, T>::save_span(std::int64_t span, const T* f, bool odd) {
-  const std::int32_t k0 = span_first_[std::size_t(span)], k1 = k0 + span_count_[std::size_t(span)];
-  for (std::int32_t k = k0; k < k1; ++k) {
-    CellIndex pre[Q], post[Q];
-    slots(bulk_[std::size_t(k)], odd, pre, post);
-    T* g = &gpre_[std::size_t(Q) * std::size_t(k)];
-    for (int q = 0; q < Q; ++q) g[q] = f[pre[q]];
-  }
 }
 
 // Shifted equilibrium (as equilibrium() in collision.hpp) with compile-time directions.
@@ -392,161 +344,6 @@ FF_LBM_INLINE void psm_equilibrium(T rho, T rho_u, const T* u, T* geq) {
     const T cu = cdot<L::c[q][0], L::c[q][1], L::c[q][2]>(u[0], u[1], u[2]);
     geq[q] = T(L::w[q]) * ((rho - T(1)) + rho_u * (T(3) * cu + T(4.5) * cu * cu - usq15));
   });
-}
-
-namespace {
-
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define FF_PSM_CLONES __attribute__((target_clones("default", "arch=x86-64-v3", "arch=x86-64-v4")))
-#else
-#define FF_PSM_CLONES
-#endif
-
-// Covered bulk cells of one span in batches of kBatch, structure of arrays, so that the arithmetic
-// of the update runs over the lanes in vector registers (one cell at a time, scalar, it cost
-// 10-20 times the bulk kernel's cell). Compiled like the bulk kernel (bulk_sweep.cpp): one clone
-// per vector width, the same IEEE operations in each (-ffp-contract=off), so a cell's result does
-// not depend on its lane, its batch or the clone.
-constexpr int kBatch = 16;
-
-template <class L, class T>
-struct PsmBatch {
-  alignas(64) T pre[L::Q][kBatch];   // g_q before the step
-  alignas(64) T post[L::Q][kBatch];  // g*_q from the kernel, then the PSM result
-  alignas(64) T sum[L::Q][kBatch];   // sum_s B_s Omega^s_q
-  alignas(64) T geqf[L::Q][kBatch];  // f^eq_q(rho, u)
-  alignas(64) T B[kBatch], Bs[kBatch], us[3][kBatch], rho[kBatch], rho_u[kBatch], u[3][kBatch];
-  alignas(64) double F[3][kBatch];   // force of each lane's first entry
-};
-
-// Fluid moments, f^eq(rho, u), and the solid term of each lane's first particle (the others are
-// added by the caller); as Psm::apply() does for one cell.
-template <class L, class T, bool kForce, bool kIncomp>
-FF_PSM_CLONES void psm_batch_solid(PsmBatch<L, T>& b, const T* force) {
-  constexpr int Q = L::Q;
-  T hf[3] = {0, 0, 0};
-  if constexpr (kForce)
-    for (int a = 0; a < L::D; ++a) hf[a] = T(0.5) * force[a];
-  for (int i = 0; i < kBatch; ++i) {
-    T drho = 0, j[3] = {0, 0, 0};
-    static_for<Q>([&](auto q) FF_LBM_LAMBDA_INLINE {
-      const T g = b.pre[q][i];
-      drho += g;
-      static_for<L::D>([&](auto a) FF_LBM_LAMBDA_INLINE {
-        if constexpr (L::c[q][a] > 0) j[a] += g;
-        if constexpr (L::c[q][a] < 0) j[a] -= g;
-      });
-    });
-    if constexpr (kForce)
-      for (int a = 0; a < L::D; ++a) j[a] += hf[a];
-    const T rho = T(1) + drho;
-    const T rho_u = kIncomp ? T(1) : rho;
-    const T inv = kIncomp ? T(1) : T(1) / rho;
-    const T u[3] = {j[0] * inv, j[1] * inv, j[2] * inv};
-    b.rho[i] = rho;
-    b.rho_u[i] = rho_u;
-    const T usq15 = T(1.5) * (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-    const T us[3] = {b.us[0][i], b.us[1][i], b.us[2][i]};
-    const T ssq15 = T(1.5) * (us[0] * us[0] + us[1] * us[1] + us[2] * us[2]);
-    T geqf[Q], geqs[Q];
-    static_for<Q>([&](auto q) FF_LBM_LAMBDA_INLINE {
-      const T cu = cdot<L::c[q][0], L::c[q][1], L::c[q][2]>(u[0], u[1], u[2]);
-      geqf[q] = T(L::w[q]) * ((rho - T(1)) + rho_u * (T(3) * cu + T(4.5) * cu * cu - usq15));
-      const T cs = cdot<L::c[q][0], L::c[q][1], L::c[q][2]>(us[0], us[1], us[2]);
-      geqs[q] = T(L::w[q]) * ((rho - T(1)) + rho_u * (T(3) * cs + T(4.5) * cs * cs - ssq15));
-      b.geqf[q][i] = geqf[q];
-    });
-    const T Bs = b.Bs[i];
-    double F[3] = {0, 0, 0};
-    static_for<Q>([&](auto q) FF_LBM_LAMBDA_INLINE {
-      constexpr int o = L::opp[q];
-      const T om = Bs * ((b.pre[o][i] - b.pre[q][i]) + (geqs[q] - geqf[o]));
-      b.sum[q][i] = T(0) + om;
-      static_for<L::D>([&](auto a) FF_LBM_LAMBDA_INLINE {
-        if constexpr (L::c[q][a] > 0) F[a] -= double(om);
-        if constexpr (L::c[q][a] < 0) F[a] += double(om);
-      });
-    });
-    for (int a = 0; a < 3; ++a) b.F[a][i] = F[a];
-  }
-}
-
-// g = (1 - B) g* + B g + sum_s B_s Omega^s, lane by lane.
-template <class L, class T>
-FF_PSM_CLONES void psm_batch_combine(PsmBatch<L, T>& b) {
-  for (int q = 0; q < L::Q; ++q)
-    for (int i = 0; i < kBatch; ++i) {
-      const T B = b.B[i], fluid = T(1) - B;
-      b.post[q][i] = fluid * b.post[q][i] + B * b.pre[q][i] + b.sum[q][i];
-    }
-}
-
-}  // namespace
-
-template <class L, class T>
-void Psm<L, T>::apply_span(std::int64_t span, T* f, bool odd, const Relax<T>& r, bool force, bool incomp) {
-  const std::int32_t k0 = span_first_[std::size_t(span)], k1 = k0 + span_count_[std::size_t(span)];
-  using Fn = void (*)(PsmBatch<L, T>&, const T*);
-  const Fn solid = force ? (incomp ? &psm_batch_solid<L, T, true, true> : &psm_batch_solid<L, T, true, false>)
-                         : (incomp ? &psm_batch_solid<L, T, false, true> : &psm_batch_solid<L, T, false, false>);
-  PsmBatch<L, T> b;
-  CellIndex post[kBatch][Q];
-  for (std::int32_t kb = k0; kb < k1; kb += kBatch) {
-    const int n = int(std::min<std::int32_t>(kBatch, k1 - kb));
-    for (int i = 0; i < n; ++i) {
-      const BulkCell& bc = bulk_[std::size_t(kb + i)];
-      CellIndex pre[Q];
-      slots(bc, odd, pre, post[i]);
-      const T* gp = &gpre_[std::size_t(Q) * std::size_t(kb + i)];
-      for (int q = 0; q < Q; ++q) {
-        b.pre[q][i] = gp[q];
-        b.post[q][i] = f[post[i][q]];
-      }
-      const Cell& c = cells_[std::size_t(bc.slot)];
-      const Entry& e = entries_[std::size_t(c.first)];
-      b.B[i] = c.B;
-      b.Bs[i] = e.Bs;
-      const Kinematics& m = kin_[std::size_t(e.particle)];
-      const Vec3 us = m.v + m.w.cross(e.arm);
-      for (int a = 0; a < 3; ++a) b.us[a][i] = T(a < L::D ? us[a] : 0.0);
-    }
-    for (int i = n; i < kBatch; ++i) {  // idle lanes: a fluid at rest
-      for (int q = 0; q < Q; ++q) b.pre[q][i] = b.post[q][i] = T(0);
-      b.B[i] = b.Bs[i] = T(0);
-      for (int a = 0; a < 3; ++a) b.us[a][i] = T(0);
-    }
-    solid(b, r.force);
-    // Cells with more than one particle: the others' terms, in entry order (as apply()).
-    for (int i = 0; i < n; ++i) {
-      const Cell& c = cells_[std::size_t(bulk_[std::size_t(kb + i)].slot)];
-      for (int a = 0; a < 3; ++a) entry_force_[3 * std::size_t(c.first) + std::size_t(a)] = b.F[a][i];
-      if (c.count == 1) continue;
-      T gpre[Q], geq_f[Q], geq_s[Q];
-      for (int q = 0; q < Q; ++q) gpre[q] = b.pre[q][i], geq_f[q] = b.geqf[q][i];
-      for (std::int32_t k = c.first + 1; k < c.first + c.count; ++k) {
-        const Entry& e = entries_[std::size_t(k)];
-        const Kinematics& m = kin_[std::size_t(e.particle)];
-        const Vec3 us = m.v + m.w.cross(e.arm);
-        const T ut[3] = {T(us[0]), T(us[1]), T(L::D == 3 ? us[2] : 0.0)};
-        psm_equilibrium<L, T>(b.rho[i], b.rho_u[i], ut, geq_s);
-        double F[3] = {0, 0, 0};
-        const T Bs = e.Bs;
-        static_for<Q>([&](auto q) FF_LBM_LAMBDA_INLINE {
-          constexpr int o = L::opp[q];
-          const T om = Bs * ((gpre[o] - gpre[q]) + (geq_s[q] - geq_f[o]));
-          b.sum[q][i] += om;
-          static_for<L::D>([&](auto a) FF_LBM_LAMBDA_INLINE {
-            if constexpr (L::c[q][a] > 0) F[a] -= double(om);
-            if constexpr (L::c[q][a] < 0) F[a] += double(om);
-          });
-        });
-        for (int a = 0; a < 3; ++a) entry_force_[3 * std::size_t(k) + std::size_t(a)] = F[a];
-      }
-    }
-    psm_batch_combine<L, T>(b);
-    for (int i = 0; i < n; ++i)
-      for (int q = 0; q < Q; ++q) f[post[i][q]] = b.post[q][i];
-  }
 }
 
 template <class L, class T>
@@ -594,18 +391,25 @@ void Psm<L, T>::apply(std::int32_t sl, const T* gpre, T* g, const Relax<T>& r, b
 }
 
 template <class L, class T>
-void Psm<L, T>::reduce() {
+void Psm<L, T>::reduce(const Vec3& body_force) {
   // Each particle sums its own entries in a fixed order: no atomics, the same on any thread count.
+  // Bulk cells: F_s = -B_s sum_q c_q Omega^s_q(u_s) = B_s (rho (u - u_s) - f_body), by the lattice's
+  // isotropy (sum_q c_q f^eq_q(rho, w) = rho w; rho u = j + f_body / 2 with j the pre-collision
+  // momentum, Guo's forcing): the cell's moments from the kernel, u_s at the cell centre.
   const std::int64_t np = std::int64_t(force_.size());
+  const Vec3 fb = L::D == 3 ? body_force : Vec3(body_force[0], body_force[1], 0);
 #pragma omp parallel for schedule(static) if (np > 2048)
   for (std::int64_t s = 0; s < np; ++s) {
+    const Kinematics& m = kin_[std::size_t(s)];
     Vec3 F = Vec3::Zero(), M = Vec3::Zero();
     for (std::int32_t i = pfirst_[std::size_t(s)]; i < pfirst_[std::size_t(s) + 1]; ++i) {
       const ParticleEntry& e = pentry_[std::size_t(i)];
       Vec3 Fk;
-      if (e.single) {
+      if (e.bulk) {
         const std::size_t c = std::size_t(e.cell);
-        Fk = Vec3(single_F_[0][c], single_F_[1][c], L::D == 3 ? single_F_[2][c] : 0.0);
+        const double rho = double(cell_rho_[c]);
+        const Vec3 u{double(cell_u_[0][c]), double(cell_u_[1][c]), L::D == 3 ? double(cell_u_[2][c]) : 0.0};
+        Fk = double(e.Bs) * (rho * (u - (m.v + m.w.cross(e.arm))) - fb);
       } else {
         const std::size_t k = std::size_t(e.k);
         Fk = Vec3(entry_force_[3 * k], entry_force_[3 * k + 1], entry_force_[3 * k + 2]);
@@ -620,13 +424,15 @@ void Psm<L, T>::reduce() {
 }
 
 template <class L, class T>
-PsmCells<T> Psm<L, T>::single_cells() {
+PsmCells<T> Psm<L, T>::bulk_cells() {
   PsmCells<T> c;
-  c.B = single_B_.data();
+  c.B = cell_B_.data();
+  c.rho = cell_rho_.data();
   for (int a = 0; a < L::D; ++a) {
-    c.us[a] = single_us_[a].data();
-    c.F[a] = single_F_[a].data();
+    c.V[a] = cell_V_[a].data();
+    c.u[a] = cell_u_[a].data();
   }
+  for (int n = 0; n < kS; ++n) c.S[n] = cell_S_[n].data();
   return c;
 }
 

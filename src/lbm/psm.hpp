@@ -88,17 +88,22 @@ inline double psm_weight(double eps, double tau, PsmWeighting w) {
 // (dim 2, d[2] ignored) or sphere of radius r (plane approximation above).
 double psm_cell_fraction(int dim, const Vec3& d, double r);
 
-// Per padded cell, the cells covered by exactly one particle (Psm::single_cells): B (= B_s; 0 for any
-// other cell), the particle's velocity u_s at the cell centre and, written by the fused kernel, the
-// cell's solid force -B sum_q c_q Omega^s_q (lattice units). Components beyond D are null.
+// Per padded cell, the bulk cells the particles cover (Psm::bulk_cells), for the fused kernel: B,
+// and the sums over the covering particles s of B_s u_s (V) and of B_s u_s u_s^T (S: xx, xy, yy in 2D;
+// xx, xy, xz, yy, yz, zz in 3D), which give sum_s B_s Omega^s_q exactly, for any number of particles
+// (f^eq is quadratic in the velocity); written by the kernel, the cell's rho (1 if incompressible)
+// and u, the collision's moments, from which each particle's force follows (Psm::reduce).
+// B = 0: not a covered bulk cell. Components beyond D (V, u) or beyond the 2D three (S) are null.
 template <class T>
 struct PsmCells {
   const T* B = nullptr;
-  const T* us[3] = {nullptr, nullptr, nullptr};
-  double* F[3] = {nullptr, nullptr, nullptr};
+  const T* V[3] = {nullptr, nullptr, nullptr};
+  const T* S[6] = {nullptr, nullptr, nullptr, nullptr, nullptr, nullptr};
+  T* rho = nullptr;
+  T* u[3] = {nullptr, nullptr, nullptr};
 };
 // The fused stream-collide + PSM kernel of one bulk span (psm_sweep.cpp), the bulk kernel's
-// signature plus the cells: g = (1 - B) g* + B g + B Omega^s where B > 0, g* elsewhere.
+// signature plus the cells: g = (1 - B) g* + B g + sum_s B_s Omega^s where B > 0, g* elsewhere.
 template <class T>
 using PsmSpanFn = void (*)(const Grid&, T*, CellIndex, int, int, int, int, bool, const Relax<T>&, T*, T* const*,
                            const PsmCells<T>&);
@@ -135,18 +140,15 @@ class Psm {
   // ---- hooks of Solver::step()
   bool active() const { return !cells_.empty(); }
   std::int32_t slot(CellIndex cell) const { return slot_[std::size_t(cell)]; }
-  // Bulk cells covered by one particle: the span runs the fused kernel (psm_span_kernel) on
-  // single_cells() instead of the bulk kernel.
-  bool span_single(std::int64_t span) const { return span_single_[std::size_t(span)] != 0; }
-  PsmCells<T> single_cells();
-  // Bulk cells covered by several particles, one span at a time inside the bulk sweep (while its
-  // rows are in the cache): save_span before the kernel runs the span, apply_span after it.
-  bool span_covered(std::int64_t span) const { return span_count_[std::size_t(span)] > 0; }
-  void save_span(std::int64_t span, const T* f, bool odd);
-  void apply_span(std::int64_t span, T* f, bool odd, const Relax<T>& r, bool force, bool incomp);
-  // One cell: g holds the kernel's post-collision populations, gpre the pre-collision ones.
+  // A span with covered bulk cells runs the fused kernel (psm_span_kernel) on bulk_cells() instead
+  // of the bulk kernel.
+  bool span_covered(std::int64_t span) const { return span_fused_[std::size_t(span)] != 0; }
+  PsmCells<T> bulk_cells();
+  // One boundary cell: g holds its post-collision populations, gpre the pre-collision ones.
   void apply(std::int32_t slot, const T* gpre, T* g, const Relax<T>& r, bool force, bool incomp);
-  void reduce();  // per-particle force and torque of the step (fixed order per particle)
+  // Per-particle force and torque of the step (fixed order per particle); body_force the fluid's
+  // (lattice units, as the collision had it).
+  void reduce(const Vec3& body_force);
   // The tangential part Ft of a wall link's momentum exchange in `cell` (Solver::reduce_forces,
   // after reduce(), in link order): B_s Ft goes to each particle s covering the cell (torque with
   // the cell's arm); returns the sum handed out, B Ft (zero if the cell is uncovered).
@@ -170,7 +172,6 @@ class Psm {
     T B = 0;
     bool boundary = false;
     bool edge = false;  // on a periodic lattice edge
-    bool single = false;  // a bulk cell covered by one particle: the fused kernel's (single_cells)
   };
   struct Entry {
     std::int32_t particle;
@@ -179,7 +180,8 @@ class Psm {
     Vec3 arm;               // cell centre minus particle centre (unwrapped)
   };
   void build(const ParticleSet& p);          // the fractions, entries and spans of `p`
-  void take_kinematics(const ParticleSet& p);  // kin_ and the single cells' u_s, cells kept
+  void take_kinematics(const ParticleSet& p);  // kin_ and the bulk cells' V and S, cells kept
+  void cell_velocity_sums(const Cell& c);      // V and S of one bulk cell from kin_
   Grid grid_;
   double tau_;
   double refresh_ = 0;
@@ -188,13 +190,11 @@ class Psm {
   std::vector<double> ref_radius_;
   PsmWeighting weighting_ = PsmWeighting::TauDependent;
   std::vector<std::int32_t> span_of_;    // per padded cell (set_cell_spans)
-  std::vector<std::int32_t> span_first_, span_count_;  // per span: its covered cells in bulk_
-  std::vector<std::int32_t> touched_;    // spans with covered cells (cleared by the next set)
-  std::vector<std::uint8_t> span_single_;  // per span: has cells covered by one particle
-  std::vector<std::int32_t> single_spans_;  // those spans (cleared by the next set)
-  // Per padded cell (single_cells): B, u_s and the solid force of single-particle bulk cells.
-  std::vector<T> single_B_, single_us_[3];
-  std::vector<double> single_F_[3];
+  std::vector<std::uint8_t> span_fused_;  // per span: has covered bulk cells
+  std::vector<std::int32_t> fused_spans_;  // those spans (cleared by the next set)
+  // Per padded cell (bulk_cells): B, V, S of covered bulk cells; rho, u written by the kernel.
+  static constexpr int kS = L::D == 3 ? 6 : 3;
+  std::vector<T> cell_B_, cell_V_[3], cell_S_[6], cell_rho_, cell_u_[3];
   // Per padded cell: index into cells_, -1 if uncovered; while set_particles() counts the
   // entries of a cell, -1 - count.
   std::vector<std::int32_t> slot_;
@@ -213,30 +213,25 @@ class Psm {
     Vec3 v, w;
   };
   std::vector<Kinematics> kin_;
+  // Particle s's velocity and angular velocity; disks: (vx, vy, 0) and (0, 0, wz), the rest ignored.
+  static Kinematics kinematics(const ParticleSet& p, std::size_t s) {
+    if constexpr (L::D == 3) return {p.velocity[s], p.omega[s]};
+    return {Vec3(p.velocity[s][0], p.velocity[s][1], 0), Vec3(0, 0, p.omega[s][2])};
+  }
   // Per particle: its entries, pentry_[pfirst_[s] .. pfirst_[s + 1]) (in the order its cells were
   // visited), so that reduce() sums each particle's force alone, in parallel and in a fixed order;
   // stored in that order with what reduce() reads (read through the entries, scattered over the
   // lattice, the sum cost a third of the fused sweep).
   struct ParticleEntry {
     Vec3 arm;
-    CellIndex cell;   // single: the force is single_F_ there
-    std::int32_t k;   // else entry_force_ of entry k
-    bool single;
+    CellIndex cell;   // bulk: the force is B_s (rho (u - u_s) - f_body) from the cell's moments
+    std::int32_t k;   // boundary: entry_force_ of entry k
+    T Bs;
+    bool bulk;
   };
   std::vector<std::int32_t> pfirst_;
   std::vector<ParticleEntry> pentry_;
-  struct BulkCell {
-    CellIndex cell;
-    std::int32_t slot;
-    bool edge;  // on a periodic lattice edge: neighbours wrap (slow path)
-  };
-  std::vector<BulkCell> bulk_;       // covered bulk cells, grouped by span
-  // Slot offsets from a cell's index for g_q before the step (pre) and g*_q after it (post),
-  // even and odd steps, where no neighbour wraps.
-  std::int64_t pre_[2][Q], post_[2][Q];
-  void slots(const BulkCell& b, bool odd, CellIndex* pre, CellIndex* post) const;
-  std::vector<T> gpre_;              // Q per bulk cell: pre-collision populations
-  std::vector<double> entry_force_;  // 3 per entry
+  std::vector<double> entry_force_;  // 3 per entry of a boundary cell
   std::vector<Vec3> force_, torque_, wall_force_;
 };
 

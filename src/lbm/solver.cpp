@@ -221,9 +221,9 @@ void Solver<L, T>::step(bool sample) {
     throw Error("internal: LBM geometry finalized after set_particles(): set the particles again before stepping");
   if (mb_ && mb_->active() && psm_kinds_stale_)
     throw Error("internal: LBM geometry finalized after set_particles(): set the particles again before stepping");
-  bulk_sweep(odd, sample);  // covered bulk cells: Psm::save_span / apply_span around their span
+  bulk_sweep(odd, sample);  // covered bulk cells: the fused PSM kernel on their spans
   boundary_sweep(odd, sample);
-  if (psm) psm_->reduce();
+  if (psm) psm_->reduce(Vec3(double(relax_.force[0]), double(relax_.force[1]), double(relax_.force[2])));
   // Solid particle cells: the links' bounce-back into the slots of the next step, then the reset.
   if (mb_) {
     if (mb_->active()) mb_->apply(f_.data(), odd);
