@@ -174,6 +174,7 @@ void Psm<L, T>::build(const ParticleSet& p) {
     row_lo_.assign(std::size_t(n[1]) * std::size_t(n[2]), INT32_MAX);
     row_hi_.assign(row_lo_.size(), -1);
     cell_B_.assign(N, T(0));
+    cell_eps_.assign(N, 0.0);
     cell_rho_.assign(N, T(0));
     for (int a = 0; a < D; ++a) {
       cell_V_[a].assign(N, T(0));
@@ -184,6 +185,7 @@ void Psm<L, T>::build(const ParticleSet& p) {
   for (const Cell& c : cells_) {
     slot_[std::size_t(c.cell)] = -1;
     cell_B_[std::size_t(c.cell)] = T(0);
+    cell_eps_[std::size_t(c.cell)] = 0;
   }
   for (const std::int32_t sp : fused_spans_) span_fused_[std::size_t(sp)] = 0;
   fused_spans_.clear();
@@ -236,19 +238,18 @@ void Psm<L, T>::build(const ParticleSet& p) {
         }
     }
   }
-  // 2. Entries per cell (slot_ holds -1 - count meanwhile) and the x range touched in each row.
+  // 2. Entries per cell (slot_ holds -1 - count meanwhile), each cell's eps summed in particle
+  //    order, and the x range touched in each row.
   std::size_t nentries = 0;
-  pfirst_.assign(np + 1, 0);
   for (std::size_t ch = 0; ch < nchunk; ++ch) {
     for (const Candidate& cd : chunk_[ch]) {
-      ++pfirst_[std::size_t(cd.particle) + 1];
       --slot_[std::size_t(cd.cell)];
+      cell_eps_[std::size_t(cd.cell)] += cd.eps;
       row_lo_[std::size_t(cd.row)] = std::min(row_lo_[std::size_t(cd.row)], cd.x);
       row_hi_[std::size_t(cd.row)] = std::max(row_hi_[std::size_t(cd.row)], cd.x);
     }
     nentries += chunk_[ch].size();
   }
-  for (std::size_t s = 0; s < np; ++s) pfirst_[s + 1] += pfirst_[s];
   // 3. The covered cells in lattice order (x fastest), as the sweeps visit them: their data is
   //    then read in order (in order of first touch, the random reads of cells and entries made the
   //    update 5-10 times slower than its arithmetic).
@@ -267,25 +268,20 @@ void Psm<L, T>::build(const ParticleSet& p) {
       // On a periodic lattice edge the neighbours wrap (slow path of the slots).
       const bool edge = edge_yz || (grid_.periodic[0] && (x == 0 || x == n[0] - 1));
       const bool boundary = span_of_[std::size_t(ci)] == kBoundaryCell;
-      cells_.push_back(Cell{ci, off, 0, 0.0, T(0), boundary, edge});
+      cells_.push_back(Cell{ci, off, 0, cell_eps_[std::size_t(ci)], T(0), boundary, edge});
       off += count;
     }
     row_lo_[row] = INT32_MAX;
     row_hi_[row] = -1;
   }
   // 4. The entries grouped by cell (counting sort, stable: particle order within a cell), straight
-  //    from the chunk buffers; each cell's eps summed in particle order.
-  //    The candidates are in particle order, so their running index is the particle's list.
+  //    from the chunk buffers.
   entries_.resize(nentries);
-  pentry_.resize(nentries);
-  std::size_t run = 0;
   for (std::size_t ch = 0; ch < nchunk; ++ch)
     for (const Candidate& cd : chunk_[ch]) {
       Cell& c = cells_[std::size_t(slot_[std::size_t(cd.cell)])];
       const std::int32_t k = c.first + c.count++;
       entries_[std::size_t(k)] = Entry{cd.particle, T(0), cd.eps, cd.arm};
-      pentry_[run++] = ParticleEntry{cd.arm, cd.cell, k, T(0), !c.boundary};
-      c.eps += cd.eps;
     }
   // The weights B and B_s, cell by cell (each cell writes its own entries).
   const std::int64_t ncell = std::int64_t(cells_.size());
@@ -302,12 +298,6 @@ void Psm<L, T>::build(const ParticleSet& p) {
       cell_velocity_sums(c);
     }
   }
-  // Each particle's B_s in its own list (read by reduce()).
-  const std::int64_t npart = std::int64_t(np);
-#pragma omp parallel for schedule(static) if (npart > 2048)
-  for (std::int64_t s = 0; s < npart; ++s)
-    for (std::int32_t i = pfirst_[std::size_t(s)]; i < pfirst_[std::size_t(s) + 1]; ++i)
-      pentry_[std::size_t(i)].Bs = entries_[std::size_t(pentry_[std::size_t(i)].k)].Bs;
   // Spans that run the fused kernel.
   for (const Cell& c : cells_) {
     if (c.boundary) continue;
@@ -392,34 +382,37 @@ void Psm<L, T>::apply(std::int32_t sl, const T* gpre, T* g, const Relax<T>& r, b
 
 template <class L, class T>
 void Psm<L, T>::reduce(const Vec3& body_force) {
-  // Each particle sums its own entries in a fixed order: no atomics, the same on any thread count.
-  // Bulk cells: F_s = -B_s sum_q c_q Omega^s_q(u_s) = B_s (rho (u - u_s) - f_body), by the lattice's
-  // isotropy (sum_q c_q f^eq_q(rho, w) = rho w; rho u = j + f_body / 2 with j the pre-collision
-  // momentum, Guo's forcing): the cell's moments from the kernel, u_s at the cell centre.
-  const std::int64_t np = std::int64_t(force_.size());
+  // One pass over the covered cells in lattice order, each entry adding to its particle: a fixed
+  // order, the same on any thread count (serial: per particle in parallel, the reads of the cells'
+  // moments scattered over the lattice cost 3-5 times this pass). Bulk cells:
+  // F_s = -B_s sum_q c_q Omega^s_q(u_s) = B_s (rho (u - u_s) - f_body), by the lattice's isotropy
+  // (sum_q c_q f^eq_q(rho, w) = rho w; rho u = j + f_body / 2 with j the pre-collision momentum,
+  // Guo's forcing), from the cell's moments written by the kernel; boundary cells: apply()'s forces.
   const Vec3 fb = L::D == 3 ? body_force : Vec3(body_force[0], body_force[1], 0);
-#pragma omp parallel for schedule(static) if (np > 2048)
-  for (std::int64_t s = 0; s < np; ++s) {
-    const Kinematics& m = kin_[std::size_t(s)];
-    Vec3 F = Vec3::Zero(), M = Vec3::Zero();
-    for (std::int32_t i = pfirst_[std::size_t(s)]; i < pfirst_[std::size_t(s) + 1]; ++i) {
-      const ParticleEntry& e = pentry_[std::size_t(i)];
-      Vec3 Fk;
-      if (e.bulk) {
-        const std::size_t c = std::size_t(e.cell);
-        const double rho = double(cell_rho_[c]);
-        const Vec3 u{double(cell_u_[0][c]), double(cell_u_[1][c]), L::D == 3 ? double(cell_u_[2][c]) : 0.0};
-        Fk = double(e.Bs) * (rho * (u - (m.v + m.w.cross(e.arm))) - fb);
-      } else {
-        const std::size_t k = std::size_t(e.k);
-        Fk = Vec3(entry_force_[3 * k], entry_force_[3 * k + 1], entry_force_[3 * k + 2]);
+  std::fill(force_.begin(), force_.end(), Vec3::Zero());
+  std::fill(torque_.begin(), torque_.end(), Vec3::Zero());
+  std::fill(wall_force_.begin(), wall_force_.end(), Vec3::Zero());
+  for (const Cell& c : cells_) {
+    if (c.boundary) {
+      for (std::int32_t k = c.first; k < c.first + c.count; ++k) {
+        const Entry& e = entries_[std::size_t(k)];
+        const std::size_t kk = std::size_t(k);
+        const Vec3 Fk(entry_force_[3 * kk], entry_force_[3 * kk + 1], entry_force_[3 * kk + 2]);
+        force_[std::size_t(e.particle)] += Fk;
+        torque_[std::size_t(e.particle)] += e.arm.cross(Fk);
       }
-      F += Fk;
-      M += e.arm.cross(Fk);
+      continue;
     }
-    force_[std::size_t(s)] = F;
-    torque_[std::size_t(s)] = M;
-    wall_force_[std::size_t(s)] = Vec3::Zero();
+    const std::size_t x = std::size_t(c.cell);
+    const double rho = double(cell_rho_[x]);
+    const Vec3 u{double(cell_u_[0][x]), double(cell_u_[1][x]), L::D == 3 ? double(cell_u_[2][x]) : 0.0};
+    for (std::int32_t k = c.first; k < c.first + c.count; ++k) {
+      const Entry& e = entries_[std::size_t(k)];
+      const Kinematics& m = kin_[std::size_t(e.particle)];
+      const Vec3 Fk = double(e.Bs) * (rho * (u - (m.v + m.w.cross(e.arm))) - fb);
+      force_[std::size_t(e.particle)] += Fk;
+      torque_[std::size_t(e.particle)] += e.arm.cross(Fk);
+    }
   }
 }
 

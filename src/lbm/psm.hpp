@@ -195,6 +195,7 @@ class Psm {
   // Per padded cell (bulk_cells): B, V, S of covered bulk cells; rho, u written by the kernel.
   static constexpr int kS = L::D == 3 ? 6 : 3;
   std::vector<T> cell_B_, cell_V_[3], cell_S_[6], cell_rho_, cell_u_[3];
+  std::vector<double> cell_eps_;  // per padded cell: sum of the covering particles' fractions (build)
   // Per padded cell: index into cells_, -1 if uncovered; while set_particles() counts the
   // entries of a cell, -1 - count.
   std::vector<std::int32_t> slot_;
@@ -218,19 +219,6 @@ class Psm {
     if constexpr (L::D == 3) return {p.velocity[s], p.omega[s]};
     return {Vec3(p.velocity[s][0], p.velocity[s][1], 0), Vec3(0, 0, p.omega[s][2])};
   }
-  // Per particle: its entries, pentry_[pfirst_[s] .. pfirst_[s + 1]) (in the order its cells were
-  // visited), so that reduce() sums each particle's force alone, in parallel and in a fixed order;
-  // stored in that order with what reduce() reads (read through the entries, scattered over the
-  // lattice, the sum cost a third of the fused sweep).
-  struct ParticleEntry {
-    Vec3 arm;
-    CellIndex cell;   // bulk: the force is B_s (rho (u - u_s) - f_body) from the cell's moments
-    std::int32_t k;   // boundary: entry_force_ of entry k
-    T Bs;
-    bool bulk;
-  };
-  std::vector<std::int32_t> pfirst_;
-  std::vector<ParticleEntry> pentry_;
   std::vector<double> entry_force_;  // 3 per entry of a boundary cell
   std::vector<Vec3> force_, torque_, wall_force_;
 };
