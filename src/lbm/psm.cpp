@@ -132,6 +132,19 @@ void Psm<L, T>::take_kinematics(const ParticleSet& p) {
 template <class L, class T>
 void Psm<L, T>::cell_velocity_sums(const Cell& c) {
   constexpr int D = L::D;
+  const std::size_t x = std::size_t(c.cell);
+  if (c.count == 1) {  // most cells (the same values as the sums below)
+    const Entry& e = entries_[std::size_t(c.first)];
+    const Kinematics& m = kin_[std::size_t(e.particle)];
+    const Vec3 us = m.v + m.w.cross(e.arm);
+    const double Bs = double(e.Bs);
+    int n = 0;
+    for (int a = 0; a < D; ++a) {
+      cell_V_[a][x] = T(Bs * us[a]);
+      for (int b = a; b < D; ++b) cell_S_[n++][x] = T(Bs * us[a] * us[b]);
+    }
+    return;
+  }
   double V[3] = {0, 0, 0}, S[6] = {0, 0, 0, 0, 0, 0};
   for (std::int32_t k = c.first; k < c.first + c.count; ++k) {
     const Entry& e = entries_[std::size_t(k)];
@@ -144,7 +157,6 @@ void Psm<L, T>::cell_velocity_sums(const Cell& c) {
       for (int b = a; b < D; ++b) S[n++] += Bs * us[a] * us[b];
     }
   }
-  const std::size_t x = std::size_t(c.cell);
   for (int a = 0; a < D; ++a) cell_V_[a][x] = T(V[a]);
   for (int n = 0; n < kS; ++n) cell_S_[n][x] = T(S[n]);
 }

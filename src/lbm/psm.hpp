@@ -29,21 +29,19 @@
 // link's momentum exchange tangential to the wall, the wall the normal part and the rest
 // (Solver::reduce_forces; docs/coupling.md, "Wall links of covered cells").
 //
-// Cost: each step clears the cells of the previous particle set and visits, in each row of a
-// particle's bounding box, only the cells within r + half a cell diagonal of its centre; nothing
-// sweeps the lattice. The fractions are computed in parallel over fixed chunks of particles and
-// gathered in particle order; the covered cells are then listed in lattice order (x fastest), so
-// the cells and entries are the same on any thread count and the sweep reads them in order. Bulk
-// cells covered by one particle (most of them in dense rock) are run by a fused kernel
-// (psm_sweep.cpp): the span's collision and the PSM update in one pass, B and u_s read from
-// per-cell arrays, the cell's force written to one. Spans without such cells keep the bulk kernel
-// (so cells away from particles keep its speed). Bulk cells covered by several particles keep a
-// second path: right before the kernel runs their span their pre-collision populations are
-// saved, and right after, the update g_new = (1 - B) g* + B g + sum_s B_s Omega^s is applied to
-// the kernel's result, in batches of cells (structure of arrays, vectorised). Boundary cells apply
+// Cost: a rebuild (set_particles) clears the cells of the previous particle set and visits, in each
+// row of a particle's bounding box, only the cells within r + half a cell diagonal of its centre;
+// nothing sweeps the lattice. The fractions are computed in parallel over fixed chunks of particles
+// and gathered in particle order; the covered cells are then listed in lattice order (x fastest),
+// so the cells and entries are the same on any thread count. With a refresh distance the fractions
+// are kept over small moves and only the velocities are taken (set_particles). Bulk spans with
+// covered cells run a fused kernel (psm_sweep.cpp): the collision and the PSM update in one pass,
+// reading per cell B, V = sum_s B_s u_s and S = sum_s B_s u_s u_s^T (exact for any number of
+// particles on the cell: f^eq is quadratic in the velocity) and writing the cell's rho and u; spans
+// without covered cells keep the bulk kernel (its speed away from particles). Boundary cells apply
 // the same update inside their own path. Every cell owns its slots (AA pattern), so cells are
-// independent; each particle's force is summed over its own entries in a fixed order: results are
-// the same on any thread count.
+// independent; the particles' forces are summed in one pass over the covered cells in lattice
+// order: results are the same on any thread count.
 #pragma once
 #include <cstdint>
 #include <vector>
