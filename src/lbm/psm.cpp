@@ -335,6 +335,8 @@ void Psm<L, T>::set_cell_spans(std::vector<std::int32_t> span_of_cell, std::size
   fused_spans_.clear();
   cells_.clear();
   entries_.clear();
+  ref_pos_.clear();  // no fractions to keep: the next set_particles() rebuilds
+  ref_radius_.clear();
   span_of_ = std::move(span_of_cell);
 }
 
