@@ -3,6 +3,7 @@
 #include "lbm/psm.hpp"
 
 #include <fmt/format.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <climits>
@@ -183,10 +184,7 @@ void Psm<L, T>::build(const ParticleSet& p) {
   if (slot_.empty()) {
     const std::size_t N = std::size_t(grid_.padded_size());
     slot_.assign(N, -1);
-    row_lo_.assign(std::size_t(n[1]) * std::size_t(n[2]), INT32_MAX);
-    row_hi_.assign(row_lo_.size(), -1);
     cell_B_.assign(N, T(0));
-    cell_eps_.assign(N, 0.0);
     cell_rho_.assign(N, T(0));
     for (int a = 0; a < D; ++a) {
       cell_V_[a].assign(N, T(0));
@@ -197,104 +195,140 @@ void Psm<L, T>::build(const ParticleSet& p) {
   for (const Cell& c : cells_) {
     slot_[std::size_t(c.cell)] = -1;
     cell_B_[std::size_t(c.cell)] = T(0);
-    cell_eps_[std::size_t(c.cell)] = 0;
   }
   for (const std::int32_t sp : fused_spans_) span_fused_[std::size_t(sp)] = 0;
   fused_spans_.clear();
-  cells_.clear();
+  // (cells_ and entries_ are overwritten below: resized, not cleared, so that only new elements are built)
   kin_.resize(np);
   for (std::size_t s = 0; s < np; ++s) kin_[s] = kinematics(p, s);
-  // 1. The covered fractions, particle by particle, in parallel: fixed chunks of consecutive
-  //    particles (independent of the thread count), each into its own buffer, which step 2 reads
-  //    in chunk order, i.e. in particle order as a serial loop would.
-  const std::size_t nchunk = std::min<std::size_t>(kChunks, np);
-  if (chunk_.size() < nchunk) chunk_.resize(nchunk);
+  // 1. Each particle into the lattice rows (y, z) its reach crosses, in particle order (a counting
+  //    sort by row; with the unwrapped y, z for its arms).
+  const std::size_t nrows = std::size_t(n[1]) * std::size_t(n[2]);
   const double half_diag = D == 3 ? std::sqrt(0.75) : std::sqrt(0.5);
-#pragma omp parallel for schedule(dynamic, 1) if (np > 256)
-  for (std::int64_t ch = 0; ch < std::int64_t(nchunk); ++ch) {
-    std::vector<Candidate>& out = chunk_[std::size_t(ch)];
-    out.clear();
-    const std::size_t s0 = std::size_t(ch) * np / nchunk, s1 = std::size_t(ch + 1) * np / nchunk;
-    for (std::size_t s = s0; s < s1; ++s) {
-      const Vec3& X = p.position[s];
-      const double r = p.radius[s];
-      int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
-      for (int a = 0; a < D; ++a) {
-        // Cell x spans [x - 1/2, x + 1/2]: it meets the particle for x in [X - r - 1/2, X + r + 1/2].
-        lo[a] = int(std::ceil(X[a] - r - 0.5));
-        hi[a] = int(std::floor(X[a] + r + 0.5));
+  row_first_.assign(nrows + 1, 0);
+  auto for_each_row = [&](std::size_t s, auto&& f) {
+    const Vec3& X = p.position[s];
+    const double r = p.radius[s], reach2 = (r + half_diag) * (r + half_diag);
+    const int lo1 = int(std::ceil(X[1] - r - 0.5)), hi1 = int(std::floor(X[1] + r + 0.5));
+    const int lo2 = D == 3 ? int(std::ceil(X[2] - r - 0.5)) : 0, hi2 = D == 3 ? int(std::floor(X[2] + r + 0.5)) : 0;
+    for (int z = lo2; z <= hi2; ++z)
+      for (int y = lo1; y <= hi1; ++y) {
+        const double dy = y - X[1], dz = D == 3 ? z - X[2] : 0.0;
+        if (reach2 - dy * dy - dz * dz < -1e-9) continue;  // (margins: rounding never drops a covered cell)
+        const int cy = wrap_axis(y, n[1], grid_.periodic[1]), cz = D == 3 ? wrap_axis(z, n[2], grid_.periodic[2]) : 0;
+        if (cy < 0 || cz < 0) continue;
+        f(std::size_t(cy) + std::size_t(n[1]) * std::size_t(cz), y, z);
       }
-      // Along x only the cells within r + half a cell diagonal of the centre can be covered
-      // (psm_cell_fraction() is 0 beyond): a row visits that range, not the whole box.
-      const double reach2 = (r + half_diag) * (r + half_diag);
-      for (int z = lo[2]; z <= hi[2]; ++z)
-        for (int y = lo[1]; y <= hi[1]; ++y) {
-          const double dy = y - X[1], dz = D == 3 ? z - X[2] : 0.0;
-          const double rest = reach2 - dy * dy - dz * dz;
-          if (rest < -1e-9) continue;  // (margins: rounding never drops a covered cell)
-          const double half = std::sqrt(std::max(rest, 0.0)) + 1e-9;
-          const int x0 = std::max(lo[0], int(std::floor(X[0] - half))), x1 = std::min(hi[0], int(std::ceil(X[0] + half)));
-          const int cy = wrap_axis(y, n[1], grid_.periodic[1]), cz = D == 3 ? wrap_axis(z, n[2], grid_.periodic[2]) : 0;
-          if (cy < 0 || cz < 0) continue;
-          const std::int32_t row = std::int32_t(cy + n[1] * cz);
-          for (int x = x0; x <= x1; ++x) {
-            const int cx = wrap_axis(x, n[0], grid_.periodic[0]);
-            if (cx < 0) continue;
-            const CellIndex ci = grid_.index(cx, cy, cz);
-            if (span_of_[std::size_t(ci)] == kNotFluid) continue;
-            const Vec3 arm = D == 3 ? Vec3(x - X[0], y - X[1], z - X[2]) : Vec3(x - X[0], y - X[1], 0);
-            const double eps = psm_cell_fraction(D, arm, r);
-            if (eps <= 0) continue;
-            out.push_back(Candidate{ci, std::int32_t(s), row, cx, eps, arm});
-          }
+  };
+  for (std::size_t s = 0; s < np; ++s) for_each_row(s, [&](std::size_t row, int, int) { ++row_first_[row + 1]; });
+  for (std::size_t row = 0; row < nrows; ++row) row_first_[row + 1] += row_first_[row];
+  row_item_.resize(std::size_t(row_first_[nrows]));
+  row_fill_.assign(row_first_.begin(), row_first_.end() - 1);
+  for (std::size_t s = 0; s < np; ++s)
+    for_each_row(s, [&](std::size_t row, int y, int z) { row_item_[std::size_t(row_fill_[row]++)] = RowItem{std::int32_t(s), y, z}; });
+  // 2. Row by row, in parallel (each row writes its own buffers): the fractions of the row's cells
+  //    for each particle in turn, then its covered cells in x order, each with its entries in
+  //    particle order (a stable counting sort by x).
+  const int nthreads = omp_get_max_threads();
+  if (int(scratch_.size()) < nthreads) scratch_.resize(std::size_t(nthreads));
+  if (row_cells_.size() < nrows) {
+    row_cells_.resize(nrows);
+    row_entries_.resize(nrows);
+  }
+#pragma omp parallel if (np > 256)
+  {
+    RowScratch& sc = scratch_[std::size_t(omp_get_thread_num())];
+    if (sc.count.size() < std::size_t(n[0]) + 1) sc.count.assign(std::size_t(n[0]) + 1, 0);
+#pragma omp for schedule(dynamic, 16)
+    for (std::int64_t rr = 0; rr < std::int64_t(nrows); ++rr) {
+      const std::size_t row = std::size_t(rr);
+      std::vector<Cell>& out_cells = row_cells_[row];
+      std::vector<Entry>& out_entries = row_entries_[row];
+      out_cells.clear();
+      out_entries.clear();
+      if (row_first_[row] == row_first_[row + 1]) continue;
+      const int cy = int(row % std::size_t(n[1])), cz = int(row / std::size_t(n[1]));
+      auto& cand = sc.cand;
+      cand.clear();
+      int xmin = n[0], xmax = -1;
+      for (std::int64_t it = row_first_[row]; it < row_first_[row + 1]; ++it) {
+        const RowItem& item = row_item_[std::size_t(it)];
+        const std::size_t s = std::size_t(item.particle);
+        const Vec3& X = p.position[s];
+        const double r = p.radius[s], reach2 = (r + half_diag) * (r + half_diag);
+        const double dy = item.y - X[1], dz = D == 3 ? item.z - X[2] : 0.0;
+        // Along x only the cells within r + half a cell diagonal of the centre can be covered
+        // (psm_cell_fraction() is 0 beyond): the row visits that range, not the whole box.
+        const double half = std::sqrt(std::max(reach2 - dy * dy - dz * dz, 0.0)) + 1e-9;
+        const int lo0 = int(std::ceil(X[0] - r - 0.5)), hi0 = int(std::floor(X[0] + r + 0.5));
+        const int x0 = std::max(lo0, int(std::floor(X[0] - half))), x1 = std::min(hi0, int(std::ceil(X[0] + half)));
+        // Cells whose farthest corner is well inside (squared distances, a margin of 1e-12 so that
+        // psm_cell_fraction's own test would say 1 too) skip its square root and corner sums.
+        const double inner = r > half_diag ? (r - half_diag) * (r - half_diag) * (1 - 1e-12) : -1.0;
+        const double dyz2 = dy * dy + dz * dz;
+        for (int x = x0; x <= x1; ++x) {
+          const int cx = wrap_axis(x, n[0], grid_.periodic[0]);
+          if (cx < 0) continue;
+          if (span_of_[std::size_t(grid_.index(cx, cy, cz))] == kNotFluid) continue;
+          const Vec3 arm = D == 3 ? Vec3(x - X[0], item.y - X[1], item.z - X[2]) : Vec3(x - X[0], item.y - X[1], 0);
+          const double eps = arm[0] * arm[0] + dyz2 < inner ? 1.0 : psm_cell_fraction(D, arm, r);
+          if (eps <= 0) continue;
+          cand.push_back(RowCandidate{cx, item.particle, eps, arm});
+          xmin = std::min(xmin, cx);
+          xmax = std::max(xmax, cx);
         }
+      }
+      if (cand.empty()) continue;
+      auto& count = sc.count;  // entries per x, then the first entry of each x (zero outside [xmin, xmax])
+      for (const RowCandidate& c : cand) ++count[std::size_t(c.x) + 1];
+      const bool edge_yz = (grid_.periodic[1] && (cy == 0 || cy == n[1] - 1)) ||
+                           (D == 3 && grid_.periodic[2] && (cz == 0 || cz == n[2] - 1));
+      std::int32_t first = 0;
+      for (int x = xmin; x <= xmax; ++x) {
+        const std::int32_t k = count[std::size_t(x) + 1];
+        if (k == 0) continue;
+        const CellIndex ci = grid_.index(x, cy, cz);
+        const bool edge = edge_yz || (grid_.periodic[0] && (x == 0 || x == n[0] - 1));  // (neighbours wrap)
+        out_cells.push_back(Cell{ci, first, k, 0.0, T(0), span_of_[std::size_t(ci)] == kBoundaryCell, edge});
+        count[std::size_t(x) + 1] = first;  // now the cursor of x's entries
+        first += k;
+      }
+      out_entries.resize(cand.size());
+      for (const RowCandidate& c : cand)
+        out_entries[std::size_t(count[std::size_t(c.x) + 1]++)] = Entry{c.particle, T(0), c.eps, c.arm};
+      for (int x = xmin; x <= xmax + 1; ++x) count[std::size_t(x)] = 0;
+      for (Cell& c : out_cells)  // eps summed in particle order
+        for (std::int32_t k = c.first; k < c.first + c.count; ++k) c.eps += out_entries[std::size_t(k)].eps;
     }
   }
-  // 2. Entries per cell (slot_ holds -1 - count meanwhile), each cell's eps summed in particle
-  //    order, and the x range touched in each row.
-  std::size_t nentries = 0;
-  for (std::size_t ch = 0; ch < nchunk; ++ch) {
-    for (const Candidate& cd : chunk_[ch]) {
-      --slot_[std::size_t(cd.cell)];
-      cell_eps_[std::size_t(cd.cell)] += cd.eps;
-      row_lo_[std::size_t(cd.row)] = std::min(row_lo_[std::size_t(cd.row)], cd.x);
-      row_hi_[std::size_t(cd.row)] = std::max(row_hi_[std::size_t(cd.row)], cd.x);
-    }
-    nentries += chunk_[ch].size();
+  // 3. The rows' cells and entries concatenated in lattice order (x fastest), as the sweeps visit
+  //    them (in order of first touch, the random reads of cells and entries made the update 5-10
+  //    times slower than its arithmetic).
+  std::size_t ncells = 0, nentries = 0;
+  row_cell_off_.resize(nrows + 1);
+  row_entry_off_.resize(nrows + 1);
+  for (std::size_t row = 0; row < nrows; ++row) {
+    row_cell_off_[row] = std::int64_t(ncells);
+    row_entry_off_[row] = std::int64_t(nentries);
+    ncells += row_cells_[row].size();
+    nentries += row_entries_[row].size();
   }
-  // 3. The covered cells in lattice order (x fastest), as the sweeps visit them: their data is
-  //    then read in order (in order of first touch, the random reads of cells and entries made the
-  //    update 5-10 times slower than its arithmetic).
-  std::int32_t off = 0;
-  for (std::size_t row = 0; row < row_lo_.size(); ++row) {
-    if (row_hi_[row] < 0) continue;
-    const int y = int(row % std::size_t(n[1])), z = int(row / std::size_t(n[1]));
-    const bool edge_yz = (grid_.periodic[1] && (y == 0 || y == n[1] - 1)) ||
-                         (D == 3 && grid_.periodic[2] && (z == 0 || z == n[2] - 1));
-    for (int x = row_lo_[row]; x <= row_hi_[row]; ++x) {
-      const CellIndex ci = grid_.index(x, y, z);
-      std::int32_t& sl = slot_[std::size_t(ci)];
-      if (sl >= -1) continue;
-      const std::int32_t count = -1 - sl;
-      sl = std::int32_t(cells_.size());
-      // On a periodic lattice edge the neighbours wrap (slow path of the slots).
-      const bool edge = edge_yz || (grid_.periodic[0] && (x == 0 || x == n[0] - 1));
-      const bool boundary = span_of_[std::size_t(ci)] == kBoundaryCell;
-      cells_.push_back(Cell{ci, off, 0, cell_eps_[std::size_t(ci)], T(0), boundary, edge});
-      off += count;
-    }
-    row_lo_[row] = INT32_MAX;
-    row_hi_[row] = -1;
-  }
-  // 4. The entries grouped by cell (counting sort, stable: particle order within a cell), straight
-  //    from the chunk buffers.
+  if (nentries >= std::size_t(INT32_MAX)) throw InputError("PSM particle set: more than 2^31 - 1 cell entries");
+  cells_.resize(ncells);
   entries_.resize(nentries);
-  for (std::size_t ch = 0; ch < nchunk; ++ch)
-    for (const Candidate& cd : chunk_[ch]) {
-      Cell& c = cells_[std::size_t(slot_[std::size_t(cd.cell)])];
-      const std::int32_t k = c.first + c.count++;
-      entries_[std::size_t(k)] = Entry{cd.particle, T(0), cd.eps, cd.arm};
+#pragma omp parallel for schedule(dynamic, 64) if (ncells > 16384)
+  for (std::int64_t rr = 0; rr < std::int64_t(nrows); ++rr) {
+    const std::size_t row = std::size_t(rr);
+    const std::size_t c0 = std::size_t(row_cell_off_[row]), e0 = std::size_t(row_entry_off_[row]);
+    const auto& rc = row_cells_[row];
+    for (std::size_t i = 0; i < rc.size(); ++i) {
+      Cell c = rc[i];
+      c.first += std::int32_t(e0);
+      cells_[c0 + i] = c;
+      slot_[std::size_t(c.cell)] = std::int32_t(c0 + i);
     }
+    std::copy(row_entries_[row].begin(), row_entries_[row].end(), entries_.begin() + std::ptrdiff_t(e0));
+  }
   // The weights B and B_s, cell by cell (each cell writes its own entries).
   const std::int64_t ncell = std::int64_t(cells_.size());
 #pragma omp parallel for schedule(static) if (ncell > 16384)

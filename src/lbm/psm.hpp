@@ -193,21 +193,30 @@ class Psm {
   // Per padded cell (bulk_cells): B, V, S of covered bulk cells; rho, u written by the kernel.
   static constexpr int kS = L::D == 3 ? 6 : 3;
   std::vector<T> cell_B_, cell_V_[3], cell_S_[6], cell_rho_, cell_u_[3];
-  std::vector<double> cell_eps_;  // per padded cell: sum of the covering particles' fractions (build)
   // Per padded cell: index into cells_, -1 if uncovered; while set_particles() counts the
   // entries of a cell, -1 - count.
   std::vector<std::int32_t> slot_;
-  std::vector<std::int32_t> row_lo_, row_hi_;  // per lattice row (y, z): x range touched (set_particles)
+  // Rebuild scratch (build): per lattice row (y, z), the particles crossing it (row_item_
+  // [row_first_[row] ..)), its cells and entries, and their offsets in cells_ / entries_.
+  struct RowItem {
+    std::int32_t particle, y, z;  // y, z unwrapped
+  };
+  std::vector<std::int64_t> row_first_, row_fill_, row_cell_off_, row_entry_off_;
+  std::vector<RowItem> row_item_;
   std::vector<Cell> cells_;          // in lattice order (x fastest), so that the sweep reads them in order
   std::vector<Entry> entries_;       // grouped by cell, particle order within a cell
-  struct Candidate {                 // an entry before its cell has a slot (set_particles, step 1)
-    CellIndex cell;
-    std::int32_t particle, row, x;
+  std::vector<std::vector<Cell>> row_cells_;
+  std::vector<std::vector<Entry>> row_entries_;
+  struct RowCandidate {  // an entry of a row before its cell is known: x, particle, eps, arm
+    std::int32_t x, particle;
     double eps;
     Vec3 arm;
   };
-  static constexpr std::size_t kChunks = 64;  // particle chunks of the parallel fraction pass
-  std::vector<std::vector<Candidate>> chunk_;
+  struct RowScratch {  // per thread
+    std::vector<RowCandidate> cand;
+    std::vector<std::int32_t> count;  // per x + 1
+  };
+  std::vector<RowScratch> scratch_;
   struct Kinematics {
     Vec3 v, w;
   };
