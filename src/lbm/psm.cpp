@@ -229,23 +229,23 @@ void Psm<L, T>::build(const ParticleSet& p) {
   // 2. Row by row, in parallel (each row writes its own buffers): the fractions of the row's cells
   //    for each particle in turn, then its covered cells in x order, each with its entries in
   //    particle order (a stable counting sort by x).
+  //    Each thread appends its rows to its own buffers (rows dealt out in fixed chunks, so that the
+  //    buffers keep their sizes from step to step: no allocation once they have grown).
   const int nthreads = omp_get_max_threads();
   if (int(scratch_.size()) < nthreads) scratch_.resize(std::size_t(nthreads));
-  if (row_cells_.size() < nrows) {
-    row_cells_.resize(nrows);
-    row_entries_.resize(nrows);
-  }
+  row_out_.resize(nrows);
 #pragma omp parallel if (np > 256)
   {
-    RowScratch& sc = scratch_[std::size_t(omp_get_thread_num())];
+    const int t = omp_get_thread_num();
+    RowScratch& sc = scratch_[std::size_t(t)];
     if (sc.count.size() < std::size_t(n[0]) + 1) sc.count.assign(std::size_t(n[0]) + 1, 0);
-#pragma omp for schedule(dynamic, 16)
+    sc.cells.clear();
+    sc.entries.clear();
+#pragma omp for schedule(static, 16)
     for (std::int64_t rr = 0; rr < std::int64_t(nrows); ++rr) {
       const std::size_t row = std::size_t(rr);
-      std::vector<Cell>& out_cells = row_cells_[row];
-      std::vector<Entry>& out_entries = row_entries_[row];
-      out_cells.clear();
-      out_entries.clear();
+      RowOut& ro = row_out_[row];
+      ro = RowOut{t, std::int64_t(sc.cells.size()), 0, std::int64_t(sc.entries.size()), 0};
       if (row_first_[row] == row_first_[row + 1]) continue;
       const int cy = int(row % std::size_t(n[1])), cz = int(row / std::size_t(n[1]));
       auto& cand = sc.cand;
@@ -279,11 +279,15 @@ void Psm<L, T>::build(const ParticleSet& p) {
         }
       }
       if (cand.empty()) continue;
+      std::vector<Cell>& out_cells = sc.cells;
+      std::vector<Entry>& out_entries = sc.entries;
+      const std::int32_t e_begin = std::int32_t(out_entries.size());
+      const std::size_t c_begin = out_cells.size();
       auto& count = sc.count;  // entries per x, then the first entry of each x (zero outside [xmin, xmax])
       for (const RowCandidate& c : cand) ++count[std::size_t(c.x) + 1];
       const bool edge_yz = (grid_.periodic[1] && (cy == 0 || cy == n[1] - 1)) ||
                            (D == 3 && grid_.periodic[2] && (cz == 0 || cz == n[2] - 1));
-      std::int32_t first = 0;
+      std::int32_t first = e_begin;  // (offsets in the thread's entries, moved to entries_ below)
       for (int x = xmin; x <= xmax; ++x) {
         const std::int32_t k = count[std::size_t(x) + 1];
         if (k == 0) continue;
@@ -293,12 +297,16 @@ void Psm<L, T>::build(const ParticleSet& p) {
         count[std::size_t(x) + 1] = first;  // now the cursor of x's entries
         first += k;
       }
-      out_entries.resize(cand.size());
+      out_entries.resize(std::size_t(e_begin) + cand.size());
       for (const RowCandidate& c : cand)
         out_entries[std::size_t(count[std::size_t(c.x) + 1]++)] = Entry{c.particle, T(0), c.eps, c.arm};
       for (int x = xmin; x <= xmax + 1; ++x) count[std::size_t(x)] = 0;
-      for (Cell& c : out_cells)  // eps summed in particle order
+      for (std::size_t i = c_begin; i < out_cells.size(); ++i) {  // eps summed in particle order
+        Cell& c = out_cells[i];
         for (std::int32_t k = c.first; k < c.first + c.count; ++k) c.eps += out_entries[std::size_t(k)].eps;
+      }
+      ro.cells = std::int64_t(out_cells.size() - c_begin);
+      ro.entries = std::int64_t(cand.size());
     }
   }
   // 3. The rows' cells and entries concatenated in lattice order (x fastest), as the sweeps visit
@@ -310,8 +318,8 @@ void Psm<L, T>::build(const ParticleSet& p) {
   for (std::size_t row = 0; row < nrows; ++row) {
     row_cell_off_[row] = std::int64_t(ncells);
     row_entry_off_[row] = std::int64_t(nentries);
-    ncells += row_cells_[row].size();
-    nentries += row_entries_[row].size();
+    ncells += std::size_t(row_out_[row].cells);
+    nentries += std::size_t(row_out_[row].entries);
   }
   if (nentries >= std::size_t(INT32_MAX)) throw InputError("PSM particle set: more than 2^31 - 1 cell entries");
   cells_.resize(ncells);
@@ -319,15 +327,18 @@ void Psm<L, T>::build(const ParticleSet& p) {
 #pragma omp parallel for schedule(dynamic, 64) if (ncells > 16384)
   for (std::int64_t rr = 0; rr < std::int64_t(nrows); ++rr) {
     const std::size_t row = std::size_t(rr);
+    const RowOut& ro = row_out_[row];
+    const RowScratch& sc = scratch_[std::size_t(ro.thread)];
     const std::size_t c0 = std::size_t(row_cell_off_[row]), e0 = std::size_t(row_entry_off_[row]);
-    const auto& rc = row_cells_[row];
-    for (std::size_t i = 0; i < rc.size(); ++i) {
-      Cell c = rc[i];
-      c.first += std::int32_t(e0);
-      cells_[c0 + i] = c;
-      slot_[std::size_t(c.cell)] = std::int32_t(c0 + i);
+    const std::int64_t shift = std::int64_t(e0) - ro.entry_begin;
+    for (std::int64_t i = 0; i < ro.cells; ++i) {
+      Cell c = sc.cells[std::size_t(ro.cell_begin + i)];
+      c.first = std::int32_t(c.first + shift);
+      cells_[c0 + std::size_t(i)] = c;
+      slot_[std::size_t(c.cell)] = std::int32_t(c0 + std::size_t(i));
     }
-    std::copy(row_entries_[row].begin(), row_entries_[row].end(), entries_.begin() + std::ptrdiff_t(e0));
+    std::copy(sc.entries.begin() + std::ptrdiff_t(ro.entry_begin), sc.entries.begin() + std::ptrdiff_t(ro.entry_begin + ro.entries),
+              entries_.begin() + std::ptrdiff_t(e0));
   }
   // The weights B and B_s, cell by cell (each cell writes its own entries).
   const std::int64_t ncell = std::int64_t(cells_.size());

@@ -205,8 +205,11 @@ class Psm {
   std::vector<RowItem> row_item_;
   std::vector<Cell> cells_;          // in lattice order (x fastest), so that the sweep reads them in order
   std::vector<Entry> entries_;       // grouped by cell, particle order within a cell
-  std::vector<std::vector<Cell>> row_cells_;
-  std::vector<std::vector<Entry>> row_entries_;
+  struct RowOut {  // where build() left a row: thread, its first cell and entry there, their counts
+    int thread = 0;
+    std::int64_t cell_begin = 0, cells = 0, entry_begin = 0, entries = 0;
+  };
+  std::vector<RowOut> row_out_;
   struct RowCandidate {  // an entry of a row before its cell is known: x, particle, eps, arm
     std::int32_t x, particle;
     double eps;
@@ -215,6 +218,8 @@ class Psm {
   struct RowScratch {  // per thread
     std::vector<RowCandidate> cand;
     std::vector<std::int32_t> count;  // per x + 1
+    std::vector<Cell> cells;          // its rows' cells and entries, in row order
+    std::vector<Entry> entries;
   };
   std::vector<RowScratch> scratch_;
   struct Kinematics {
