@@ -324,8 +324,8 @@ int main(int argc, char** argv) {
       if (o.motion != "slow" && o.motion != "fast") usage("--motion: slow or fast");
     } else if (a == "-h" || a == "--help") {
       fmt::print(
-          "Usage: coupled [--quick] [--threads 1,2] [--steps N] [--block N] [--dim 2|3] [--scheme psm|psm-r|stair|interp]\n"
-          "               [--motion slow|fast] [--sub N]\n"
+          "Usage: coupled [--quick] [--threads 1,2] [--steps N] [--block N] [--dim 2|3]\n"
+          "               [--scheme psm|psm-r|stair|interp] [--motion slow|fast] [--sub N]\n"
           "Times the coupled DEM-LBM step of a bonded block with a borehole (2D: 1000^2 D2Q9, ~10,000 disks;\n"
           "3D: 96^3 D3Q19, ~18,500 spheres; --quick: small lattices) for each particle scheme, split into\n"
           "LBM (the same lattice without particles), coup (everything the particles add), set (its part\n"

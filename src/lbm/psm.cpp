@@ -225,7 +225,9 @@ void Psm<L, T>::build(const ParticleSet& p) {
   row_item_.resize(std::size_t(row_first_[nrows]));
   row_fill_.assign(row_first_.begin(), row_first_.end() - 1);
   for (std::size_t s = 0; s < np; ++s)
-    for_each_row(s, [&](std::size_t row, int y, int z) { row_item_[std::size_t(row_fill_[row]++)] = RowItem{std::int32_t(s), y, z}; });
+    for_each_row(s, [&](std::size_t row, int y, int z) {
+      row_item_[std::size_t(row_fill_[row]++)] = RowItem{std::int32_t(s), y, z};
+    });
   // 2. Row by row, in parallel (each row writes its own buffers): the fractions of the row's cells
   //    for each particle in turn, then its covered cells in x order, each with its entries in
   //    particle order (a stable counting sort by x).
@@ -337,8 +339,8 @@ void Psm<L, T>::build(const ParticleSet& p) {
       cells_[c0 + std::size_t(i)] = c;
       slot_[std::size_t(c.cell)] = std::int32_t(c0 + std::size_t(i));
     }
-    std::copy(sc.entries.begin() + std::ptrdiff_t(ro.entry_begin), sc.entries.begin() + std::ptrdiff_t(ro.entry_begin + ro.entries),
-              entries_.begin() + std::ptrdiff_t(e0));
+    const auto from = sc.entries.begin() + std::ptrdiff_t(ro.entry_begin);
+    std::copy(from, from + std::ptrdiff_t(ro.entries), entries_.begin() + std::ptrdiff_t(e0));
   }
   // The weights B and B_s, cell by cell (each cell writes its own entries).
   const std::int64_t ncell = std::int64_t(cells_.size());

@@ -109,7 +109,8 @@ FF_PSM_SWEEP_CLONES void psm_span(const Grid& g, T* f, CellIndex N, int x0, int 
     const Relax<T> rl = r;
     std::int64_t i = 0;
     for (; i + kLine <= n; i += kLine) {
-      static_for<L::Q>([&](auto q) FF_LBM_LAMBDA_INLINE { __builtin_prefetch(p[q] + i + kPrefetchLines * kLine, 0, 3); });
+      static_for<L::Q>(
+          [&](auto q) FF_LBM_LAMBDA_INLINE { __builtin_prefetch(p[q] + i + kPrefetchLines * kLine, 0, 3); });
       psm_cells<L, T, M, kForce, kMoments, kIncomp>(p, i, i + kLine, rl, m, c);
     }
     psm_cells<L, T, M, kForce, kMoments, kIncomp>(p, i, n, rl, m, c);

@@ -333,6 +333,26 @@ TEST(Psm, BoundaryCellsAtARestingWall) {
   EXPECT_LT(worst, 1e-10);
 }
 
+namespace {
+// Forty disks in two rows along the walls of the 180 x 120 box, moving and spinning (neighbours
+// overlap; > 4096 covered cells: the parallel PSM passes), stepped from the solver's time to `steps`.
+void step_forty_disks(Solver<D2Q9, double>& sol, long steps) {
+  ParticleSet p;
+  p.resize(40);
+  for (int s = 0; s < 40; ++s) {
+    p.radius[s] = 6.5 + 0.1 * (s % 7);
+    p.velocity[s] = Vec3(0.01 * std::sin(s), 0.01 * std::cos(s), 0);
+    p.omega[s] = Vec3(0, 0, 0.002 * (s % 3 - 1));
+  }
+  for (long t = sol.time_step(); t < steps; ++t) {
+    for (int s = 0; s < 40; ++s)
+      p.position[s] = Vec3(9.0 * (s % 20) + 3.1, s < 20 ? 3.2 : 60.3, 0) + double(t) * p.velocity[s];
+    sol.set_particles(p);
+    sol.step();
+  }
+}
+}  // namespace
+
 // 1 and 2 threads give identical populations and forces, with particles touching the walls (the
 // boundary-cell path) and enough cells for the parallel sweeps and PSM passes; a run resumed from the
 // populations at step 10 (particles set again) continues bit-for-bit.
@@ -341,19 +361,7 @@ TEST(Psm, ThreadsAndResumeBitIdentical) {
     omp_set_num_threads(threads);
     auto sol = periodic_box<D2Q9>(180, 120, 1, 0.7, Vec3::Zero(), true);
     if (from) sol.restore(std::vector<double>(from->populations().begin(), from->populations().end()), from->time_step());
-    ParticleSet p;
-    p.resize(40);
-    for (int s = 0; s < 40; ++s) {
-      p.radius[s] = 6.5 + 0.1 * (s % 7);  // neighbours overlap; > 4096 covered cells: parallel PSM passes
-      p.velocity[s] = Vec3(0.01 * std::sin(s), 0.01 * std::cos(s), 0);
-      p.omega[s] = Vec3(0, 0, 0.002 * (s % 3 - 1));
-    }
-    for (long t = sol.time_step(); t < steps; ++t) {
-      for (int s = 0; s < 40; ++s)
-        p.position[s] = Vec3(9.0 * (s % 20) + 3.1, s < 20 ? 3.2 : 60.3, 0) + double(t) * p.velocity[s];
-      sol.set_particles(p);
-      sol.step();
-    }
+    step_forty_disks(sol, steps);
     return sol;
   };
   const int saved = omp_get_max_threads();
@@ -388,19 +396,7 @@ TEST(Psm, RefreshKeepsTheFractionsAndResumesBitIdentical) {
       sol.restore(std::vector<double>(from->populations().begin(), from->populations().end()), from->time_step());
       sol.restore_psm_geometry(from->psm()->geometry_positions(), from->psm()->geometry_radii());
     }
-    ParticleSet p;
-    p.resize(40);
-    for (int s = 0; s < 40; ++s) {
-      p.radius[s] = 6.5 + 0.1 * (s % 7);
-      p.velocity[s] = Vec3(0.01 * std::sin(s), 0.01 * std::cos(s), 0);
-      p.omega[s] = Vec3(0, 0, 0.002 * (s % 3 - 1));
-    }
-    for (long t = sol.time_step(); t < steps; ++t) {
-      for (int s = 0; s < 40; ++s)
-        p.position[s] = Vec3(9.0 * (s % 20) + 3.1, s < 20 ? 3.2 : 60.3, 0) + double(t) * p.velocity[s];
-      sol.set_particles(p);
-      sol.step();
-    }
+    step_forty_disks(sol, steps);
     return sol;
   };
   const int saved = omp_get_max_threads();
@@ -413,11 +409,11 @@ TEST(Psm, RefreshKeepsTheFractionsAndResumesBitIdentical) {
   EXPECT_GE(kept.psm()->rebuilds(), 4);
   EXPECT_LE(kept.psm()->rebuilds(), 10);
   double worst = 0, scale = 0;
-  for (std::size_t s = 0; s < exact.particle_forces().size(); ++s) scale = std::max(scale, exact.particle_forces()[s].norm());
+  for (const Vec3& f : exact.particle_forces()) scale = std::max(scale, f.norm());
   for (std::size_t s = 0; s < exact.particle_forces().size(); ++s)
     worst = std::max(worst, (kept.particle_forces()[s] - exact.particle_forces()[s]).norm() / scale);
-  std::printf("refresh 0.05 cells: %ld rebuilds in 30 steps, forces within %.2e of the largest\n", kept.psm()->rebuilds(),
-              worst);
+  std::printf("refresh 0.05 cells: %ld rebuilds in 30 steps, forces within %.2e of the largest\n",
+              kept.psm()->rebuilds(), worst);
   EXPECT_LT(worst, 0.02);
   for (std::size_t i = 0; i < kept.populations().size(); ++i)
     ASSERT_EQ(kept.populations()[i], resumed.populations()[i]) << "resume, slot " << i;

@@ -189,7 +189,8 @@ TEST(SaturatedUcs3D, ResumeWithDrainedSidesAndSubCyclingBitIdentical) {
   ASSERT_EQ(test::run_scenario(text, sets, whole, 1), RunStatus::Finished);
   ASSERT_EQ(test::run_scenario(text, sets, parts, 1, 1000), RunStatus::Interrupted);
   ASSERT_EQ(test::run_scenario(text, sets, parts, 1, 0, true), RunStatus::Finished);
-  test::expect_same_results(whole, parts, "3D saturated UCS, drained sides, flow_every = 0, resumed at step 1000 (4 % strain)");
+  test::expect_same_results(whole, parts,
+                            "3D saturated UCS, drained sides, flow_every = 0, resumed at step 1000 (4 % strain)");
   std::filesystem::remove_all(whole);
   std::filesystem::remove_all(parts);
 }
