@@ -1,14 +1,20 @@
 // Shared by the hydrofrac tests: the coal-matrix material of examples/ucs_2d.toml (the Brazilian
-// tests' material), an output section without VTK, plots or progress, and where the first cracks lie.
+// tests' material), an output section without VTK, plots or progress, where the first cracks lie,
+// and the stop-and-resume check.
 #pragma once
 #include <fmt/format.h>
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "io/csv.hpp"
+#include "../program_runner.hpp"
 
 namespace ff::test {
 
@@ -50,6 +56,27 @@ inline std::vector<double> first_crack_distances(const std::filesystem::path& cs
   std::vector<double> d;
   for (std::size_t r = 0; r < t.rows() && d.size() < n; ++r) d.push_back(std::hypot(x[r] - cx, y[r] - cy));
   return d;
+}
+
+// `file` run into `parts`, stopped after `stop` steps and resumed by `fracflow resume` (one thread,
+// `sets` as the whole run had them): series.csv and cracks.csv byte for byte those of the whole run
+// in `whole`.
+inline void expect_resume_identical(const std::filesystem::path& file, const std::filesystem::path& whole,
+                                    const std::filesystem::path& parts, long stop, const std::string& sets = "") {
+  const auto bytes = [](const std::filesystem::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  };
+  auto r = run_program("run " + file.string() + " --out " + parts.string() + " -q -j1 --max-steps " +
+                       std::to_string(stop) + sets);
+  ASSERT_EQ(r.code, 0) << r.output;
+  ASSERT_FALSE(std::filesystem::exists(parts / "summary.json"));
+  r = run_program("resume " + parts.string() + " -q -j1");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(bytes(whole / "series.csv"), bytes(parts / "series.csv"));
+  EXPECT_EQ(bytes(whole / "cracks.csv"), bytes(parts / "cracks.csv"));
 }
 
 }  // namespace ff::test

@@ -76,20 +76,6 @@ std::string slurp(const fs::path& p) {
   return ss.str();
 }
 
-// `file` run into `parts`, stopped after `stop` steps and resumed (one thread, `sets` as the whole
-// run had them): series.csv and cracks.csv byte for byte those of the whole run in `whole`.
-void expect_resume_identical(const fs::path& file, const fs::path& whole, const fs::path& parts, long stop,
-                             const std::string& sets = "") {
-  auto r = fracflow("run " + file.string() + " --out " + parts.string() + " -q -j1 --max-steps " +
-                    std::to_string(stop) + sets);
-  ASSERT_EQ(r.code, 0) << r.output;
-  ASSERT_FALSE(fs::exists(parts / "summary.json"));
-  r = fracflow("resume " + parts.string() + " -q -j1");
-  ASSERT_EQ(r.code, 0) << r.output;
-  EXPECT_EQ(slurp(whole / "series.csv"), slurp(parts / "series.csv"));
-  EXPECT_EQ(slurp(whole / "cracks.csv"), slurp(parts / "cracks.csv"));
-}
-
 }  // namespace
 
 
@@ -116,7 +102,7 @@ TEST(HydrofracLbm, ResumeAndTwoThreadsAreBitIdenticalAndTheRockBreaks) {
               b["injected"].get<double>() + b["covering_refill"].get<double>() + b["residual"].get<double>(),
               1e-9 * b["lattice_change"].get<double>());
   EXPECT_LT(std::abs(b["residual"].get<double>()), 0.02 * b["injected"].get<double>());
-  expect_resume_identical(file, whole, parts, 9000);
+  ff::test::expect_resume_identical(file, whole, parts, 9000);
   auto r = fracflow("run " + file.string() + " --out " + two.string() + " -q -j2 --set dem.parallel_min=200");
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_EQ(slurp(whole / "series.csv"), slurp(two / "series.csv"));
@@ -133,7 +119,7 @@ TEST(HydrofracLbm, PsmResumeIsBitIdentical) {
   const std::string sets = " --set fluid.scheme=psm --set injection.max_pressure=8e6";
   const auto r = fracflow("run " + file.string() + " --out " + whole.string() + " -q -j1" + sets);
   ASSERT_EQ(r.code, 0) << r.output;
-  expect_resume_identical(file, whole, parts, 3000, sets);
+  ff::test::expect_resume_identical(file, whole, parts, 3000, sets);
 }
 
 // `fracflow check` on an LBM scenario prints what `run` logs at the start of injection: dt_lbm,

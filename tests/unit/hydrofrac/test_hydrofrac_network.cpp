@@ -204,17 +204,12 @@ TEST(HydrofracNetwork, ResumeAndTwoThreadsAreBitIdentical) {
   const fs::path file = s.write("block.toml", block("network"));
   const fs::path whole = s / "whole", parts = s / "parts", two = s / "two";
   const auto j = run_scenario(file, whole);
-  auto r = fracflow("run " + file.string() + " --out " + parts.string() + " -q -j1 --max-steps 9000");
-  ASSERT_EQ(r.code, 0) << r.output;
-  ASSERT_FALSE(fs::exists(parts / "summary.json"));
-  r = fracflow("resume " + parts.string() + " -q -j1");
-  ASSERT_EQ(r.code, 0) << r.output;
-  EXPECT_EQ(slurp(whole / "series.csv"), slurp(parts / "series.csv"));
-  EXPECT_EQ(slurp(whole / "cracks.csv"), slurp(parts / "cracks.csv"));
+  ff::test::expect_resume_identical(file, whole, parts, 9000);
   const auto jp = ff::test::read_json(parts / "summary.json");
   EXPECT_EQ(j["breakdown"], jp["breakdown"]);
   EXPECT_EQ(j["network"]["mass_budget_kg"], jp["network"]["mass_budget_kg"]);
-  r = fracflow("run " + file.string() + " --out " + two.string() + " -q -j2 --max-steps 12000 --set dem.parallel_min=200");
+  const auto r = fracflow("run " + file.string() + " --out " + two.string() +
+                          " -q -j2 --max-steps 12000 --set dem.parallel_min=200");
   ASSERT_EQ(r.code, 0) << r.output;
   const std::string s1 = slurp(whole / "series.csv"), s2 = slurp(two / "series.csv");
   const std::string c1 = slurp(whole / "cracks.csv"), c2 = slurp(two / "cracks.csv");
