@@ -121,7 +121,7 @@ class Psm {
   // Clears the previous set's cells and covers those of `p`; throws InputError on bad input.
   // With a refresh distance d > 0 (set_refresh) the fractions are kept while every particle lies
   // within d cells of where they were computed (same count and radii): then only the particles'
-  // velocities are taken (u_s of every covered cell), at a cost of one pass over the covered cells
+  // velocities are taken (V and S of every covered bulk cell), at a cost of one pass over the cells
   // instead of a rebuild. The fractions then lag the particles by at most d cells (psm_cell_fraction
   // itself is within 0.02 of the sub-cell integral), and the forces' arms by as much.
   void set_particles(const ParticleSet& p);
@@ -144,8 +144,8 @@ class Psm {
   PsmCells<T> bulk_cells();
   // One boundary cell: g holds its post-collision populations, gpre the pre-collision ones.
   void apply(std::int32_t slot, const T* gpre, T* g, const Relax<T>& r, bool force, bool incomp);
-  // Per-particle force and torque of the step (fixed order per particle); body_force the fluid's
-  // (lattice units, as the collision had it).
+  // Per-particle force and torque of the step (one pass over the covered cells in lattice order);
+  // body_force the fluid's (lattice units, as the collision had it).
   void reduce(const Vec3& body_force);
   // The tangential part Ft of a wall link's momentum exchange in `cell` (Solver::reduce_forces,
   // after reduce(), in link order): B_s Ft goes to each particle s covering the cell (torque with
@@ -193,21 +193,21 @@ class Psm {
   // Per padded cell (bulk_cells): B, V, S of covered bulk cells; rho, u written by the kernel.
   static constexpr int kS = L::D == 3 ? 6 : 3;
   std::vector<T> cell_B_, cell_V_[3], cell_S_[6], cell_rho_, cell_u_[3];
-  // Per padded cell: index into cells_, -1 if uncovered; while set_particles() counts the
-  // entries of a cell, -1 - count.
+  // Per padded cell: index into cells_, -1 if uncovered.
   std::vector<std::int32_t> slot_;
   // Rebuild scratch (build): per lattice row (y, z), the particles crossing it (row_item_
-  // [row_first_[row] ..)), its cells and entries, and their offsets in cells_ / entries_.
+  // [row_first_[row] ..)) and where its cells and entries are (row_out_).
   struct RowItem {
     std::int32_t particle, y, z;  // y, z unwrapped
   };
-  std::vector<std::int64_t> row_first_, row_fill_, row_cell_off_, row_entry_off_;
+  std::vector<std::int64_t> row_first_, row_fill_;
   std::vector<RowItem> row_item_;
   std::vector<Cell> cells_;          // in lattice order (x fastest), so that the sweep reads them in order
   std::vector<Entry> entries_;       // grouped by cell, particle order within a cell
-  struct RowOut {  // where build() left a row: thread, its first cell and entry there, their counts
+  struct RowOut {  // where build() left a row (thread, first cell and entry there, counts) and where it goes
     int thread = 0;
     std::int64_t cell_begin = 0, cells = 0, entry_begin = 0, entries = 0;
+    std::int64_t cell_dest = 0, entry_dest = 0;  // its first cell in cells_, entry in entries_
   };
   std::vector<RowOut> row_out_;
   struct RowCandidate {  // an entry of a row before its cell is known: x, particle, eps, arm

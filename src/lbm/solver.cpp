@@ -447,19 +447,20 @@ void Solver<L, T>::restore_particles(const ParticleSet& last) {
 template <class L, class T>
 void Solver<L, T>::restore_psm_geometry(const std::vector<Vec3>& positions, const std::vector<double>& radii) {
   if (settings_.particle_scheme != ParticleScheme::Psm) return;
-  ParticleSet g;
-  g.resize(radii.size());
-  if (positions.size() != radii.size())
-    throw InputError(fmt::format("PSM geometry: {} positions for {} radii", positions.size(), radii.size()));
-  g.position = positions;
-  g.radius = radii;
-  set_particles(g);                              // the cell classification, as a first set would
-  psm_->restore_geometry(positions, radii);      // and the fractions from exactly these
+  prepare_psm();
+  psm_->restore_geometry(positions, radii);
 }
 
 template <class L, class T>
 void Solver<L, T>::set_particles(const ParticleSet& p) {
   if (settings_.particle_scheme != ParticleScheme::Psm) return moving_particles(p, true);
+  prepare_psm();
+  psm_->set_particles(p);
+}
+
+// The PSM object and its cell classification (again after finalize() changed the geometry).
+template <class L, class T>
+void Solver<L, T>::prepare_psm() {
   if (!psm_) {
     psm_ = std::make_unique<Psm<L, T>>(grid_, settings_.tau, settings_.psm_weighting);
     psm_->set_refresh(settings_.psm_refresh);
@@ -473,7 +474,6 @@ void Solver<L, T>::set_particles(const ParticleSet& p) {
     psm_->set_cell_spans(std::move(span_of), spans_.size());
     psm_kinds_stale_ = false;
   }
-  psm_->set_particles(p);
 }
 
 template <class L, class T>

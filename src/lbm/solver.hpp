@@ -235,6 +235,7 @@ class Solver {
   std::unique_ptr<Psm<L, T>> psm_;     // created by the first set_particles()
   std::unique_ptr<MovingBoundary<L, T>> mb_;  // the same for the bounce-back schemes
   void moving_particles(const ParticleSet& p, bool bookkeeping);
+  void prepare_psm();  // creates the PSM and (re)classifies its cells
   bool psm_kinds_stale_ = true;        // finalize() changed the cell classification
 };
 
