@@ -14,6 +14,7 @@
 // count. An LBM implementation sub-cycles or strides as it likes inside add_forces/advance (e.g.
 // one LBM step every n DEM steps) and keeps the fluid state in its checkpoint sections.
 #pragma once
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -89,6 +90,13 @@ class FluidLoad {
   // Particles (indices) lining the borehole, for the fracture measurements (cracks connected
   // to the hole start from them).
   virtual const std::vector<Index>& wall_particles() const = 0;
+  // Mean gauge pressure (above p0) of the fluid on each face of the block [Pa], index 2a + side
+  // as sys.walls (x-, x+, y-, y+, z-, z+); dry parts of a face count as zero. The servo walls carry
+  // it over their area together with the grains' contacts, as the platens of a lab cell do: they
+  // hold the total stress, so pore fluid that reaches the faces unloads the skeleton (Terzaghi's
+  // effective stress). Zero where the model's fluid never reaches the faces (sleeve) or pushes
+  // the hull grains instead (network: a hull pore's pressure loads its grains outwards).
+  virtual std::array<Real, 6> face_pressures() const { return {}; }
   // Checkpoint sections (after the DEM system's; the object is rebuilt from the scenario).
   virtual void save(CheckpointWriter& w) const = 0;
   virtual void load(CheckpointReader& r, const dem::DemSystem& sys) = 0;

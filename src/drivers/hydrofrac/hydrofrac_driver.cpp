@@ -133,6 +133,11 @@ void declare(ParamTable& t) {
   t.boolean("fluid.moving_walls", false,
             "lbm: the particles' velocities enter the fluid's wall condition (false: quasi-static walls; true diverged "
             "on the test block, docs/hydrofrac.md)");
+  t.string("fluid.faces", "closed",
+           "lbm: the lattice's outer faces (the block's faces plus one cell): closed (bounce-back; fluid that reaches "
+           "them pushes the servo walls, as on a lab cell's platens) or drained (held at the pore pressure p0: the far "
+           "field of a borehole in a permeable formation; the fluid that seeps out leaves)")
+      .one_of({"closed", "drained"});
   t.real("fluid.reference_velocity", 0.0, "m/s", "lbm: expected largest fluid speed, for the Mach check (0: no check)")
       .non_negative();
   t.real("fluid.pressure_range", 0.0, "Pa",
@@ -270,7 +275,8 @@ const std::vector<std::string> kColumns = {
     "step", "time_s", "stage", "pressure_Pa", "injected_volume_m3", "borehole_volume_m3", "sigma_xx_wall_Pa",
     "sigma_yy_wall_Pa", "sigma_zz_wall_Pa", "cracks_tensile", "cracks_shear", "cracks_total", "cracks_connected",
     "wetted_cracks", "fracture_length_m", "fracture_extent_m", "fracture_azimuth_deg", "kinetic_energy_J",
-    "unbalanced_force_ratio"};
+    "unbalanced_force_ratio", "sigma_xx_fluid_Pa", "sigma_yy_fluid_Pa", "sigma_zz_fluid_Pa"};
+constexpr std::size_t kUnbalancedColumn = 18;  // kColumns' "unbalanced_force_ratio"
 
 // The loop's state (raw bytes in the checkpoint: its layout is the format).
 struct HfState {
@@ -318,6 +324,7 @@ class HydrofracRun {
   void servo();
   void advance(long steps);
   Vec3 wall_stress() const;
+  Vec3 fluid_wall_stress() const;
   Real face_gap() const;  // distance from the hole's wall to the nearest wall [m]
   void measure_row();
   std::vector<CircleRecord> snapshot(Real pressure) const;
@@ -429,6 +436,7 @@ void HydrofracRun::make_fluid() {
   l.psm_weighting =
       cfg.string("fluid.psm_weighting") == "linear" ? lbm::PsmWeighting::Linear : lbm::PsmWeighting::TauDependent;
   l.moving_walls = cfg.boolean("fluid.moving_walls");
+  l.drained_faces = cfg.string("fluid.faces") == "drained";
   l.rate_mode = s.rate_mode;
   l.ramp_rate = s.ramp_rate;
   l.initial_pressure = s.initial_pressure;
@@ -492,6 +500,8 @@ void HydrofracRun::set_up() {
 }
 
 // Compressive stress on each pair of opposite walls (mean of the two) [Pa].
+// Mean normal stress on each pair of walls: the grains' contacts plus the fluid's push on the
+// faces (fluid_wall_stress), the total stress the servos hold.
 Vec3 HydrofracRun::wall_stress() const {
   const int dim = sys.settings.dim;
   const auto& W = sys.walls;
@@ -503,6 +513,16 @@ Vec3 HydrofracRun::wall_stress() const {
     // Particles push the low wall towards -a and the high one towards +a.
     s[a] = 0.5 * (-W[2 * a].force[a] + W[2 * a + 1].force[a]) / area;
   }
+  return s + fluid_wall_stress();
+}
+
+// The fluid's share of wall_stress(): the mean gauge pressure on each pair of faces (zero before
+// injection and for fluids that never reach the faces).
+Vec3 HydrofracRun::fluid_wall_stress() const {
+  Vec3 s = Vec3::Zero();
+  if (st_.stage != 1) return s;
+  const auto p = fluid_->face_pressures();
+  for (int a = 0; a < sys.settings.dim; ++a) s[a] = 0.5 * (p[std::size_t(2 * a)] + p[std::size_t(2 * a + 1)]);
   return s;
 }
 
@@ -511,11 +531,13 @@ void HydrofracRun::servo() {
   const auto& W0 = sys.walls;
   const Real len[3] = {W0[1].point.x() - W0[0].point.x(), W0[3].point.y() - W0[2].point.y(),
                        dim == 3 ? W0[5].point.z() - W0[4].point.z() : 1.0};
+  const std::array<Real, 6> fluid = st_.stage == 1 ? fluid_->face_pressures() : std::array<Real, 6>{};
   for (int a = 0; a < dim; ++a) {
     const Real area = dim == 3 ? len[(a + 1) % 3] * len[(a + 2) % 3] : len[1 - a];
     for (int side = 0; side < 2; ++side) {
       auto& w = sys.walls[2 * a + side];
-      const Real pushed = side == 0 ? -w.force[a] : w.force[a];
+      // What the wall carries: the grains' contacts and the fluid that reached its face.
+      const Real pushed = (side == 0 ? -w.force[a] : w.force[a]) + fluid[std::size_t(2 * a + side)] * area;
       const Real v = dem::FlexibleMembrane::servo_law(targets_[a] * area, -pushed, w.contact_stiffness, sys.settings.dt,
                                                       servo_alpha_, servo_v_);
       w.velocity = Vec3::Zero();
@@ -634,7 +656,7 @@ void HydrofracRun::vtk() {
 }
 
 void HydrofracRun::measure_row() {
-  const Vec3 ws = wall_stress();
+  const Vec3 ws = wall_stress(), fws = fluid_wall_stress();
   const hydrofrac::FluidState f = st_.stage == 1 ? fluid_->state() : hydrofrac::FluidState{};
   long connected = 0;
   shape_ = {};
@@ -650,7 +672,7 @@ void HydrofracRun::measure_row() {
           f.borehole_volume, ws.x(), ws.y(), ws.z(), static_cast<double>(sys.cracks.tensile),
           static_cast<double>(sys.cracks.shear), static_cast<double>(sys.cracks.total()), static_cast<double>(connected),
           static_cast<double>(f.wetted_cracks), shape_.length, extent_, shape_.azimuth_deg, kinetic_energy(sys),
-          max_unbalanced_force_ratio(sys)};
+          max_unbalanced_force_ratio(sys), fws.x(), fws.y(), fws.z()};
   for (double v : row_)
     if (!std::isfinite(v))
       throw NumericalError(fmt::format(
@@ -662,7 +684,7 @@ void HydrofracRun::measure_row() {
   status_.clear();
   if (st_.stage == 0)
     fmt::format_to(std::back_inserter(status_), "in-situ: walls {:.3f}/{:.3f} MPa, unbalanced {:.3g}", 1e-6 * ws.x(),
-                   1e-6 * ws.y(), row_.back());
+                   1e-6 * ws.y(), row_[kUnbalancedColumn]);
   else
     fmt::format_to(std::back_inserter(status_), "p {:.3f} MPa  cracks {} ({} connected)  fracture {:.3g} m", 1e-6 * f.pressure,
                    sys.cracks.total(), connected, extent_);
@@ -754,14 +776,14 @@ RunStatus HydrofracRun::run() {
         const Vec3 ws = wall_stress();
         Real err = 0;
         for (int a = 0; a < sys.settings.dim; ++a) err = std::max(err, std::abs(ws[a] - targets_[a]) / targets_[a]);
-        const bool eq = err <= tol && row_.back() <= tol && st_.rows >= 3;
+        const bool eq = err <= tol && row_[kUnbalancedColumn] <= tol && st_.rows >= 3;
         fraction = 0.5 * static_cast<double>(sys.step_count) / static_cast<double>(insitu_max);
         if (eq || sys.step_count >= insitu_max) {
           st_.equilibrium = eq;
           if (!eq)
             log::warn("hydrofrac: the in-situ stage reached insitu.max_steps = {} without equilibrium (largest wall-stress "
                       "error {:.3g}, unbalanced-force ratio {:.3g}, tolerance {}); injecting anyway",
-                      insitu_max, err, row_.back(), tol);
+                      insitu_max, err, row_[kUnbalancedColumn], tol);
           begin_injection();
         }
       } else {
@@ -947,13 +969,16 @@ void HydrofracRun::finish(const std::string& stop) {
                 {"mass_budget_m3",
                  {{"injected", b.injected},
                   {"lattice_change", b.lattice_change},
+                  {"drained", b.drained},
                   {"covering_refill", b.covering_refill},
                   {"residual", b.residual},
-                  {"definition", "volumes at the reference density: lattice_change = injected + covering_refill + residual; "
-                                 "the residual is what the bounce-back walls created or destroyed (the box is closed)"}}}};
+                  {"definition", "volumes at the reference density: lattice_change = injected + drained + covering_refill + "
+                                 "residual; drained is what the drained faces added (negative: outflow; 0 with closed faces), "
+                                 "the residual what the bounce-back walls created or destroyed"}}},
+                {"faces", cfg.string("fluid.faces")}};
     log::info("hydrofrac: LBM mass budget over {} LBM steps ({} new particle sets; m^3 at rho_f): injected {:.4g}, lattice "
-              "change {:.4g}, covering and refill {:.4g}, residual (walls) {:.4g}",
-              b.lbm_steps, b.set_changes, b.injected, b.lattice_change, b.covering_refill, b.residual);
+              "change {:.4g}, drained {:.4g}, covering and refill {:.4g}, residual (walls) {:.4g}",
+              b.lbm_steps, b.set_changes, b.injected, b.lattice_change, b.drained, b.covering_refill, b.residual);
   }
   if (net_) {
     const auto& in = net_->info();

@@ -92,6 +92,7 @@ class LbmLoad final : public LbmLoadBase {
     st_.mass0 = lattice_mass();
     const double rho_b = info_.scales.lattice_density(s_.initial_pressure);
     st_.injected += fluid_->impose_equilibrium(hole_cells_, rho_b, Vec3::Zero()) * cell_volume();
+    measure_face_pressures();
     if (s_.moving_walls)
       log::warn("fluid.moving_walls = true: the particles' velocities enter the bounce-back walls; with explicit coupling "
                 "this diverges for grains of a few cells in tight pores (added-mass instability, docs/hydrofrac.md)");
@@ -122,6 +123,7 @@ class LbmLoad final : public LbmLoadBase {
     return f;
   }
   const std::vector<Index>& wall_particles() const override { return wall_; }
+  std::array<Real, 6> face_pressures() const override { return face_pressure_; }
   const LbmInfo& info() const override { return info_; }
   Real effective_radius() const override { return effective_radius_; }
   const std::vector<Vec3>& hydro_force() const override { return force_; }
@@ -130,7 +132,8 @@ class LbmLoad final : public LbmLoadBase {
     b.injected = st_.injected;
     b.lattice_change = (lattice_mass() - st_.mass0) * cell_volume();
     b.covering_refill = st_.changes;
-    b.residual = b.lattice_change - b.injected - b.covering_refill;
+    b.drained = st_.drained;
+    b.residual = b.lattice_change - b.injected - b.drained - b.covering_refill;
     b.lbm_steps = st_.lbm_steps;
     b.set_changes = st_.set_changes;
     return b;
@@ -243,6 +246,7 @@ class LbmLoad final : public LbmLoadBase {
     r.get("lbm.force", force_);
     r.get("lbm.torque", torque_);
     count_wetted(sys);
+    measure_face_pressures();  // from the restored populations: what the uninterrupted run holds
   }
 
  private:
@@ -250,6 +254,7 @@ class LbmLoad final : public LbmLoadBase {
     Real t0 = 0, pressure = 0, injected = 0;
     Real mass0 = 0;    // lattice mass after the first set of particles, before the first imposition
     Real changes = 0;  // mass that covering and refill added (refill minus covered) [m^3 at rho_f]
+    Real drained = 0;  // mass the drained faces added (negative: outflow) [m^3 at rho_f]
     long dem_steps = 0, lbm_steps = 0;
     long set_changes = 0;  // LBM steps that handed the solver a new particle set
   };
@@ -298,6 +303,13 @@ class LbmLoad final : public LbmLoadBase {
         }
     if (hole_cells_.empty())
       throw InputError(fmt::format("fluid.dx: {} m is too coarse: no lattice cell centre lies in the borehole", dx));
+    face_cells_.clear();
+    if (s_.drained_faces)
+      for (int z = 0; z < g.nz; ++z)
+        for (int y = 0; y < g.ny; ++y)
+          for (int x = 0; x < g.nx; ++x)
+            if (x == 0 || x == g.nx - 1 || y == 0 || y == g.ny - 1 || (L::D == 3 && (z == 0 || z == g.nz - 1)))
+              face_cells_.push_back({x, y, z});
     set_.resize(sys.particles.size());
     force_.assign(sys.particles.size(), Vec3::Zero());
     torque_.assign(sys.particles.size(), Vec3::Zero());
@@ -384,7 +396,34 @@ class LbmLoad final : public LbmLoadBase {
       force_[i] = si.force;
       torque_[i] = si.torque;
     }
+    // Drained faces: the far field's pore pressure p0 on the lattice's outer layer (the fluid that
+    // seeps out of the block leaves; the rock's skeleton feels the seepage gradient).
+    if (s_.drained_faces) st_.drained += fluid_->impose_equilibrium(face_cells_, 1.0, Vec3::Zero()) * cell_volume();
     count_wetted(sys);  // O(cracks) per LBM step
+    measure_face_pressures();
+  }
+
+  // The fluid's mean gauge pressure on each of the lattice's faces (its outer layer of cells: the
+  // block's faces plus one cell), K_eff (rho - 1) over the cells connected to the hole's fluid,
+  // the others counting zero; summed in lattice order, O(faces) once per LBM step.
+  void measure_face_pressures() {
+    face_pressure_.fill(0);
+    const auto& g = fluid_->grid();
+    const int n[3] = {g.nx, g.ny, g.nz};
+    for (int a = 0; a < L::D; ++a) {
+      const int b = (a + 1) % 3, c = (a + 2) % 3;
+      for (int side = 0; side < 2; ++side) {
+        double sum = 0;
+        int at[3];
+        at[a] = side == 0 ? 0 : n[a] - 1;
+        for (at[c] = 0; at[c] < n[c]; ++at[c])
+          for (at[b] = 0; at[b] < n[b]; ++at[b]) {
+            const std::size_t k = std::size_t(at[0]) + std::size_t(g.nx) * (std::size_t(at[1]) + std::size_t(g.ny) * at[2]);
+            if (wet_[k]) sum += fluid_->cell_density(at[0], at[1], at[2]) - 1.0;
+          }
+        face_pressure_[std::size_t(2 * a + side)] = info_.scales.bulk_modulus * sum / (double(n[b]) * double(n[c]));
+      }
+    }
   }
 
   // The fluid connected to the hole now: flood over uncovered cells from the hole's cells along
@@ -454,10 +493,12 @@ class LbmLoad final : public LbmLoadBase {
   std::vector<Index> wall_, id_index_;
   std::unique_ptr<Solver> fluid_;
   std::vector<std::array<int, 3>> hole_cells_;
+  std::vector<std::array<int, 3>> face_cells_;  // the lattice's outer layer (drained faces only)
   lbm::ParticleSet set_;
   std::vector<Vec3> force_, torque_;
   State st_;
   long wetted_cracks_ = 0;
+  std::array<Real, 6> face_pressure_{};  // measure_face_pressures, after each LBM step [Pa]
   Real effective_radius_ = 0;
   std::vector<std::uint8_t> wet_;
   std::vector<char> loaded_;  // per particle: touches the hole's fluid (find_loaded)

@@ -13,8 +13,10 @@
 //      FluidScales::lattice_density(p(t)), rate mode rho_b such that the hole gains the pumped
 //      mass Q dt (a uniform mass source; the pressure is then the mean over the hole's cells);
 //      the mass imposed, integrated, is the injected volume (at the reference density);
-//   3. each particle touching fluid connected to the hole gets the solver's load (relative to
-//      rho_lb = 1: p - p0), converted to SI and held over the next n DEM steps.
+//   3. drained faces (fluid.faces = "drained"): the lattice's outer layer gets f^eq(1, 0) (p0);
+//   4. each particle touching fluid connected to the hole gets the solver's load (relative to
+//      rho_lb = 1: p - p0), converted to SI and held over the next n DEM steps; the mean gauge
+//      pressure on each face of the lattice goes to the servo walls (face_pressures()).
 // Verified (test_hydrofrac_lbm_load): the wall's load is p times its wetted chord (total within
 // 0.2%), a pre-cut crack fills to the hole pressure, an isolated one stays dry, and the mass budget
 // (budget()) closes. fluid.moving_walls = true diverges (explicit coupling, added-mass instability:
@@ -42,6 +44,7 @@ struct LbmSettings {
   Real ramp_rate = 0, initial_pressure = 0, flow_rate = 0;  // [Pa/s], [Pa], [m^3/s] (2D: per metre)
   Real cell = 0, inflate = 0, reach = 0;                    // wall particles (hole_surface)
   bool moving_walls = false;  // particle velocities enter bounce-back (false: quasi-static walls)
+  bool drained_faces = false;  // fluid.faces = "drained": the lattice's outer layer held at p0
   Real wet_fraction = 0.5;  // a crack is wetted when its cell's p - p0 exceeds this fraction of the hole's
 };
 
@@ -56,10 +59,11 @@ struct LbmInfo {
 };
 
 // Where the injected fluid went (volumes at the reference density rho_f, m^3; 2D per metre):
-// lattice_change = injected + covering_refill + residual, the residual being what the walls'
-// bounce-back (interpolation, moving-wall term) created or destroyed; the box is closed.
+// lattice_change = injected + drained + covering_refill + residual, the residual being what the
+// walls' bounce-back (interpolation, moving-wall term) created or destroyed.
 struct LbmBudget {
   Real injected = 0, lattice_change = 0, covering_refill = 0, residual = 0;
+  Real drained = 0;  // mass the drained faces removed (negative: outflow); 0 with closed faces
   long lbm_steps = 0;
   long set_changes = 0;  // LBM steps that rebuilt the particles' solid cells (quasi-static walls: after 0.02 dx of motion)
 };
