@@ -3,7 +3,8 @@
 
 Usage: plot_series.py SPEC.json   where SPEC.json holds one job object or a list of them:
   {"csv", "png", "title", "xlabel", "ylabel", "y2label", "x", "y": [...], "y2": [...],
-   "x_scale", "y_scale", "y2_scale", "reference_csv", "ref_x", "ref_y", "ref_label", "logx", "logy"}
+   "x_scale", "y_scale", "y2_scale", "reference_csv", "ref_x", "ref_y", "ref_label", "logx", "logy",
+   "equal_aspect", "y_labels": [...]}
 Exit codes: 0 all written, 1 some job failed, 2 bad usage, 3 matplotlib or numpy missing.
 CSV files: comma-separated, one header line; lines starting with '#' are comments; cells that
 are not numbers read as NaN (same rules as ff::read_csv).
@@ -76,9 +77,11 @@ def plot(job):
     fig, ax = plt.subplots(figsize=(7.0, 4.5))
     colours = plt.rcParams["axes.prop_cycle"].by_key().get("color", ["C0"])
     lines = []
-    for name in job.get("y", []):
+    names = job.get("y_labels") or []
+    for k, name in enumerate(job.get("y", [])):
         colour = colours[len(lines) % len(colours)]
-        lines += ax.plot(x, column(table, name, csv) * job.get("y_scale", 1.0), color=colour, label=legend_label(name))
+        label = names[k] if k < len(names) else legend_label(name)
+        lines += ax.plot(x, column(table, name, csv) * job.get("y_scale", 1.0), color=colour, label=label)
     ref = job.get("reference_csv", "")
     if ref:
         rt = read_csv(ref)
@@ -91,6 +94,8 @@ def plot(job):
         ax.set_xscale("log")
     if job.get("logy"):
         ax.set_yscale("log")
+    if job.get("equal_aspect"):
+        ax.set_aspect("equal", adjustable="datalim")
     ax.grid(True, alpha=0.3)
     if job.get("y2"):
         ax2 = ax.twinx()

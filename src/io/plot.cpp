@@ -35,7 +35,8 @@ nlohmann::json to_json(const PlotJob& j) {
           {"x", s.x},                    {"y", s.y},                  {"y2", s.y2},
           {"x_scale", s.x_scale},        {"y_scale", s.y_scale},      {"y2_scale", s.y2_scale},
           {"reference_csv", s.reference_csv.string()}, {"ref_x", s.ref_x}, {"ref_y", s.ref_y},
-          {"ref_label", s.ref_label},    {"logx", s.logx},            {"logy", s.logy}};
+          {"ref_label", s.ref_label},    {"logx", s.logx},            {"logy", s.logy},
+          {"equal_aspect", s.equal_aspect}, {"y_labels", s.y_labels}};
 }
 
 std::string last_line(const std::filesystem::path& log) {

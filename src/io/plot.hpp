@@ -17,6 +17,8 @@ struct PlotSpec {
   std::filesystem::path reference_csv;  // optional markers overlaid on the left axis,
   std::string ref_x, ref_y, ref_label;  // scaled by x_scale / y_scale like the data
   bool logx = false, logy = false;
+  bool equal_aspect = false;         // one unit as long on both axes (maps, fracture patterns)
+  std::vector<std::string> y_labels;  // legend names of the y columns (empty: the column names)
 };
 
 // One figure to draw: a CSV, the PNG to write and what to plot.

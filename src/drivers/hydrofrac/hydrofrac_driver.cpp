@@ -1081,6 +1081,8 @@ void HydrofracRun::plots() {
   c.spec.ref_x = "x_m";
   c.spec.ref_y = "y_m";
   c.spec.ref_label = "cracks";
+  c.spec.y_labels = {"block and borehole"};
+  c.spec.equal_aspect = true;
   const std::vector<PlotJob> jobs = {p, v, c};
   plot_series(jobs);
 }
