@@ -36,6 +36,10 @@ void declare(ParamTable& t) {
       .one_of({"D2Q9", "D3Q19"});
   t.string("lbm.precision", "double", "storage and arithmetic precision of the populations").one_of({"double", "float"});
   t.real("lbm.dx", 1e-4, "m", "lattice spacing (cells across a particle: its diameter / dx; keep it >= 8)").positive();
+  t.real("lbm.psm_refresh", 0.0, "cells",
+         "keep the particles' solid fractions while every particle stays within this distance of where they were "
+         "computed (velocities are taken every step); 0: recompute every step (docs/lbm.md, \"Refresh distance\")")
+      .range(0, 0.5);
   t.real_list("box.size", {0.02, 0.08}, "m", "box [0, Lx] x [0, Ly] (x [0, Lz] in 3D): walls on every side, no slip")
       .size_between(2, 3);
   t.real("box.gravity", 9.81, "m/s^2", "gravity, along -y in 2D and -z in 3D").non_negative();
@@ -262,6 +266,7 @@ void SedimentationRun<L, T>::build() {
   lbm::Grid g(d, geo_.n[0], geo_.n[1], geo_.n[2], {false, false, d == 2});
   lbm::SolverSettings s;
   s.tau = sc_.units.tau();
+  s.psm_refresh = cfg_.real("lbm.psm_refresh");
   fluid_ = std::make_unique<lbm::Solver<L, T>>(g, s);
   for (int f = 0; f < 2 * d; ++f) fluid_->set_face(f, lbm::FaceCondition{});
   fluid_->finalize();
@@ -292,6 +297,10 @@ void SedimentationRun<L, T>::write_checkpoint(const fs::path& dir) {
   w.put_value("sed.state", st_);
   w.put("sed.history", history_);
   dem::save_dem(w, dem_);
+  // With lbm.psm_refresh the fractions come from where the particles were at the last rebuild.
+  const auto* psm = fluid_->psm();
+  w.put("sed.psm_positions", psm ? psm->geometry_positions() : std::vector<Vec3>{});
+  w.put("sed.psm_radii", psm ? psm->geometry_radii() : std::vector<double>{});
   w.commit();
 }
 
@@ -309,6 +318,13 @@ void SedimentationRun<L, T>::read_checkpoint() {
   fluid_->restore(f, long(st_.step));
   r.get("sed.history", history_);
   dem::load_dem(r, dem_);
+  std::vector<Vec3> pos;
+  std::vector<double> radii;
+  if (r.has("sed.psm_positions")) {  // absent in checkpoints before lbm.psm_refresh (rebuilt every step)
+    r.get("sed.psm_positions", pos);
+    r.get("sed.psm_radii", radii);
+  }
+  if (!pos.empty()) fluid_->restore_psm_geometry(pos, radii);
   if (std::size_t(st_.columns) != columns_.size())
     throw InputError(fmt::format("{}: the checkpoint's series has {} columns, this scenario writes {}",
                                  r.path().string(), st_.columns, columns_.size()));
