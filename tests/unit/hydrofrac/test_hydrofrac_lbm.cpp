@@ -135,8 +135,8 @@ TEST(HydrofracLbm, CheckPrintsTheStepsAndTheFluid) {
     EXPECT_NE(r.output.find(want), std::string::npos) << want << " not in:\n" << r.output;
 }
 
-// 3D (D3Q19): an 11 x 11 x 4 mm block of ~500 bonded spheres (0.4-0.6 mm, porosity 0.4, the
-// material of examples/hydrofrac_3d.toml) with a vertical 1.8 mm borehole, sigma_H / sigma_h /
+// 3D (D3Q19): examples/hydrofrac_3d_lbm.toml's rock (bonded spheres 0.4-0.6 mm, porosity 0.4) in
+// an 11 x 11 x 4 mm block (~500 spheres) with a vertical 1.8 mm borehole, sigma_H / sigma_h /
 // sigma_v = 6 / 3 / 8 MPa, the hole's pressure ramped at 1e11 Pa/s. Bonded spheres leave their
 // pores connected, so the fluid fills the whole pore space (docs/hydrofrac.md, "3D").
 //  - Closed faces: the box fills to a nearly uniform pressure, which loads no grain; the fluid on
@@ -149,51 +149,12 @@ TEST(HydrofracLbm, CheckPrintsTheStepsAndTheFluid) {
 //    resumed: bit for bit.
 TEST(HydrofracLbm, ThreeDBreaksWithDrainedFacesAlongSigmaHNotInAClosedBox) {
   Scratch s;
-  const fs::path file = s.write("block3d.toml", R"(driver = "hydrofrac"
-[dem]
-dim = 3
-bond_law = "parallel"
-[dem.group.rock]
-density = 2600
-[dem.contact.rock-rock]
-emod = 10e9
-kratio = 2.5
-friction = 0.5
-[dem.bond.rock-rock]
-emod = 10e9
-kratio = 2.5
-tensile_strength = 20e6
-cohesion = 40e6
-friction_angle = 30.0
-[sample]
-shape = "box"
-width = 11e-3
-depth = 11e-3
-height = 4e-3
-radius_min = 0.4e-3
-radius_max = 0.6e-3
-porosity = 0.4
-bond_gap = 0.1e-3
-seed = 1
-[borehole]
-radius = 1.8e-3
-[insitu]
-sigma_H = 6e6
-sigma_h = 3e6
-sigma_v = 8e6
-[injection]
-fluid = "lbm"
-ramp_rate = 1e11
-max_pressure = 30e6
-[fluid]
-viscosity = 1e-2
-bulk_modulus = 4e8
-[measure]
-radii = [1.8, 2.3]
-circle_radius = 0.35
-)" + kOutput);
+  const fs::path file = s.write("block3d.toml", slurp(fs::path(FRACFLOW_SOURCE_DIR) / "examples" / "hydrofrac_3d_lbm.toml") + kOutput);
+  const std::string block = " --set sample.width=11e-3 --set sample.depth=11e-3 --set sample.height=4e-3 --set "
+                            "borehole.radius=1.8e-3 --set measure.radii=[1.8,2.3] --set measure.circle_radius=0.35 --set "
+                            "injection.ramp_rate=1e11 --set injection.max_pressure=30e6";
   const fs::path closed = s / "closed", drained = s / "drained", parts = s / "parts";
-  const auto c = run_scenario(file, closed, " --set fluid.faces=closed --set injection.max_pressure=12e6");
+  const auto c = run_scenario(file, closed, block + " --set fluid.faces=closed --set injection.max_pressure=12e6");
   EXPECT_EQ(c["cracks"]["total"].get<long>(), 0);
   EXPECT_TRUE(c["breakdown"]["pressure_Pa"].is_null());
   const auto series = ff::read_csv(closed / "series.csv");
@@ -204,7 +165,7 @@ circle_radius = 0.35
   EXPECT_GT(fluid[last], 3e6);                     // the pore fluid on the faces passed sigma_h ...
   EXPECT_NEAR(total[last], fluid[last], 1e-3 * fluid[last]);  // ... and carries the walls alone
   EXPECT_LT(fluid[last], p[last]);                 // lagging the hole's pressure
-  const std::string faces = " --set fluid.faces=drained";
+  const std::string faces = block + " --set fluid.faces=drained";
   const auto d = run_scenario(file, drained, faces);
   ASSERT_TRUE(d["breakdown"]["pressure_Pa"].is_number());
   EXPECT_GT(d["cracks"]["tensile"].get<long>(), 10 * d["cracks"]["shear"].get<long>());
