@@ -97,7 +97,15 @@ void DemPorenetCoupling::fill_pair_state(const dem::DemSystem& sys) {
 
 void DemPorenetCoupling::set_boundaries(porenet::TwoPhaseFlow& flow, const porenet::Network2D& net) {
   bc_pore_.assign(static_cast<std::size_t>(net.n_pores()), 0);
-  if (prm_.drainage != Drainage::Sides) return;
+  if (prm_.drainage == Drainage::Closed) return;
+  if (prm_.drainage == Drainage::Hull) {
+    for (Index i = 0; i < net.n_pores(); ++i)
+      if (net.pore_hull[i]) {
+        flow.set_bc(i, porenet::PoreBc::Pressure, prm_.ambient_pressure, prm_.saturation);
+        bc_pore_[static_cast<std::size_t>(i)] = 1;
+      }
+    return;
+  }
   Real xmin = x_[0], xmax = x_[0], rmax = 0;
   for (std::size_t k = 0; k < x_.size(); ++k) {
     xmin = std::min(xmin, x_[k]);

@@ -32,9 +32,10 @@
 
 namespace ff::coupling {
 
-// Which pores drain: none (closed sample, undrained), or the pores on the convex hull within two
-// max radii of the sample's lateral sides (x extremes), held at the ambient pressure.
-enum class Drainage : std::uint8_t { Closed = 0, Sides = 1 };
+// Which pores drain (held at the ambient pressure): none (closed sample, undrained), the pores on
+// the convex hull within two max radii of the sample's lateral sides (x extremes), or every pore
+// on the hull (all faces drained, e.g. the far field of a borehole).
+enum class Drainage : std::uint8_t { Closed = 0, Sides = 1, Hull = 2 };
 
 // Height of the wetted grain surface in B27 (A_k = height x arc) and B28 (height x L_k); it must
 // be the height over which the grain's contacts and bonds carry their forces (the pressures do not

@@ -60,6 +60,7 @@ struct NetworkSettings {
   Real pfv_factor = 1.0;           // 3D throat conductance factor
   Real retriangulation_tolerance = 0.25;  // x mean radius
   bool shear_forces = true;               // 2D: channel shear B25/B28
+  bool drained_faces = true;              // network.faces = "drained": hull pores held at p0
   long flow_every = 0;                    // DEM steps per flow step; 0: from the fluid-grain stiffness
   Real flow_safety = 0.3;                 // N dt <= safety x sqrt(m / k) (median)
   long max_flow_every = 100;
@@ -102,6 +103,7 @@ class NetworkLoad final : public FluidLoad {
   void load(CheckpointReader& r, const dem::DemSystem& sys) override;
 
   const NetworkInfo& info() const { return info_; }
+  bool drained_faces() const { return s_.drained_faces; }
   NetworkBudget budget() const;
   Real effective_radius() const { return st_.effective_radius; }
   const porenet::Network2D& network() const;
@@ -120,11 +122,13 @@ class NetworkLoad final : public FluidLoad {
     double t_sync = 0, t_flow = 0, t_forces = 0;
     long retriangulations = 0, cavitations = 0;
     Real vapour_volume = 0;
+    Real band_lo[3] = {0, 0, 0}, band_hi[3] = {0, 0, 0};  // 3D drained faces: pores outside are held at p0
   };
   porenet::TwoPhaseFlow& flow();
   const porenet::TwoPhaseFlow& flow() const;
   void make_coupling();
   void find_hole_pores(const porenet::Network2D& net);
+  void drain_faces(porenet::TwoPhaseFlow& f, const porenet::Network2D& net) const;
   void set_hole_bc(porenet::TwoPhaseFlow& f, const porenet::Network2D& net, Real time);
   void flow_step(const dem::DemSystem& sys);
   void gather_forces();
