@@ -132,7 +132,10 @@ std::string DemRun::curve_row(const DemRowReport& r, double& fraction) {
     while (*c_.next_vtk_strain <= r.strain) *c_.next_vtk_strain += vtk_every_;
   }
   std::string stop;
-  const bool past_peak = peak > 0 && *c_.rows > 10 && r.strain > *c_.strain_at_peak && r.stress < stop_fraction_ * peak;
+  // The peak must lie 10 rows into the loading: a slow platen's first rows are start-up noise (a
+  // saturated specimen's first row at 2 mm/s held 3.7 Pa, its tenth 2 Pa, and the run stopped there).
+  const bool past_peak =
+      peak > 0 && *c_.peak_row >= 10 && r.strain > *c_.strain_at_peak && r.stress < stop_fraction_ * peak;
   if (past_peak) stop = fmt::format("{} fell below {} of the peak", spec.stress_name, stop_fraction_);
   stopped_at_strain_cap_ = r.strain >= max_strain_;
   if (stopped_at_strain_cap_) stop = fmt::format("{} reached {}.max_strain = {}", spec.strain_name, spec.name, max_strain_);
