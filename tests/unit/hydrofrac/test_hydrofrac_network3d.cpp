@@ -39,6 +39,17 @@ nlohmann::json run_scenario(const fs::path& file, const fs::path& out, const std
   return ff::test::read_json(out / "summary.json");
 }
 
+// examples/hydrofrac_3d.toml's scenario written into the scratch folder, and the sets that make
+// it a 12 x 12 x 4 mm block (~550 spheres) without VTK.
+fs::path small_block(const Scratch& s) {
+  std::ifstream in(fs::path(FRACFLOW_SOURCE_DIR) / "examples" / "hydrofrac_3d.toml");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return s.write("block3d.toml", ss.str() + kOutput);
+}
+const std::string kSmallBlock = " --set hydrofrac.vtk_interval=0 --set sample.width=12e-3 --set sample.depth=12e-3 --set "
+                                "sample.height=4e-3 --set measure.radii=[1.8] --set measure.circle_radius=0.3";
+
 }  // namespace
 
 // examples/hydrofrac_3d.toml's rock in a 12 x 12 x 4 mm block (~550 spheres, sigma_H = 6, sigma_h = 3,
@@ -47,12 +58,8 @@ nlohmann::json run_scenario(const fs::path& file, const fs::path& out, const std
 // A few minutes (one implicit flow step per DEM step on ~3000 pores): label long.
 TEST(HydrofracNetwork, ThreeDimensionalBlockBreaksFromTheHole) {
   Scratch s;
-  std::ifstream in(fs::path(FRACFLOW_SOURCE_DIR) / "examples" / "hydrofrac_3d.toml");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const fs::path file = s.write("block3d.toml", ss.str() + kOutput);
-  const std::string sets = " --set hydrofrac.vtk_interval=0 --set sample.width=12e-3 --set sample.depth=12e-3 --set "
-                           "sample.height=4e-3 --set measure.radii=[1.8] --set measure.circle_radius=0.3";
+  const fs::path file = small_block(s);
+  const std::string& sets = kSmallBlock;
   const auto js = run_scenario(file, s / "sleeve", sets + " --set injection.penetration=false");
   const auto j = run_scenario(file, s / "network", sets + " --set injection.fluid=network");
   ASSERT_FALSE(j["breakdown"]["pressure_Pa"].is_null()) << j["breakdown"].dump();
@@ -75,13 +82,8 @@ TEST(HydrofracNetwork, ThreeDimensionalBlockBreaksFromTheHole) {
 // bonds at 0.1-0.4 MPa on the 30,000-sphere example: docs/hydrofrac.md, "Faces").
 TEST(HydrofracNetwork, ThreeDimensionalDrainedFacesResumeBitForBit) {
   Scratch s;
-  std::ifstream in(fs::path(FRACFLOW_SOURCE_DIR) / "examples" / "hydrofrac_3d.toml");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const fs::path file = s.write("block3d.toml", ss.str() + kOutput);
-  const std::string sets = " --set hydrofrac.vtk_interval=0 --set sample.width=12e-3 --set sample.depth=12e-3 --set "
-                           "sample.height=4e-3 --set measure.radii=[1.8] --set measure.circle_radius=0.3 --set "
-                           "injection.fluid=network --set injection.max_pressure=3e6";
+  const fs::path file = small_block(s);
+  const std::string sets = kSmallBlock + " --set injection.fluid=network --set injection.max_pressure=3e6";
   const auto j = run_scenario(file, s / "whole", sets);
   EXPECT_EQ(j["network"]["faces"].get<std::string>(), "drained");
   EXPECT_EQ(j["cracks"]["total"].get<long>(), 0);
