@@ -9,9 +9,9 @@
 //   fluid.add_forces(sys);          // ADDS fluid forces/moments to particles.ext_force/ext_moment
 //   sys.add_external_loads(); sys.integrate();
 //   fluid.advance(sys);             // fluid state to sys.time (pressure, volumes), after the move
-// Virtual calls happen twice per step, never per particle or contact; an implementation keeps
-// its own scratch arrays (no allocation per step) and must give the same result on any thread
-// count. An LBM implementation sub-cycles or strides as it likes inside add_forces/advance (e.g.
+// Virtual calls happen three times per step (add_forces, advance and the servos' face_pressures),
+// never per particle or contact; an implementation keeps its own scratch arrays (no allocation per
+// step) and must give the same result on any thread count. An LBM implementation sub-cycles or strides as it likes inside add_forces/advance (e.g.
 // one LBM step every n DEM steps) and keeps the fluid state in its checkpoint sections.
 #pragma once
 #include <array>

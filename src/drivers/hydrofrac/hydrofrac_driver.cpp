@@ -328,6 +328,8 @@ class HydrofracRun {
   void make_fluid();
   void servo();
   void advance(long steps);
+  Vec3 wall_areas() const;
+  std::array<Real, 6> face_pressures() const;
   Vec3 wall_stress() const;
   Vec3 fluid_wall_stress() const;
   Real face_gap() const;  // distance from the hole's wall to the nearest wall [m]
@@ -506,19 +508,31 @@ void HydrofracRun::set_up() {
             joints.size(), joints_.size(), sys.settings.dt);
 }
 
-// Compressive stress on each pair of opposite walls (mean of the two) [Pa].
-// Mean normal stress on each pair of walls: the grains' contacts plus the fluid's push on the
-// faces (fluid_wall_stress), the total stress the servos hold.
-Vec3 HydrofracRun::wall_stress() const {
+// Area of each pair of opposite walls [m^2; 2D: m^2 per m of thickness].
+Vec3 HydrofracRun::wall_areas() const {
   const int dim = sys.settings.dim;
   const auto& W = sys.walls;
-  Vec3 s = Vec3::Zero();
   const Real len[3] = {W[1].point.x() - W[0].point.x(), W[3].point.y() - W[2].point.y(),
                        dim == 3 ? W[5].point.z() - W[4].point.z() : 1.0};
-  for (int a = 0; a < dim; ++a) {
-    const Real area = dim == 3 ? len[(a + 1) % 3] * len[(a + 2) % 3] : len[1 - a];
+  Vec3 area = Vec3::Zero();
+  for (int a = 0; a < dim; ++a) area[a] = dim == 3 ? len[(a + 1) % 3] * len[(a + 2) % 3] : len[1 - a];
+  return area;
+}
+
+// The fluid's mean gauge pressure on each face (FluidLoad::face_pressures); zero before injection.
+std::array<Real, 6> HydrofracRun::face_pressures() const {
+  return st_.stage == 1 ? fluid_->face_pressures() : std::array<Real, 6>{};
+}
+
+// Mean compressive stress on each pair of opposite walls [Pa]: the grains' contacts plus the
+// fluid's push on the faces (fluid_wall_stress), the total stress the servos hold.
+Vec3 HydrofracRun::wall_stress() const {
+  const auto& W = sys.walls;
+  const Vec3 area = wall_areas();
+  Vec3 s = Vec3::Zero();
+  for (int a = 0; a < sys.settings.dim; ++a) {
     // Particles push the low wall towards -a and the high one towards +a.
-    s[a] = 0.5 * (-W[2 * a].force[a] + W[2 * a + 1].force[a]) / area;
+    s[a] = 0.5 * (-W[2 * a].force[a] + W[2 * a + 1].force[a]) / area[a];
   }
   return s + fluid_wall_stress();
 }
@@ -527,26 +541,21 @@ Vec3 HydrofracRun::wall_stress() const {
 // injection and for fluids that never reach the faces).
 Vec3 HydrofracRun::fluid_wall_stress() const {
   Vec3 s = Vec3::Zero();
-  if (st_.stage != 1) return s;
-  const auto p = fluid_->face_pressures();
+  const auto p = face_pressures();
   for (int a = 0; a < sys.settings.dim; ++a) s[a] = 0.5 * (p[std::size_t(2 * a)] + p[std::size_t(2 * a + 1)]);
   return s;
 }
 
 void HydrofracRun::servo() {
-  const int dim = sys.settings.dim;
-  const auto& W0 = sys.walls;
-  const Real len[3] = {W0[1].point.x() - W0[0].point.x(), W0[3].point.y() - W0[2].point.y(),
-                       dim == 3 ? W0[5].point.z() - W0[4].point.z() : 1.0};
-  const std::array<Real, 6> fluid = st_.stage == 1 ? fluid_->face_pressures() : std::array<Real, 6>{};
-  for (int a = 0; a < dim; ++a) {
-    const Real area = dim == 3 ? len[(a + 1) % 3] * len[(a + 2) % 3] : len[1 - a];
+  const Vec3 area = wall_areas();
+  const std::array<Real, 6> fluid = face_pressures();
+  for (int a = 0; a < sys.settings.dim; ++a) {
     for (int side = 0; side < 2; ++side) {
       auto& w = sys.walls[2 * a + side];
       // What the wall carries: the grains' contacts and the fluid that reached its face.
-      const Real pushed = (side == 0 ? -w.force[a] : w.force[a]) + fluid[std::size_t(2 * a + side)] * area;
-      const Real v = dem::FlexibleMembrane::servo_law(targets_[a] * area, -pushed, w.contact_stiffness, sys.settings.dt,
-                                                      servo_alpha_, servo_v_);
+      const Real pushed = (side == 0 ? -w.force[a] : w.force[a]) + fluid[std::size_t(2 * a + side)] * area[a];
+      const Real v = dem::FlexibleMembrane::servo_law(targets_[a] * area[a], -pushed, w.contact_stiffness,
+                                                      sys.settings.dt, servo_alpha_, servo_v_);
       w.velocity = Vec3::Zero();
       w.velocity[a] = side == 0 ? v : -v;
     }

@@ -8,13 +8,12 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "io/csv.hpp"
 #include "../program_runner.hpp"
+#include "../../validation/resume_compare.hpp"  // read_bytes
 
 namespace ff::test {
 
@@ -63,20 +62,14 @@ inline std::vector<double> first_crack_distances(const std::filesystem::path& cs
 // in `whole`.
 inline void expect_resume_identical(const std::filesystem::path& file, const std::filesystem::path& whole,
                                     const std::filesystem::path& parts, long stop, const std::string& sets = "") {
-  const auto bytes = [](const std::filesystem::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-  };
   auto r = run_program("run " + file.string() + " --out " + parts.string() + " -q -j1 --max-steps " +
                        std::to_string(stop) + sets);
   ASSERT_EQ(r.code, 0) << r.output;
   ASSERT_FALSE(std::filesystem::exists(parts / "summary.json"));
   r = run_program("resume " + parts.string() + " -q -j1");
   ASSERT_EQ(r.code, 0) << r.output;
-  EXPECT_EQ(bytes(whole / "series.csv"), bytes(parts / "series.csv"));
-  EXPECT_EQ(bytes(whole / "cracks.csv"), bytes(parts / "cracks.csv"));
+  EXPECT_EQ(read_bytes(whole / "series.csv"), read_bytes(parts / "series.csv"));
+  EXPECT_EQ(read_bytes(whole / "cracks.csv"), read_bytes(parts / "cracks.csv"));
 }
 
 }  // namespace ff::test

@@ -11,7 +11,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -69,13 +68,6 @@ nlohmann::json run_scenario(const fs::path& file, const fs::path& out, const std
   return ff::test::read_json(out / "summary.json");
 }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 }  // namespace
 
 
@@ -105,8 +97,8 @@ TEST(HydrofracLbm, ResumeAndTwoThreadsAreBitIdenticalAndTheRockBreaks) {
   ff::test::expect_resume_identical(file, whole, parts, 9000);
   auto r = fracflow("run " + file.string() + " --out " + two.string() + " -q -j2 --set dem.parallel_min=200");
   ASSERT_EQ(r.code, 0) << r.output;
-  EXPECT_EQ(slurp(whole / "series.csv"), slurp(two / "series.csv"));
-  EXPECT_EQ(slurp(whole / "cracks.csv"), slurp(two / "cracks.csv"));
+  EXPECT_EQ(ff::test::read_bytes(whole / "series.csv"), ff::test::read_bytes(two / "series.csv"));
+  EXPECT_EQ(ff::test::read_bytes(whole / "cracks.csv"), ff::test::read_bytes(two / "cracks.csv"));
 }
 
 // The same block with the partially saturated cells (fluid.scheme = "psm"), stopped at step 3000 and
@@ -149,7 +141,7 @@ TEST(HydrofracLbm, CheckPrintsTheStepsAndTheFluid) {
 //    resumed: bit for bit.
 TEST(HydrofracLbm, ThreeDBreaksWithDrainedFacesAlongSigmaHNotInAClosedBox) {
   Scratch s;
-  const fs::path file = s.write("block3d.toml", slurp(fs::path(FRACFLOW_SOURCE_DIR) / "examples" / "hydrofrac_3d_lbm.toml") + kOutput);
+  const fs::path file = s.write("block3d.toml", ff::test::read_bytes(fs::path(FRACFLOW_SOURCE_DIR) / "examples" / "hydrofrac_3d_lbm.toml") + kOutput);
   const std::string block = " --set sample.width=11e-3 --set sample.depth=11e-3 --set sample.height=4e-3 --set "
                             "borehole.radius=1.8e-3 --set measure.radii=[1.8,2.3] --set measure.circle_radius=0.35 --set "
                             "injection.ramp_rate=1e11 --set injection.max_pressure=30e6";

@@ -15,7 +15,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -68,13 +67,6 @@ nlohmann::json run_scenario(const fs::path& file, const fs::path& out, const std
   const auto r = fracflow("run " + file.string() + " --out " + out.string() + " -q -j1" + sets);
   EXPECT_EQ(r.code, 0) << r.output;
   return ff::test::read_json(out / "summary.json");
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 }  // namespace
@@ -211,8 +203,8 @@ TEST(HydrofracNetwork, ResumeAndTwoThreadsAreBitIdentical) {
   const auto r = fracflow("run " + file.string() + " --out " + two.string() +
                           " -q -j2 --max-steps 12000 --set dem.parallel_min=200");
   ASSERT_EQ(r.code, 0) << r.output;
-  const std::string s1 = slurp(whole / "series.csv"), s2 = slurp(two / "series.csv");
-  const std::string c1 = slurp(whole / "cracks.csv"), c2 = slurp(two / "cracks.csv");
+  const std::string s1 = ff::test::read_bytes(whole / "series.csv"), s2 = ff::test::read_bytes(two / "series.csv");
+  const std::string c1 = ff::test::read_bytes(whole / "cracks.csv"), c2 = ff::test::read_bytes(two / "cracks.csv");
   ASSERT_GT(s2.size(), 1000u);
   ASSERT_GT(c2.size(), 100u) << "no crack by step 12000: the comparison would not cover the fracturing";
   EXPECT_EQ(s1.substr(0, s2.size()), s2);

@@ -8,7 +8,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -42,10 +41,7 @@ nlohmann::json run_scenario(const fs::path& file, const fs::path& out, const std
 // examples/hydrofrac_3d.toml's scenario written into the scratch folder, and the sets that make
 // it a 12 x 12 x 4 mm block (~550 spheres) without VTK.
 fs::path small_block(const Scratch& s) {
-  std::ifstream in(fs::path(FRACFLOW_SOURCE_DIR) / "examples" / "hydrofrac_3d.toml");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return s.write("block3d.toml", ss.str() + kOutput);
+  return s.write("block3d.toml", ff::test::read_bytes(fs::path(FRACFLOW_SOURCE_DIR) / "examples" / "hydrofrac_3d.toml") + kOutput);
 }
 const std::string kSmallBlock = " --set hydrofrac.vtk_interval=0 --set sample.width=12e-3 --set sample.depth=12e-3 --set "
                                 "sample.height=4e-3 --set measure.radii=[1.8] --set measure.circle_radius=0.3";
