@@ -10,6 +10,7 @@
 #include <set>
 #include <thread>
 
+#include "batch/jobs.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "io/json_out.hpp"
@@ -249,48 +250,42 @@ SweepResult run_sweep(const SweepOptions& opt) {
               opt.threads_per_job, out.string());
 
   // Workers take the next case; each case is one child process that the worker waits for.
-  std::atomic<std::size_t> next{0};
   std::atomic<int> done{0};
   std::mutex print;
-  auto worker = [&] {
-    for (std::size_t i = next++; i < r.cases.size(); i = next++) {
-      SweepCase& c = r.cases[i];
-      std::vector<std::string> args = {"run"};
-      if (!opt.scenario.empty()) args.push_back(opt.scenario);
-      args.insert(args.end(), {"--out", c.dir.string(), "--threads", std::to_string(opt.threads_per_job)});
-      for (auto& o : c.overrides) args.insert(args.end(), {"--set", o});
-      c.exit_code = run_child_process(opt.executable, args, c.log);
-      if (c.exit_code == 0) {
-        try {
-          c.summary = read_run_summary(c.dir);
-          c.status = "ok";
-        } catch (const Error& e) {
-          c.status = "no summary";
-          c.error = e.what();
-        }
-      } else {
-        c.status = "failed";
-        c.error = tail_of_file(c.log, 5);
-        if (c.exit_code == -1 && c.error.empty()) c.error = "could not start " + opt.executable.string();
+  run_jobs(r.cases.size(), resolved.jobs, [&](std::size_t i) {
+    SweepCase& c = r.cases[i];
+    std::vector<std::string> args = {"run"};
+    if (!opt.scenario.empty()) args.push_back(opt.scenario);
+    args.insert(args.end(), {"--out", c.dir.string(), "--threads", std::to_string(opt.threads_per_job)});
+    for (auto& o : c.overrides) args.insert(args.end(), {"--set", o});
+    c.exit_code = run_child_process(opt.executable, args, c.log);
+    if (c.exit_code == 0) {
+      try {
+        c.summary = read_run_summary(c.dir);
+        c.status = "ok";
+      } catch (const Error& e) {
+        c.status = "no summary";
+        c.error = e.what();
       }
-      std::lock_guard lock(print);
-      const int n = ++done;
-      if (opt.quiet) continue;
-      std::string vals;
-      for (auto& kv : c.values) vals += fmt::format(" {}={}", kv.first, kv.second);
-      if (c.status == "ok") {
-        const auto p = peak_strength(*c.summary);
-        log::info("[{}/{}] {}{}: peak {:.3f} MPa, E {:.3f} GPa, nu {:.3f}", n, r.cases.size(), c.name, vals,
-                  p ? 1e-6 * p->sigma_p : std::nan(""), 1e-9 * c.summary->youngs_modulus_Pa, c.summary->poisson_ratio);
-      } else {
-        log::warn("[{}/{}] {}{}: {} (exit code {}); log {}:\n{}", n, r.cases.size(), c.name, vals, c.status, c.exit_code,
-                  c.log.string(), c.error);
-      }
+    } else {
+      c.status = "failed";
+      c.error = tail_of_file(c.log, 5);
+      if (c.exit_code == -1 && c.error.empty()) c.error = "could not start " + opt.executable.string();
     }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 0; t < resolved.jobs; ++t) pool.emplace_back(worker);
-  for (auto& t : pool) t.join();
+    std::lock_guard lock(print);
+    const int n = ++done;
+    if (opt.quiet) return;
+    std::string vals;
+    for (auto& kv : c.values) vals += fmt::format(" {}={}", kv.first, kv.second);
+    if (c.status == "ok") {
+      const auto p = peak_strength(*c.summary);
+      log::info("[{}/{}] {}{}: peak {:.3f} MPa, E {:.3f} GPa, nu {:.3f}", n, r.cases.size(), c.name, vals,
+                p ? 1e-6 * p->sigma_p : std::nan(""), 1e-9 * c.summary->youngs_modulus_Pa, c.summary->poisson_ratio);
+    } else {
+      log::warn("[{}/{}] {}{}: {} (exit code {}); log {}:\n{}", n, r.cases.size(), c.name, vals, c.status, c.exit_code,
+                c.log.string(), c.error);
+    }
+  });
 
   std::set<double> pressures;
   for (auto& c : r.cases) {
