@@ -33,6 +33,16 @@ inline void arc_span_2d(const Network2D& net, const Particles2D& p, Index j, Ind
   dy = u2y - u1y;
 }
 
+// The energy-consistent alternative to B26-B27 (coupling::PressureForce::VoidGradient): grain j feels
+// P_i 2 r_j g_ij from pore i, g_ij = d(void per unit depth)/d(x_j), the void being the triangle less the
+// three disc sectors (network.cpp's pore_geometry without its floors). The fluid's work on the grains is
+// then sum_i P_i dV_i: a pore whose pressure follows its void is a conservative spring (the arc force is
+// not, unless the pore is equilateral with equal discs). Zero net force on an interior grain at uniform
+// pressure (the triangles around it tile, and each neighbour's two angles beside it sum to a fixed angle).
+void void_gradient_2d(const Network2D& net, const Particles2D& p, Index j, Index e, Real& gx, Real& gy);
+void add_pressure_forces_void_gradient(const Network2D& net, const Particles2D& particles,
+                                       std::span<const Real> pore_pressure, std::span<Real> fx, std::span<Real> fy);
+
 void add_shear_forces(const Network2D& net, const Particles2D& particles, std::span<const Real> pore_pressure,
                       std::span<Real> fx, std::span<Real> fy);
 

@@ -413,9 +413,12 @@ void DemPorenetCoupling::compute_fluid_forces(Real p_floor) {
   std::fill(fx_.begin(), fx_.end(), 0.0);
   std::fill(fy_.begin(), fy_.end(), 0.0);
   const porenet::Particles2D parts{x_, y_, r_, {}};
-  porenet::add_pressure_forces(*net_, parts, pg_, fx_, fy_);
+  if (prm_.pressure_force == PressureForce::Arc)
+    porenet::add_pressure_forces(*net_, parts, pg_, fx_, fy_);
+  else
+    porenet::add_pressure_forces_void_gradient(*net_, parts, pg_, fx_, fy_);
   if (prm_.shear_forces) porenet::add_shear_forces(*net_, parts, pg_, fx_, fy_);
-  // porenet applies both over the seed's height 2 r_j; every term of particle k carries it once.
+  // porenet applies all of them over the seed's height 2 r_j; every term of particle k carries it once.
   if (prm_.force_height == ForceHeight::Thickness)
     for (std::size_t k = 0; k < fx_.size(); ++k) {
       const Real scale = prm_.network.thickness / (2 * r_[k]);
@@ -439,14 +442,24 @@ std::vector<Real> DemPorenetCoupling::fluid_stiffness() const {
       const Index i = net.pp_pore[e];
       const int c = net.pp_corner[e];
       const Index b = net.pore_v[3 * i + (c + 1) % 3], d = net.pore_v[3 * i + (c + 2) % 3];
-      Real dx, dy;
-      porenet::arc_span_2d(net, parts, j, e, dx, dy);
-      const Real chord = r_[j] * std::hypot(dx, dy);
+      // The force per unit pressure (|a|, per unit height) times the void's change (t |g|) per unit move.
+      Real force_per_p, gx, gy;
+      porenet::void_gradient_2d(net, parts, j, e, gx, gy);
+      if (prm_.pressure_force == PressureForce::Arc) {
+        Real dx, dy;
+        porenet::arc_span_2d(net, parts, j, e, dx, dy);
+        force_per_p = r_[j] * std::hypot(dx, dy);
+      } else {
+        force_per_p = std::hypot(gx, gy);
+      }
       // At the fraction floor (overlapping discs, V = phi x the triangle) phi of the triangle's change.
       const Real edge = std::hypot(x_[d] - x_[b], y_[d] - y_[b]);
       const Real phi =
           net.pore_void[i] <= net.params.min_void_fraction * net.pore_cell[i] ? net.params.min_void_fraction : 1.0;
-      sum += K[static_cast<std::size_t>(i)] * h * chord * t * phi * edge / (2 * net.pore_void[i]);
+      // (The arc force kept its estimate of before 2026-11-28: the triangle's change, edge / 2.)
+      const Real dvoid =
+          prm_.pressure_force == PressureForce::Arc || phi < 1 ? phi * edge / 2 : std::hypot(gx, gy);
+      sum += K[static_cast<std::size_t>(i)] * h * force_per_p * t * dvoid / net.pore_void[i];
     }
     k[static_cast<std::size_t>(j)] = sum;
   }

@@ -47,6 +47,18 @@ enum class Drainage : std::uint8_t { Closed = 0, Sides = 1, Hull = 2 };
 // sweep unchanged (docs/saturated.md).
 enum class ForceHeight : std::uint8_t { Thickness = 0, Diameter = 1 };
 
+// How a pore's pressure pushes the grains at its corners (per unit height, times the height above).
+// VoidGradient: p dV/dx_j, the change of the pore's void (the triangle less the three disc sectors,
+// the volume the flow's mass balance uses) as grain j moves (porenet::void_gradient_2d): the work the
+// fluid does on the grains is then sum p dV, and a pore's pressure, a function of its void, acts as a
+// conservative spring. Arc: seed 004's B26-B27, the pressure integrated over the arc of the disc inside
+// the triangle (porenet::add_pressure_forces). The two agree on an equilateral pore of equal discs and
+// differ otherwise (unequal radii, distorted triangles): the arc force is then not the gradient of the
+// void, the coupled stiffness is not symmetric and a liquid-full specimen can flutter (kinetic energy
+// growing without a broken bond; docs/saturated.md, "Pressure forces"). Both give zero net force on an
+// interior grain at uniform pressure.
+enum class PressureForce : std::uint8_t { VoidGradient = 0, Arc = 1 };
+
 struct PorenetCouplingParams {
   porenet::NetworkParams network;
   porenet::TwoPhaseParams fluid;
@@ -70,6 +82,10 @@ struct PorenetCouplingParams {
   // barotropic liquid then takes any tension: a dilating saturated sample is held together by suction).
   Real cavitation_pressure = 2.34e3;  // [Pa]
   ForceHeight force_height = ForceHeight::Thickness;
+  // Arc here (the hydrofrac driver's 2D network); saturated_ucs's fluid.pressure_forces defaults to the
+  // void gradient. The 2D hydrofrac test block with the void gradient cracked away from the hole at
+  // 8.8 MPa (sleeve 33 MPa): not understood yet (docs/saturated.md, "Pressure forces").
+  PressureForce pressure_force = PressureForce::Arc;
   Drainage drainage = Drainage::Closed;
 };
 
@@ -110,9 +126,10 @@ class DemPorenetCoupling {
   Real fluid_fy(Index k) const { return fy_[static_cast<std::size_t>(k)]; }
   // Stiffness the pore fluid adds to each grain [N/m], for the DEM's critical time step
   // (dem::critical_time_step's extra_stiffness). Pore i of void V_i pushes on grain j with
-  // (p_i - p_a) h w_j (B27; w_j the chord of j's arc in the pore, h the force height), and moving j
-  // towards the pore by dx shrinks V_i by t e_j dx / 2 (e_j the triangle edge opposite j), so
-  // k_j = sum_i K_i h w_j t e_j / (2 V_i), K_i = rho dp/drho of the pore's liquid-gas mixture
+  // (p_i - p_a) h w_j (h the force height; w_j = |g_ij|, g_ij = dV_i/dx_j / t, with the void-gradient
+  // force; the chord of j's arc in the pore with the arc force, B27), and moving j towards the pore by
+  // dx shrinks V_i by t |g_ij| dx (the arc force kept its estimate t e_j dx / 2, e_j the triangle edge
+  // opposite j), so k_j = sum_i K_i h w_j t |g_ij| / V_i, K_i = rho dp/drho of the pore's liquid-gas mixture
   // (1/K = alpha/K_q + (1 - alpha)/K_p) at its current state; pores at a prescribed pressure add
   // none. A pore held at the void floor (min_void_relative: its volume does not follow the grains now)
   // counts as if it had just come off it: the smallest pores are the stiffest springs once they open,

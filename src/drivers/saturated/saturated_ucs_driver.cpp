@@ -97,6 +97,14 @@ void declare(ParamTable& t) {
            "auto (diameter with dem.contact_law = cohesive, else thickness)")
       .one_of({"auto", "thickness", "diameter"})
       .fallback();
+  t.string("fluid.pressure_forces", "void_gradient",
+           "2D: how a pore's pressure pushes the grains at its corners: void_gradient (p dV/dx_j, the change of the "
+           "pore's void as the grain moves: the fluid's work is sum p dV and a liquid-full pore is a conservative "
+           "spring) or arc (seed 004's B26-B27, the pressure over the disc's arc in the pore: not the gradient of the "
+           "void unless the pore is equilateral, so the coupled stiffness is not symmetric and a saturated specimen "
+           "can flutter, docs/saturated.md)")
+      .one_of({"void_gradient", "arc"})
+      .fallback();
   t.boolean("fluid.stiffness_in_time_step", true,
             "the DEM's critical time step counts the stiffness the pore fluid adds to each grain (a liquid-full "
             "pore adds ~2 contact stiffnesses per face; false: contacts and bonds only, as before 2026-11-27)");
@@ -106,7 +114,8 @@ void declare(ParamTable& t) {
 // declared .fallback() so that the saved scenario of a run (read back by `fracflow resume`) leaves
 // them unset unless the user set them.
 const std::vector<std::string> k2DOnly = {"fluid.aperture_h0", "fluid.aperture_hinf", "fluid.aperture_gamma",
-                                          "fluid.shear_forces", "fluid.cavitation_pressure", "fluid.force_height"};
+                                          "fluid.shear_forces", "fluid.cavitation_pressure", "fluid.force_height",
+                                          "fluid.pressure_forces"};
 const std::vector<std::string> k3DOnly = {"fluid.pfv_factor", "fluid.cg_tolerance", "fluid.flow_every"};
 
 porenet::TwoPhaseParams fluid_params(const Config& cfg) {
@@ -137,6 +146,8 @@ coupling::PorenetCouplingParams coupling_params(const Config& cfg) {
   const std::string& h = cfg.string("fluid.force_height");
   const bool diameter = h == "diameter" || (h == "auto" && cfg.string("dem.contact_law") == dem::CohesiveContact::name);
   p.force_height = diameter ? coupling::ForceHeight::Diameter : coupling::ForceHeight::Thickness;
+  p.pressure_force = cfg.string("fluid.pressure_forces") == "arc" ? coupling::PressureForce::Arc
+                                                                   : coupling::PressureForce::VoidGradient;
   return p;
 }
 
@@ -429,6 +440,7 @@ class SaturatedUcsRun final : public UcsRun {
       for (Real r : sys.particles.radius) rm += r;
       rm /= static_cast<Real>(sys.particles.size());
       f["force_height"] = layer ? "diameter" : "thickness";
+      f["pressure_forces"] = fluid_.c2().params().pressure_force == coupling::PressureForce::Arc ? "arc" : "void_gradient";
       if (layer && out.no_peak.empty()) {
         j["layer"]["thickness_m"] = 2 * rm;
         j["layer"]["ucs_Pa"] = ucs_state().peak_stress / (2 * rm);
