@@ -413,7 +413,7 @@ void DemPorenetCoupling::compute_fluid_forces(Real p_floor) {
   std::fill(fx_.begin(), fx_.end(), 0.0);
   std::fill(fy_.begin(), fy_.end(), 0.0);
   const porenet::Particles2D parts{x_, y_, r_, {}};
-  if (prm_.pressure_force == PressureForce::Arc)
+  if (prm_.pressure_force == PressureForce::Surface)
     porenet::add_pressure_forces(*net_, parts, pg_, fx_, fy_);
   else
     porenet::add_pressure_forces_void_gradient(*net_, parts, pg_, fx_, fy_);
@@ -445,7 +445,7 @@ std::vector<Real> DemPorenetCoupling::fluid_stiffness() const {
       // The force per unit pressure (|a|, per unit height) times the void's change (t |g|) per unit move.
       Real force_per_p, gx, gy;
       porenet::void_gradient_2d(net, parts, j, e, gx, gy);
-      if (prm_.pressure_force == PressureForce::Arc) {
+      if (prm_.pressure_force == PressureForce::Surface) {
         Real dx, dy;
         porenet::arc_span_2d(net, parts, j, e, dx, dy);
         force_per_p = r_[j] * std::hypot(dx, dy);
@@ -458,7 +458,7 @@ std::vector<Real> DemPorenetCoupling::fluid_stiffness() const {
           net.pore_void[i] <= net.params.min_void_fraction * net.pore_cell[i] ? net.params.min_void_fraction : 1.0;
       // (The arc force kept its estimate of before 2026-11-28: the triangle's change, edge / 2.)
       const Real dvoid =
-          prm_.pressure_force == PressureForce::Arc || phi < 1 ? phi * edge / 2 : std::hypot(gx, gy);
+          prm_.pressure_force == PressureForce::Surface || phi < 1 ? phi * edge / 2 : std::hypot(gx, gy);
       sum += K[static_cast<std::size_t>(i)] * h * force_per_p * t * dvoid / net.pore_void[i];
     }
     k[static_cast<std::size_t>(j)] = sum;

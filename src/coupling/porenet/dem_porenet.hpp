@@ -28,6 +28,7 @@
 #include "dem/dem_system.hpp"
 #include "io/checkpoint.hpp"
 #include "porenet/network.hpp"
+#include "coupling/porenet/pressure_force.hpp"
 #include "porenet/two_phase.hpp"
 
 namespace ff::coupling {
@@ -47,17 +48,6 @@ enum class Drainage : std::uint8_t { Closed = 0, Sides = 1, Hull = 2 };
 // sweep unchanged (docs/saturated.md).
 enum class ForceHeight : std::uint8_t { Thickness = 0, Diameter = 1 };
 
-// How a pore's pressure pushes the grains at its corners (per unit height, times the height above).
-// VoidGradient: p dV/dx_j, the change of the pore's void (the triangle less the three disc sectors,
-// the volume the flow's mass balance uses) as grain j moves (porenet::void_gradient_2d): the work the
-// fluid does on the grains is then sum p dV, and a pore's pressure, a function of its void, acts as a
-// conservative spring. Arc: seed 004's B26-B27, the pressure integrated over the arc of the disc inside
-// the triangle (porenet::add_pressure_forces). The two agree on an equilateral pore of equal discs and
-// differ otherwise (unequal radii, distorted triangles): the arc force is then not the gradient of the
-// void, the coupled stiffness is not symmetric and a liquid-full specimen can flutter (kinetic energy
-// growing without a broken bond; docs/saturated.md, "Pressure forces"). Both give zero net force on an
-// interior grain at uniform pressure.
-enum class PressureForce : std::uint8_t { VoidGradient = 0, Arc = 1 };
 
 struct PorenetCouplingParams {
   porenet::NetworkParams network;
@@ -82,10 +72,10 @@ struct PorenetCouplingParams {
   // barotropic liquid then takes any tension: a dilating saturated sample is held together by suction).
   Real cavitation_pressure = 2.34e3;  // [Pa]
   ForceHeight force_height = ForceHeight::Thickness;
-  // Arc here (the hydrofrac driver's 2D network); saturated_ucs's fluid.pressure_forces defaults to the
-  // void gradient. The 2D hydrofrac test block with the void gradient cracked away from the hole at
+  // Surface here (the hydrofrac driver's 2D network); saturated_ucs's fluid.pressure_forces defaults to
+  // the void gradient. The 2D hydrofrac test block with the void gradient cracked away from the hole at
   // 8.8 MPa (sleeve 33 MPa): not understood yet (docs/saturated.md, "Pressure forces").
-  PressureForce pressure_force = PressureForce::Arc;
+  PressureForce pressure_force = PressureForce::Surface;
   Drainage drainage = Drainage::Closed;
 };
 

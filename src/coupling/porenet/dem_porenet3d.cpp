@@ -9,6 +9,7 @@
 
 #include "core/error.hpp"
 #include "porenet/forces.hpp"
+#include "porenet/reduce.hpp"
 #include "porenet/remap.hpp"
 
 namespace ff::coupling {
@@ -119,7 +120,26 @@ void DemPorenet3D::compute_fluid_forces(Real p_floor) {
   std::fill(fx_.begin(), fx_.end(), 0.0);
   std::fill(fy_.begin(), fy_.end(), 0.0);
   std::fill(fz_.begin(), fz_.end(), 0.0);
-  porenet::add_pressure_forces_3d(*net_, view(), pg_, fx_, fy_, fz_);
+  if (prm_.pressure_force == PressureForce::Surface) {
+    porenet::add_pressure_forces_3d(*net_, view(), pg_, fx_, fy_, fz_);
+    return;
+  }
+  // p dV/dx_j, the floors as the fluid stiffness's open_floored (the geometric gradient at the relative
+  // floor: at a fixed pressure it is the gradient of p V, conservative).
+  const auto& net = *net_;
+  const porenet::Particles3D parts = view();
+#pragma omp parallel for schedule(static) if (net.n_particles > porenet::kParallelMin)
+  for (Index j = 0; j < net.n_particles; ++j) {
+    Vec3 f = Vec3::Zero();
+    for (Index e = net.pp_start[j]; e < net.pp_start[j + 1]; ++e) {
+      Real a[3];
+      porenet::unit_patch_force_3d(net, parts, j, e, a);
+      f += pg_[static_cast<std::size_t>(net.pp_pore[e])] * void_gradient(j, e, Vec3(a[0], a[1], a[2]), false);
+    }
+    fx_[static_cast<std::size_t>(j)] = f.x();
+    fy_[static_cast<std::size_t>(j)] = f.y();
+    fz_[static_cast<std::size_t>(j)] = f.z();
+  }
 }
 
 void DemPorenet3D::add_forces(dem::DemSystem& sys) {
@@ -321,7 +341,9 @@ std::vector<Real> DemPorenet3D::fluid_stiffness(bool open_floored) const {
       Real a[3];
       porenet::unit_patch_force_3d(net, parts, j, e, a);
       const Vec3 av(a[0], a[1], a[2]);
-      sum += K * av.norm() * void_gradient(j, e, av, !open_floored).norm() / net.pore_void[i];
+      const Real g = void_gradient(j, e, av, !open_floored).norm();
+      const Real force_per_p = prm_.pressure_force == PressureForce::Surface ? av.norm() : g;
+      sum += K * force_per_p * g / net.pore_void[i];
     }
     k[static_cast<std::size_t>(j)] = sum;
   }

@@ -97,14 +97,13 @@ void declare(ParamTable& t) {
            "auto (diameter with dem.contact_law = cohesive, else thickness)")
       .one_of({"auto", "thickness", "diameter"})
       .fallback();
-  t.string("fluid.pressure_forces", "void_gradient",
-           "2D: how a pore's pressure pushes the grains at its corners: void_gradient (p dV/dx_j, the change of the "
-           "pore's void as the grain moves: the fluid's work is sum p dV and a liquid-full pore is a conservative "
-           "spring) or arc (seed 004's B26-B27, the pressure over the disc's arc in the pore: not the gradient of the "
-           "void unless the pore is equilateral, so the coupled stiffness is not symmetric and a saturated specimen "
-           "can flutter, docs/saturated.md)")
-      .one_of({"void_gradient", "arc"})
-      .fallback();
+  t.string("fluid.pressure_forces", "auto",
+           "how a pore's pressure pushes the grains at its corners: void_gradient (p dV/dx_j, the change of the pore's "
+           "void as the grain moves: the fluid's work is sum p dV, a liquid-full pore a conservative spring), surface "
+           "(the pressure over the grain's wetted surface in the pore: seed 004's B26-B27 arc in 2D, the spherical "
+           "patches in 3D; not the gradient of the void, so a saturated specimen can flutter: docs/saturated.md), "
+           "auto (void_gradient in 2D, surface in 3D)")
+      .one_of({"auto", "void_gradient", "surface"});
   t.boolean("fluid.stiffness_in_time_step", true,
             "the DEM's critical time step counts the stiffness the pore fluid adds to each grain (a liquid-full "
             "pore adds ~2 contact stiffnesses per face; false: contacts and bonds only, as before 2026-11-27)");
@@ -114,8 +113,7 @@ void declare(ParamTable& t) {
 // declared .fallback() so that the saved scenario of a run (read back by `fracflow resume`) leaves
 // them unset unless the user set them.
 const std::vector<std::string> k2DOnly = {"fluid.aperture_h0", "fluid.aperture_hinf", "fluid.aperture_gamma",
-                                          "fluid.shear_forces", "fluid.cavitation_pressure", "fluid.force_height",
-                                          "fluid.pressure_forces"};
+                                          "fluid.shear_forces", "fluid.cavitation_pressure", "fluid.force_height"};
 const std::vector<std::string> k3DOnly = {"fluid.pfv_factor", "fluid.cg_tolerance", "fluid.flow_every"};
 
 porenet::TwoPhaseParams fluid_params(const Config& cfg) {
@@ -146,8 +144,8 @@ coupling::PorenetCouplingParams coupling_params(const Config& cfg) {
   const std::string& h = cfg.string("fluid.force_height");
   const bool diameter = h == "diameter" || (h == "auto" && cfg.string("dem.contact_law") == dem::CohesiveContact::name);
   p.force_height = diameter ? coupling::ForceHeight::Diameter : coupling::ForceHeight::Thickness;
-  p.pressure_force = cfg.string("fluid.pressure_forces") == "arc" ? coupling::PressureForce::Arc
-                                                                   : coupling::PressureForce::VoidGradient;
+  p.pressure_force = cfg.string("fluid.pressure_forces") == "surface" ? coupling::PressureForce::Surface
+                                                                       : coupling::PressureForce::VoidGradient;
   return p;
 }
 
@@ -163,6 +161,8 @@ coupling::Porenet3DParams params_3d(const Config& cfg) {
   p.implicit = cfg.string("fluid.flow_scheme") != "explicit";
   p.flow_every = cfg.integer("fluid.flow_every");
   p.drained = false;  // the lateral hull pores only: set by SaturatedUcsRun's on_network
+  p.pressure_force = cfg.string("fluid.pressure_forces") == "void_gradient" ? coupling::PressureForce::VoidGradient
+                                                                             : coupling::PressureForce::Surface;
   return p;
 }
 
@@ -420,6 +420,7 @@ class SaturatedUcsRun final : public UcsRun {
     if (fluid_.dim3()) {
       const auto& c = fluid_.c3();
       f["flow_scheme"] = c.params().implicit ? "implicit" : "explicit";
+      f["pressure_forces"] = c.params().pressure_force == coupling::PressureForce::Surface ? "surface" : "void_gradient";
       f["flow_steps"] = c.stats().flow_steps;
       f["flow_every_last"] = c.stats().flow_every;
       f["throats"] = fluid_.network().n_channels();
@@ -440,7 +441,7 @@ class SaturatedUcsRun final : public UcsRun {
       for (Real r : sys.particles.radius) rm += r;
       rm /= static_cast<Real>(sys.particles.size());
       f["force_height"] = layer ? "diameter" : "thickness";
-      f["pressure_forces"] = fluid_.c2().params().pressure_force == coupling::PressureForce::Arc ? "arc" : "void_gradient";
+      f["pressure_forces"] = fluid_.c2().params().pressure_force == coupling::PressureForce::Surface ? "surface" : "void_gradient";
       if (layer && out.no_peak.empty()) {
         j["layer"]["thickness_m"] = 2 * rm;
         j["layer"]["ucs_Pa"] = ucs_state().peak_stress / (2 * rm);
