@@ -27,6 +27,7 @@
 #include "commands.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "io/scenario.hpp"
 
 namespace fs = std::filesystem;
 using namespace ff;
@@ -43,7 +44,7 @@ struct Args {
   double bond_gap = 0.5;  // x radius_min: neighbours this close are bonded (0.1: ~1.7 bonds per disc, brittle)
   double safety = 0.3;    // dem.time_step_safety (of the critical step with the pore fluid's stiffness)
   int seed = 7, threads = 1, packings = 3, jobs = 1;
-  bool quick = false, overwrite = false;
+  bool quick = false, overwrite = false, resume = false;
 };
 
 // The seed's law with concrete-like micro-parameters (module Ec, Ks/Kn, friction tan(mu_c),
@@ -126,6 +127,7 @@ struct Case {
   double p_max_prepeak = 0, p_mean_at_peak = 0, strain_at_pmax = 0;
   double cracks_at_peak = 0, cracks_final = 0, tensile_final = 0, shear_final = 0, wall = 0;
   long particles = 0, bonds = 0;
+  char how = 'r';  // r: run now, c: continued from a checkpoint (--resume), f: finished before (--resume)
 };
 
 Case run_case(const fs::path& scen, const Args& a, double s, double mu, int seed, const fs::path& dir) {
@@ -137,11 +139,34 @@ Case run_case(const fs::path& scen, const Args& a, double s, double mu, int seed
   batch::InProcessRun r;
   r.out_dir = dir;
   r.threads = a.threads;
-  log::info("validate-saturated: S = {:g}, mu = {:g} Pa s, seed {}", s, mu, seed);
-  batch::run_in_process(scen.string(),
-                        {fmt::format("fluid.saturation={}", s), fmt::format("fluid.liquid_viscosity={}", mu),
-                         fmt::format("sample.seed={}", seed)},
-                        r);
+  const std::string what = fmt::format("S = {:g}, mu = {:g} Pa s, seed {}", s, mu, seed);
+  RunStatus st = RunStatus::Finished;
+  // --resume: a finished run (its summary.json written) is read as it is, an interrupted one continues
+  // from its checkpoint, one stopped before its first checkpoint starts again.
+  if (a.resume && fs::exists(dir / "summary.json")) {
+    log::info("validate-saturated: {}: finished before, read from {}", what, dir.string());
+    c.how = 'f';
+  } else if (a.resume && fs::exists(dir / "checkpoint")) {
+    log::info("validate-saturated: {}: continuing from {}/checkpoint", what, dir.string());
+    st = batch::resume_in_process(dir, r);
+    c.how = 'c';
+  } else {
+    if (a.resume && fs::exists(dir)) {
+      if (!fs::exists(dir / ".fracflow"))
+        throw InputError(fmt::format("--resume: '{}' is not a run of this study (no .fracflow marker); move it away",
+                                     dir.string()));
+      fs::remove_all(dir);  // the study's own run, stopped before it wrote a checkpoint
+    }
+    log::info("validate-saturated: {}", what);
+    st = batch::run_in_process(scen.string(),
+                               {fmt::format("fluid.saturation={}", s), fmt::format("fluid.liquid_viscosity={}", mu),
+                                fmt::format("sample.seed={}", seed)},
+                               r);
+  }
+  if (st != RunStatus::Finished)
+    throw InputError(fmt::format("validate-saturated: the run {} ({}) stopped before its end; continue the study "
+                                 "with the same options and --resume",
+                                 dir.string(), what));
   std::ifstream f(dir / "summary.json");
   const auto j = nlohmann::json::parse(f);
   if (j["ucs_Pa"].is_number()) c.ucs = j["ucs_Pa"];
@@ -240,13 +265,26 @@ int run_validate(Args a) {
     a.height = 16e-3;
   }
   const fs::path out = a.out;
-  if (fs::exists(out)) {
-    if (!a.overwrite) throw InputError(fmt::format("'{}' exists; pass --overwrite to replace it", out.string()));
-    fs::remove_all(out);
-  }
-  fs::create_directories(out);
   const fs::path scen = out / "specimen.toml";
-  write_text(scen, scenario(a));
+  if (a.resume && a.overwrite) throw InputError("--resume continues the study in --out; --overwrite replaces it: not both");
+  if (a.resume) {
+    if (!fs::exists(scen))
+      throw InputError(fmt::format("--resume: '{}' holds no study (no specimen.toml)", out.string()));
+    if (read_text_file(scen.string()) != scenario(a))
+      throw InputError(fmt::format("--resume: the study in '{}' was started with other options (its specimen.toml "
+                                   "differs from what these options give: width, height, velocity, bond gap, time "
+                                   "step safety, --quick); give the same options, or a new --out",
+                                   out.string()));
+  } else {
+    if (fs::exists(out)) {
+      if (!a.overwrite)
+        throw InputError(fmt::format("'{}' exists; pass --overwrite to replace it, or --resume to continue it",
+                                     out.string()));
+      fs::remove_all(out);
+    }
+    fs::create_directories(out);
+    write_text(scen, scenario(a));
+  }
   const auto t0 = std::chrono::steady_clock::now();
   struct Spec {
     double s, mu;
@@ -301,10 +339,17 @@ int run_validate(Args a) {
   };
   std::string md;
   md += "# Seed 004: partially saturated concrete under uniaxial compression (2D)\n\n";
+  long n_read = 0, n_continued = 0;
+  for (const auto& c : cases) n_read += c.how == 'f', n_continued += c.how == 'c';
+  const std::string resumed =
+      a.resume ? fmt::format("; continued with --resume: {} run(s) read as finished before, {} continued from their "
+                             "checkpoints (the runs' own wall times are in the table below)",
+                             n_read, n_continued)
+               : std::string();
   md += fmt::format("Generated by `fracflow validate-saturated{}` on {} ({} thread(s) per run, {} run(s) at a time, {:.0f} s "
-                    "in all). Do not edit by hand.\n\n",
+                    "in all{}). Do not edit by hand.\n\n",
                     a.quick ? " --quick" : "", fmt::format("{:%Y-%m-%d %H:%M} UTC", fmt::gmtime(std::time(nullptr))),
-                    a.threads, std::min<int>(a.jobs, static_cast<int>(specs.size())), total_wall);
+                    a.threads, std::min<int>(a.jobs, static_cast<int>(specs.size())), total_wall, resumed);
   const Case& c0 = cases.front();
   md += fmt::format(
       "**Specimen.** {:.0f} x {:.0f} mm box of {} bonded discs (radii {:.2f}-{:.2f} mm, {} cohesive bonds), "
@@ -313,8 +358,11 @@ int run_validate(Args a) {
       "\"cohesive\"`, src/dem/bond/cohesive_bond.hpp): Ec = 11.3 GPa, Ks/Kn = 0.2, tan(mu_c) = 0.325 (18 deg), "
       "C = 140 MPa, T = 25 MPa, alpha_d = 0.08. Platens {:g} m/s each (strain rate {:.2g} 1/s), lateral faces "
       "drained at 0.1 MPa, platens impermeable. Pore network of seed 004 (B1-B28): water as a barotropic liquid "
-      "(K = 2.2 GPa), air as an ideal gas; B1 h0 = 1 um, h_inf = 0.1 um, B2 gamma = 0.01; pressure and channel-shear "
-      "forces over the spheres' height 2 r (B27-B28, as the law's forces are those of spheres).\n\n",
+      "(K = 2.2 GPa), air as an ideal gas; B1 h0 = 1 um, h_inf = 0.1 um, B2 gamma = 0.01; forces over the spheres' "
+      "height 2 r (as the law's forces are those of spheres): channel shear (B25, B28) and the pore pressure as "
+      "p dV/dx on each grain, the gradient of the pore's void (`fluid.pressure_forces = void_gradient`: seed 004's "
+      "B26-B27 arc force is not the gradient of the void, and with it the saturated specimens fluttered, kinetic "
+      "energy growing before the first crack; docs/saturated.md, \"Pressure forces\").\n\n",
       1e3 * a.width, 1e3 * a.height, c0.particles, 1e3 * a.radius_min, 1e3 * a.radius_max, c0.bonds, a.packings, a.seed,
       a.seed + a.packings - 1, 1e3 * a.bond_gap * a.radius_min, a.velocity, 2 * a.velocity / a.height);
   md += fmt::format(
@@ -458,6 +506,9 @@ const bool registered = ff::cli::register_command({"validate-saturated", [](CLI:
   sub->add_option("--jobs,-j", a->jobs, "runs at a time")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_flag("--quick", a->quick, "one packing of a 8 x 16 mm specimen (a smoke run)");
   sub->add_flag("--overwrite", a->overwrite, "replace an existing --out folder");
+  sub->add_flag("--resume", a->resume,
+                "continue the study in --out (same options): finished runs are read, interrupted ones continue from "
+                "their checkpoints, the rest run");
   return ff::cli::Command::Run([a] {
     if (a->saturations.empty() || a->saturations.front() != 0)
       throw InputError("validate-saturated: --saturations must start with 0 (the dry reference)");

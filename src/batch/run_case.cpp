@@ -82,6 +82,34 @@ RunStatus run_in_process(const std::string& scenario_path, const std::vector<std
   }
 }
 
+RunStatus resume_in_process(const fs::path& dir, const InProcessRun& run) {
+  if (!fs::exists(dir / "scenario.toml") || !fs::exists(dir / "checkpoint"))
+    throw InputError(fmt::format("'{}' holds no run with a checkpoint to resume from", dir.string()));
+  const FolderLock lock = FolderLock::acquire(dir);  // one writer per folder
+  auto l = load_scenario_for_run((dir / "scenario.toml").string(), {}, /*resume=*/true);
+  RunOptions opt;
+  opt.out_dir = dir;
+  opt.resume = true;
+  opt.threads = std::max(1, run.threads);
+  opt.max_steps = run.max_steps;
+  opt.max_wall_s = run.max_wall_s;
+  opt.abort_file = dir / "ABORT";
+  opt.progress_interval_s = run.quiet ? 0 : l->config.real("output.progress_interval");
+  const int threads_before = omp_get_max_threads();
+  const bool quiet_before = log::quiet();
+  omp_set_num_threads(opt.threads);
+  log::quiet() = run.quiet || quiet_before;
+  struct Restore {
+    int threads;
+    bool quiet;
+    ~Restore() {
+      omp_set_num_threads(threads);
+      log::quiet() = quiet;
+    }
+  } restore{threads_before, quiet_before};
+  return l->driver->run(l->config, opt);
+}
+
 double json_number(const nlohmann::json& j, std::initializer_list<const char*> path) {
   const nlohmann::json* p = &j;
   for (const char* k : path) {

@@ -46,6 +46,11 @@ struct InProcessRun {
 RunStatus run_in_process(const std::string& scenario_path, const std::vector<std::string>& overrides,
                          const InProcessRun& run);
 
+// Continues an interrupted run in `dir` from its checkpoint in this process, as `fracflow resume`
+// does (its lock held for the run; the scenario as the folder's scenario.toml has it; out_dir of
+// `run` is ignored). Throws ff::InputError when dir holds no run or no checkpoint.
+RunStatus resume_in_process(const std::filesystem::path& dir, const InProcessRun& run);
+
 // The headline numbers of a finished run's summary.json; absent and null numbers are NaN
 // (a run writes null where it has no trustworthy value, e.g. an elastic fit without points).
 struct RunSummary {

@@ -279,6 +279,10 @@ void DemPorenetCoupling::cavitate() {
     else
       vap_[i] = std::min(mp[i], vap_[i] + chi * dm);
     const Real V = net_->pore_void[i];
+    // A pore without liquid has nothing to cavitate: its gas expands below pc as a gas does (the
+    // vapour added to dry pores became liquid when they closed again, and the pressure solved for
+    // that liquid with the air was negative: "ideal-gas density asked at p = -1.7e9 Pa").
+    if (!(mq[i] > 0) && !(vap_[i] > 0)) continue;
     if (p[i] < pc) {
       // Same liquid mass at the vapour pressure; the rest of the void is vapour at pc. Vapour is only
       // added: a pore whose gas would fill that space already is left alone (gas mass never falls).

@@ -12,6 +12,8 @@
 #include <string>
 
 #include "../program_runner.hpp"
+#include "batch/run_case.hpp"
+#include "core/error.hpp"
 #include "dem/presets.hpp"
 namespace fs = std::filesystem;
 
@@ -221,4 +223,43 @@ TEST(RunResults, CalibrationRefusesARunWithoutPeakOrFit) {
   EXPECT_TRUE(has(r.output, "raise ucs.max_strain")) << r.output;
   EXPECT_FALSE(fs::exists(out / "iter_02")) << "a second run was started from a run without results";
   fs::remove_all(out);
+}
+
+// batch::run_in_process stopped by max_steps leaves a checkpoint; batch::resume_in_process continues
+// it (as `fracflow resume`) to the same series.csv as an uninterrupted run, byte for byte
+// (validate-saturated --resume continues interrupted runs this way).
+TEST(RunResults, InProcessRunStoppedAndResumedEqualsTheWholeRun) {
+  const std::vector<std::string> tiny = {"sample.diameter=5e-3", "sample.height=8e-3", "sample.porosity=0.45",
+                                         "output.vtk=false",     "output.plots=false", "output.progress_interval=0",
+                                         "ucs.max_strain=0.01"};
+  const auto whole = scratch("inproc_whole"), parts = scratch("inproc_parts");
+  fs::remove_all(whole);
+  fs::remove_all(parts);
+  ff::batch::InProcessRun r;
+  r.out_dir = whole;
+  ASSERT_EQ(ff::batch::run_in_process("", tiny, r), ff::RunStatus::Finished);
+  long steps = 0;  // the whole run's last step; stop the other half-way
+  {
+    std::ifstream f(whole / "series.csv");
+    std::string line, last;
+    while (std::getline(f, line)) last = line;
+    steps = std::stol(last.substr(0, last.find(',')));
+  }
+  ASSERT_GT(steps, 100);
+  r.out_dir = parts;
+  r.max_steps = steps / 2;
+  ASSERT_EQ(ff::batch::run_in_process("", tiny, r), ff::RunStatus::Interrupted);
+  ASSERT_TRUE(fs::exists(parts / "checkpoint"));
+  EXPECT_FALSE(fs::exists(parts / "summary.json"));
+  r.max_steps = 0;
+  ASSERT_EQ(ff::batch::resume_in_process(parts, r), ff::RunStatus::Finished);
+  std::ifstream a(whole / "series.csv"), b(parts / "series.csv");
+  std::stringstream sa, sb;
+  sa << a.rdbuf();
+  sb << b.rdbuf();
+  EXPECT_GT(sa.str().size(), 100u);
+  EXPECT_EQ(sa.str(), sb.str());
+  EXPECT_THROW(ff::batch::resume_in_process(scratch("inproc_none"), r), ff::InputError);
+  fs::remove_all(whole);
+  fs::remove_all(parts);
 }
