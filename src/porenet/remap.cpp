@@ -64,8 +64,8 @@ void remap_single_phase(const Network2D& old_net, SinglePhaseFlow& old_flow, con
   new_flow.load_masses(m);
 }
 
-void remap_two_phase(const Network2D& old_net, TwoPhaseFlow& old_flow, const Network2D& new_net,
-                     TwoPhaseFlow& new_flow) {
+RemapChange remap_two_phase(const Network2D& old_net, TwoPhaseFlow& old_flow, const Network2D& new_net,
+                            TwoPhaseFlow& new_flow, RemapConserve conserve) {
   const auto near = nearest_pores(old_net, new_net);
   const std::size_t n = near.size();
   std::vector<Real> mq(n), mp(n);
@@ -78,12 +78,16 @@ void remap_two_phase(const Network2D& old_net, TwoPhaseFlow& old_flow, const Net
     tq += mq[k];
     tp += mp[k];
   }
-  const Real sq = tq > 0 ? old_flow.total_liquid_mass() / tq : 0, sp = tp > 0 ? old_flow.total_gas_mass() / tp : 0;
-  for (std::size_t k = 0; k < n; ++k) {
-    mq[k] *= sq;
-    mp[k] *= sp;
+  const Real old_q = old_flow.total_liquid_mass(), old_p = old_flow.total_gas_mass();
+  if (conserve == RemapConserve::Mass) {
+    const Real sq = tq > 0 ? old_q / tq : 0, sp = tp > 0 ? old_p / tp : 0;
+    for (std::size_t k = 0; k < n; ++k) {
+      mq[k] *= sq;
+      mp[k] *= sp;
+    }
   }
   new_flow.load_masses(mq, mp);
+  return {new_flow.total_liquid_mass() - old_q, new_flow.total_gas_mass() - old_p};
 }
 
 }  // namespace ff::porenet

@@ -168,7 +168,10 @@ void DemPorenetCoupling::retriangulate(const dem::DemSystem& sys) {
   make_network_and_flow(net_, flow_);
   flow_->init(prm_.initial_pressure, prm_.saturation);
   set_boundaries(*flow_, *net_);
-  porenet::remap_two_phase(*old_net, *old_flow, *net_, *flow_);
+  const auto change = porenet::remap_two_phase(*old_net, *old_flow, *net_, *flow_, prm_.remap);
+  stats_.remap_liquid_change += change.liquid;
+  stats_.remap_gas_change += change.gas;
+  stats_.remap_liquid_change_max = std::max(stats_.remap_liquid_change_max, std::abs(change.liquid));
   pg_.assign(static_cast<std::size_t>(net_->n_pores()), 0);
   const std::vector<Real> old_vap = vap_;
   carry_vapour(*old_net, old_vap, old_flow->gas_mass());

@@ -29,6 +29,7 @@
 #include "io/checkpoint.hpp"
 #include "porenet/network.hpp"
 #include "coupling/porenet/pressure_force.hpp"
+#include "porenet/remap.hpp"
 #include "porenet/two_phase.hpp"
 
 namespace ff::coupling {
@@ -77,6 +78,10 @@ struct PorenetCouplingParams {
   // 8.8 MPa (sleeve 33 MPa): not understood yet (docs/saturated.md, "Pressure forces").
   PressureForce pressure_force = PressureForce::Surface;
   Drainage drainage = Drainage::Closed;
+  // What a retriangulation keeps (porenet/remap.hpp): each phase's mass (here, the hydrofrac
+  // driver's network) or the pores' pressures (saturated_ucs's fluid.remap default: with water the
+  // mass-conserving remap moved every pore's pressure by 1.5-5.4 MPa at a retriangulation).
+  porenet::RemapConserve remap = porenet::RemapConserve::Mass;
 };
 
 struct CouplingStats {
@@ -90,6 +95,8 @@ struct CouplingStats {
   long condensations = 0;     // pore-steps whose vapour (partly) condensed
   Real condensed_mass = 0;    // vapour mass condensed back into liquid [kg per m of depth]
   long implicit_steps = 0;    // DEM steps finished by an implicit flow step (implicit_above)
+  Real remap_liquid_change = 0, remap_gas_change = 0;  // sum over retriangulations of new - old mass [kg per m]
+  Real remap_liquid_change_max = 0;                    // largest |change| of one retriangulation [kg per m]
 };
 
 class DemPorenetCoupling {

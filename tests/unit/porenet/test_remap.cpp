@@ -84,3 +84,39 @@ TEST(PorenetRemap, TwoPhaseMassConserved) {
   EXPECT_LT(eg, 1e-14);
   EXPECT_NEAR(g.saturation(), f.saturation(), 0.02);
 }
+
+// RemapConserve::Pressure: each new pore keeps its source pore's pressure and liquid fraction (to
+// round-off), and the masses change by what the two networks' voids differ, returned. With the
+// mass-conserving remap the same water-saturated sample shifts every pore's pressure by
+// K x (relative change of the total void): measured and printed, bounded below to show why the
+// saturated driver carries pressures (docs/saturated.md).
+TEST(PorenetRemap, PressureRemapCarriesPressuresAndReportsTheMassChange) {
+  auto s = test_packings::hex_packing(20, 20, 1e-3, 0.45e-3, 0.05, 0.1);
+  Network2D old_net = build_network_2d(s.view(), {});
+  TwoPhaseParams prm;
+  prm.liquid = Eos::barotropic(1000, 1e5, 2.2e9);
+  TwoPhaseFlow f(old_net, prm);
+  f.init(1e5, 1.0);
+  for (Index k = 0; k < old_net.n_pores(); ++k) f.set_pore_state(k, 1e5 + 2e6 * old_net.pore_cx[k] / 20e-3, 1.0);
+  const auto t = deform(s);
+  update_network_2d(old_net, t.view(), {});
+  f.load_masses(std::vector<Real>(f.liquid_mass().begin(), f.liquid_mass().end()),
+                std::vector<Real>(f.gas_mass().begin(), f.gas_mass().end()));
+  const Real q0 = f.total_liquid_mass();
+  const Network2D new_net = build_network_2d(t.view(), {});
+  const auto near = nearest_pores(old_net, new_net);
+  TwoPhaseFlow g(new_net, prm), h(new_net, prm);
+  const RemapChange c = remap_two_phase(old_net, f, new_net, g, RemapConserve::Pressure);
+  const RemapChange cm = remap_two_phase(old_net, f, new_net, h, RemapConserve::Mass);
+  Real dp = 0, dp_mass = 0;
+  for (Index k = 0; k < new_net.n_pores(); ++k) {
+    dp = std::max(dp, std::abs(g.pressure()[k] - f.pressure()[near[k]]));
+    dp_mass = std::max(dp_mass, std::abs(h.pressure()[k] - f.pressure()[near[k]]));
+  }
+  std::printf("pressure remap: max |dp| %.2e Pa, liquid mass change %.3e (relative %.2e); mass remap: max |dp| %.3e Pa, "
+              "mass change %.1e\n", dp, c.liquid, c.liquid / q0, dp_mass, cm.liquid / q0);
+  EXPECT_LT(dp, 1e-6);
+  EXPECT_NEAR(c.liquid, g.total_liquid_mass() - q0, 1e-12 * q0);
+  EXPECT_LT(std::abs(cm.liquid), 1e-13 * q0);
+  EXPECT_GT(dp_mass, 1e3);  // the shift the mass-conserving remap gives water here
+}
