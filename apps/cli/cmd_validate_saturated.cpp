@@ -362,7 +362,8 @@ int run_validate(Args a) {
       "height 2 r (as the law's forces are those of spheres): channel shear (B25, B28) and the pore pressure as "
       "p dV/dx on each grain, the gradient of the pore's void (`fluid.pressure_forces = void_gradient`: seed 004's "
       "B26-B27 arc force is not the gradient of the void, and with it the saturated specimens fluttered, kinetic "
-      "energy growing before the first crack; docs/saturated.md, \"Pressure forces\").\n\n",
+      "energy growing before the first crack; docs/saturated.md, \"Pressure forces\"); a retriangulation carries the "
+      "pores' pressures over (`fluid.remap = pressure`; conserving the mass instead moved every pore by 1.5-8 MPa).\n\n",
       1e3 * a.width, 1e3 * a.height, c0.particles, 1e3 * a.radius_min, 1e3 * a.radius_max, c0.bonds, a.packings, a.seed,
       a.seed + a.packings - 1, 1e3 * a.bond_gap * a.radius_min, a.velocity, 2 * a.velocity / a.height);
   md += fmt::format(
