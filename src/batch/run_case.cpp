@@ -44,6 +44,28 @@ std::unique_ptr<LoadedScenario> load_scenario_for_run(const std::string& path, c
   return l;
 }
 
+namespace {
+// The driver reads the thread count from the OpenMP runtime and quiet is a process-wide flag: both
+// set for one in-process run and restored afterwards.
+class ThreadsAndQuiet {
+ public:
+  ThreadsAndQuiet(int threads, bool quiet) : threads_(omp_get_max_threads()), quiet_(log::quiet()) {
+    omp_set_num_threads(threads);
+    log::quiet() = quiet || quiet_;
+  }
+  ~ThreadsAndQuiet() {
+    omp_set_num_threads(threads_);
+    log::quiet() = quiet_;
+  }
+  ThreadsAndQuiet(const ThreadsAndQuiet&) = delete;
+  ThreadsAndQuiet& operator=(const ThreadsAndQuiet&) = delete;
+
+ private:
+  int threads_;
+  bool quiet_;
+};
+}  // namespace
+
 RunStatus run_in_process(const std::string& scenario_path, const std::vector<std::string>& overrides,
                          const InProcessRun& run) {
   auto l = load_scenario_for_run(scenario_path, overrides);  // every key validated before anything is written
@@ -60,20 +82,7 @@ RunStatus run_in_process(const std::string& scenario_path, const std::vector<std
   opt.abort_file = run.out_dir / "ABORT";
   opt.progress_interval_s = run.quiet ? 0 : l->config.real("output.progress_interval");
   opt.begin_output = [&folder, resolved = l->config.resolved_toml(), command] { folder.begin(resolved, command); };
-  // The driver reads the thread count from the OpenMP runtime; quiet is a process-wide flag,
-  // so both are restored afterwards.
-  const int threads_before = omp_get_max_threads();
-  const bool quiet_before = log::quiet();
-  omp_set_num_threads(opt.threads);
-  log::quiet() = run.quiet || quiet_before;
-  struct Restore {
-    int threads;
-    bool quiet;
-    ~Restore() {
-      omp_set_num_threads(threads);
-      log::quiet() = quiet;
-    }
-  } restore{threads_before, quiet_before};
+  const ThreadsAndQuiet scoped(opt.threads, run.quiet);
   try {
     return l->driver->run(l->config, opt);
   } catch (const InputError&) {
@@ -95,18 +104,7 @@ RunStatus resume_in_process(const fs::path& dir, const InProcessRun& run) {
   opt.max_wall_s = run.max_wall_s;
   opt.abort_file = dir / "ABORT";
   opt.progress_interval_s = run.quiet ? 0 : l->config.real("output.progress_interval");
-  const int threads_before = omp_get_max_threads();
-  const bool quiet_before = log::quiet();
-  omp_set_num_threads(opt.threads);
-  log::quiet() = run.quiet || quiet_before;
-  struct Restore {
-    int threads;
-    bool quiet;
-    ~Restore() {
-      omp_set_num_threads(threads);
-      log::quiet() = quiet;
-    }
-  } restore{threads_before, quiet_before};
+  const ThreadsAndQuiet scoped(opt.threads, run.quiet);
   return l->driver->run(l->config, opt);
 }
 
