@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <cstdint>
 #include <cstdlib>
 #include <ctime>
 #include <filesystem>
@@ -127,7 +128,7 @@ struct Case {
   double p_max_prepeak = 0, p_mean_at_peak = 0, strain_at_pmax = 0;
   double cracks_at_peak = 0, cracks_final = 0, tensile_final = 0, shear_final = 0, wall = 0;
   long particles = 0, bonds = 0;
-  char how = 'r';  // r: run now, c: continued from a checkpoint (--resume), f: finished before (--resume)
+  enum class Source : std::uint8_t { Run, Continued, Read } source = Source::Run;  // Continued, Read: --resume
 };
 
 Case run_case(const fs::path& scen, const Args& a, double s, double mu, int seed, const fs::path& dir) {
@@ -145,11 +146,11 @@ Case run_case(const fs::path& scen, const Args& a, double s, double mu, int seed
   // from its checkpoint, one stopped before its first checkpoint starts again.
   if (a.resume && fs::exists(dir / "summary.json")) {
     log::info("validate-saturated: {}: finished before, read from {}", what, dir.string());
-    c.how = 'f';
+    c.source = Case::Source::Read;
   } else if (a.resume && fs::exists(dir / "checkpoint")) {
     log::info("validate-saturated: {}: continuing from {}/checkpoint", what, dir.string());
     st = batch::resume_in_process(dir, r);
-    c.how = 'c';
+    c.source = Case::Source::Continued;
   } else {
     if (a.resume && fs::exists(dir)) {
       if (!fs::exists(dir / ".fracflow"))
@@ -340,7 +341,8 @@ int run_validate(Args a) {
   std::string md;
   md += "# Seed 004: partially saturated concrete under uniaxial compression (2D)\n\n";
   long n_read = 0, n_continued = 0;
-  for (const auto& c : cases) n_read += c.how == 'f', n_continued += c.how == 'c';
+  for (const auto& c : cases)
+    n_read += c.source == Case::Source::Read, n_continued += c.source == Case::Source::Continued;
   const std::string resumed =
       a.resume ? fmt::format("; continued with --resume: {} run(s) read as finished before, {} continued from their "
                              "checkpoints (the runs' own wall times are in the table below)",

@@ -61,6 +61,44 @@ void add_shear_forces(const Network2D& net, const Particles2D& p, std::span<cons
   }
 }
 
+void void_gradient_2d(const Network2D& net, const Particles2D& p, Index j, Index e, Real& gx, Real& gy) {
+  const Index k = net.pp_pore[e];
+  const int c = net.pp_corner[e];
+  const Index b = net.pore_v[3 * k + (c + 1) % 3], d = net.pore_v[3 * k + (c + 2) % 3];
+  const Real xj = p.x[j], yj = p.y[j], xb = p.x[b], yb = p.y[b], xd = p.x[d], yd = p.y[d];
+  // Triangle (j, b, d), counter-clockwise: dA/dx_j = (y_b - y_d, x_d - x_b) / 2.
+  gx = 0.5 * (yb - yd);
+  gy = 0.5 * (xd - xb);
+  // Less the sectors theta_c r_c^2 / 2. The polar angle of a vector v turns by (-v_y, v_x) / |v|^2 per
+  // unit move of its tip (and by minus that per move of its tail).
+  const Real ux = xb - xj, uy = yb - yj, wx = xd - xj, wy = yd - yj;  // theta_j = angle(w) - angle(u)
+  const Real uu = ux * ux + uy * uy, ww = wx * wx + wy * wy;
+  const Real tjx = wy / ww - uy / uu, tjy = ux / uu - wx / ww;          // j is the tail of u and w
+  const Real bx = xj - xb, by = yj - yb, bb = bx * bx + by * by;        // theta_b = angle(j - b) - angle(d - b)
+  const Real dx = xj - xd, dy = yj - yd, dd = dx * dx + dy * dy;        // theta_d = angle(b - d) - angle(j - d)
+  const Real rj = p.radius[j], rb = p.radius[b], rd = p.radius[d];
+  gx -= 0.5 * (rj * rj * tjx - rb * rb * by / bb + rd * rd * dy / dd);
+  gy -= 0.5 * (rj * rj * tjy + rb * rb * bx / bb - rd * rd * dx / dd);
+}
+
+void add_pressure_forces_void_gradient(const Network2D& net, const Particles2D& p, std::span<const Real> P,
+                                       std::span<Real> fx, std::span<Real> fy) {
+  check(net, p, P, fx, fy);
+#pragma omp parallel for schedule(static) if (net.n_particles > kParallelMin)
+  for (Index j = 0; j < net.n_particles; ++j) {
+    Real sx = 0, sy = 0;
+    for (Index e = net.pp_start[j]; e < net.pp_start[j + 1]; ++e) {
+      Real gx, gy;
+      void_gradient_2d(net, p, j, e, gx, gy);
+      const Real w = P[net.pp_pore[e]] * 2 * p.radius[j];  // over the seed's height 2 r_j, as B27
+      sx += w * gx;
+      sy += w * gy;
+    }
+    fx[j] += sx;
+    fy[j] += sy;
+  }
+}
+
 }  // namespace ff::porenet
 
 namespace ff::porenet {
@@ -126,48 +164,6 @@ void add_pressure_forces_3d(const Network2D& net, const Particles3D& p, std::spa
     fx[j] += s[0];
     fy[j] += s[1];
     fz[j] += s[2];
-  }
-}
-
-}  // namespace ff::porenet
-
-namespace ff::porenet {
-
-void void_gradient_2d(const Network2D& net, const Particles2D& p, Index j, Index e, Real& gx, Real& gy) {
-  const Index k = net.pp_pore[e];
-  const int c = net.pp_corner[e];
-  const Index b = net.pore_v[3 * k + (c + 1) % 3], d = net.pore_v[3 * k + (c + 2) % 3];
-  const Real xj = p.x[j], yj = p.y[j], xb = p.x[b], yb = p.y[b], xd = p.x[d], yd = p.y[d];
-  // Triangle (j, b, d), counter-clockwise: dA/dx_j = (y_b - y_d, x_d - x_b) / 2.
-  gx = 0.5 * (yb - yd);
-  gy = 0.5 * (xd - xb);
-  // Less the sectors theta_c r_c^2 / 2. The polar angle of a vector v turns by (-v_y, v_x) / |v|^2 per
-  // unit move of its tip (and by minus that per move of its tail).
-  const Real ux = xb - xj, uy = yb - yj, wx = xd - xj, wy = yd - yj;  // theta_j = angle(w) - angle(u)
-  const Real uu = ux * ux + uy * uy, ww = wx * wx + wy * wy;
-  const Real tjx = wy / ww - uy / uu, tjy = ux / uu - wx / ww;          // j is the tail of u and w
-  const Real bx = xj - xb, by = yj - yb, bb = bx * bx + by * by;        // theta_b = angle(j - b) - angle(d - b)
-  const Real dx = xj - xd, dy = yj - yd, dd = dx * dx + dy * dy;        // theta_d = angle(b - d) - angle(j - d)
-  const Real rj = p.radius[j], rb = p.radius[b], rd = p.radius[d];
-  gx -= 0.5 * (rj * rj * tjx - rb * rb * by / bb + rd * rd * dy / dd);
-  gy -= 0.5 * (rj * rj * tjy + rb * rb * bx / bb - rd * rd * dx / dd);
-}
-
-void add_pressure_forces_void_gradient(const Network2D& net, const Particles2D& p, std::span<const Real> P,
-                                       std::span<Real> fx, std::span<Real> fy) {
-  check(net, p, P, fx, fy);
-#pragma omp parallel for schedule(static) if (net.n_particles > kParallelMin)
-  for (Index j = 0; j < net.n_particles; ++j) {
-    Real sx = 0, sy = 0;
-    for (Index e = net.pp_start[j]; e < net.pp_start[j + 1]; ++e) {
-      Real gx, gy;
-      void_gradient_2d(net, p, j, e, gx, gy);
-      const Real w = P[net.pp_pore[e]] * 2 * p.radius[j];  // over the seed's height 2 r_j, as B27
-      sx += w * gx;
-      sy += w * gy;
-    }
-    fx[j] += sx;
-    fy[j] += sy;
   }
 }
 

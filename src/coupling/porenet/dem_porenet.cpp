@@ -449,23 +449,24 @@ std::vector<Real> DemPorenetCoupling::fluid_stiffness() const {
       const Index i = net.pp_pore[e];
       const int c = net.pp_corner[e];
       const Index b = net.pore_v[3 * i + (c + 1) % 3], d = net.pore_v[3 * i + (c + 2) % 3];
-      // The force per unit pressure (|a|, per unit height) times the void's change (t |g|) per unit move.
-      Real force_per_p, gx, gy;
-      porenet::void_gradient_2d(net, parts, j, e, gx, gy);
+      // At the fraction floor (overlapping discs, V = phi x the triangle) phi of the triangle's change.
+      const Real edge = std::hypot(x_[d] - x_[b], y_[d] - y_[b]);
+      const Real phi =
+          net.pore_void[i] <= net.params.min_void_fraction * net.pore_cell[i] ? net.params.min_void_fraction : 1.0;
+      // The force per unit pressure (per unit height) times the void's change (per unit depth and move):
+      // the arc's chord and the triangle's change edge / 2 (the estimate of before 2026-11-28), or |g|
+      // for both with the void-gradient force (the triangle's phi edge / 2 still at the fraction floor).
+      Real force_per_p, dvoid = phi * edge / 2;
       if (prm_.pressure_force == PressureForce::Surface) {
         Real dx, dy;
         porenet::arc_span_2d(net, parts, j, e, dx, dy);
         force_per_p = r_[j] * std::hypot(dx, dy);
       } else {
+        Real gx, gy;
+        porenet::void_gradient_2d(net, parts, j, e, gx, gy);
         force_per_p = std::hypot(gx, gy);
+        if (phi == 1.0) dvoid = force_per_p;
       }
-      // At the fraction floor (overlapping discs, V = phi x the triangle) phi of the triangle's change.
-      const Real edge = std::hypot(x_[d] - x_[b], y_[d] - y_[b]);
-      const Real phi =
-          net.pore_void[i] <= net.params.min_void_fraction * net.pore_cell[i] ? net.params.min_void_fraction : 1.0;
-      // (The arc force kept its estimate of before 2026-11-28: the triangle's change, edge / 2.)
-      const Real dvoid =
-          prm_.pressure_force == PressureForce::Surface || phi < 1 ? phi * edge / 2 : std::hypot(gx, gy);
       sum += K[static_cast<std::size_t>(i)] * h * force_per_p * t * dvoid / net.pore_void[i];
     }
     k[static_cast<std::size_t>(j)] = sum;

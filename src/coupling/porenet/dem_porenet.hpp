@@ -25,10 +25,10 @@
 #include <span>
 #include <vector>
 
+#include "coupling/porenet/pressure_force.hpp"
 #include "dem/dem_system.hpp"
 #include "io/checkpoint.hpp"
 #include "porenet/network.hpp"
-#include "coupling/porenet/pressure_force.hpp"
 #include "porenet/remap.hpp"
 #include "porenet/two_phase.hpp"
 
@@ -48,7 +48,6 @@ enum class Drainage : std::uint8_t { Closed = 0, Sides = 1, Hull = 2 };
 // pressure's force (1e-3 for r = 0.5 mm): why 20 MPa of pore pressure left the UCS of the first
 // sweep unchanged (docs/saturated.md).
 enum class ForceHeight : std::uint8_t { Thickness = 0, Diameter = 1 };
-
 
 struct PorenetCouplingParams {
   porenet::NetworkParams network;

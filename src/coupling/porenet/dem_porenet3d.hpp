@@ -25,8 +25,8 @@
 #include <memory>
 #include <vector>
 
-#include "dem/dem_system.hpp"
 #include "coupling/porenet/pressure_force.hpp"
+#include "dem/dem_system.hpp"
 #include "io/checkpoint.hpp"
 #include "porenet/network.hpp"
 #include "porenet/two_phase.hpp"
@@ -93,7 +93,8 @@ class DemPorenet3D {
   Vec3 fluid_force(Index k) const { return {fx_[k], fy_[k], fz_[k]}; }
   // Stiffness the pore fluid adds to each sphere [N/m], for the DEM's critical step (as
   // DemPorenetCoupling::fluid_stiffness in 2D): tetrahedron i pushes on sphere j with p_i a_ij
-  // (a_ij = porenet::unit_patch_force_3d; with the void-gradient force a_ij = g_ij) and moving j by dx changes V_i by g_ij.dx (void_gradient), so
+  // (a_ij = porenet::unit_patch_force_3d; with the void-gradient force a_ij = g_ij) and moving j by dx
+  // changes V_i by g_ij.dx (void_gradient), so
   // pore i adds K_i a_ij g_ij^T / V_i to j's stiffness; k_j = sum_i K_i |a_ij| |g_ij| / V_i bounds its
   // largest eigenvalue. K_i the mixture's modulus; pores at a prescribed pressure add none; one at
   // the fraction floor (overlapping spheres, V = phi V_tet) phi of the tetrahedron's change. A pore held

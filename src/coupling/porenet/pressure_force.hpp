@@ -17,4 +17,7 @@ namespace ff::coupling {
 // net force on an interior grain at uniform pressure.
 enum class PressureForce : std::uint8_t { VoidGradient = 0, Surface = 1 };
 
+// The scenario's spelling (fluid.pressure_forces) and summary.json's.
+inline const char* name(PressureForce f) { return f == PressureForce::Surface ? "surface" : "void_gradient"; }
+
 }  // namespace ff::coupling

@@ -136,6 +136,13 @@ porenet::TwoPhaseParams fluid_params(const Config& cfg) {
   return f;
 }
 
+// fluid.pressure_forces; auto: the void gradient in 2D, the surface (patches) in 3D.
+coupling::PressureForce pressure_force(const Config& cfg, bool dim3) {
+  const std::string& v = cfg.string("fluid.pressure_forces");
+  if (v == "auto") return dim3 ? coupling::PressureForce::Surface : coupling::PressureForce::VoidGradient;
+  return v == "surface" ? coupling::PressureForce::Surface : coupling::PressureForce::VoidGradient;
+}
+
 coupling::PorenetCouplingParams coupling_params(const Config& cfg) {
   coupling::PorenetCouplingParams p;
   p.fluid = fluid_params(cfg);
@@ -152,8 +159,7 @@ coupling::PorenetCouplingParams coupling_params(const Config& cfg) {
   const std::string& h = cfg.string("fluid.force_height");
   const bool diameter = h == "diameter" || (h == "auto" && cfg.string("dem.contact_law") == dem::CohesiveContact::name);
   p.force_height = diameter ? coupling::ForceHeight::Diameter : coupling::ForceHeight::Thickness;
-  p.pressure_force = cfg.string("fluid.pressure_forces") == "surface" ? coupling::PressureForce::Surface
-                                                                       : coupling::PressureForce::VoidGradient;
+  p.pressure_force = pressure_force(cfg, false);
   p.remap = cfg.string("fluid.remap") == "mass" ? porenet::RemapConserve::Mass : porenet::RemapConserve::Pressure;
   return p;
 }
@@ -170,8 +176,7 @@ coupling::Porenet3DParams params_3d(const Config& cfg) {
   p.implicit = cfg.string("fluid.flow_scheme") != "explicit";
   p.flow_every = cfg.integer("fluid.flow_every");
   p.drained = false;  // the lateral hull pores only: set by SaturatedUcsRun's on_network
-  p.pressure_force = cfg.string("fluid.pressure_forces") == "void_gradient" ? coupling::PressureForce::VoidGradient
-                                                                             : coupling::PressureForce::Surface;
+  p.pressure_force = pressure_force(cfg, true);
   return p;
 }
 
@@ -429,7 +434,7 @@ class SaturatedUcsRun final : public UcsRun {
     if (fluid_.dim3()) {
       const auto& c = fluid_.c3();
       f["flow_scheme"] = c.params().implicit ? "implicit" : "explicit";
-      f["pressure_forces"] = c.params().pressure_force == coupling::PressureForce::Surface ? "surface" : "void_gradient";
+      f["pressure_forces"] = coupling::name(c.params().pressure_force);
       f["flow_steps"] = c.stats().flow_steps;
       f["flow_every_last"] = c.stats().flow_every;
       f["throats"] = fluid_.network().n_channels();
@@ -450,7 +455,7 @@ class SaturatedUcsRun final : public UcsRun {
       for (Real r : sys.particles.radius) rm += r;
       rm /= static_cast<Real>(sys.particles.size());
       f["force_height"] = layer ? "diameter" : "thickness";
-      f["pressure_forces"] = fluid_.c2().params().pressure_force == coupling::PressureForce::Surface ? "surface" : "void_gradient";
+      f["pressure_forces"] = coupling::name(fluid_.c2().params().pressure_force);
       f["remap"] = fluid_.c2().params().remap == porenet::RemapConserve::Mass ? "mass" : "pressure";
       f["remap_mass_change_kg_per_m"] = {{"liquid", st.remap_liquid_change},
                                          {"gas", st.remap_gas_change},
