@@ -104,6 +104,8 @@ RunStatus resume_in_process(const fs::path& dir, const InProcessRun& run) {
   opt.max_wall_s = run.max_wall_s;
   opt.abort_file = dir / "ABORT";
   opt.progress_interval_s = run.quiet ? 0 : l->config.real("output.progress_interval");
+  std::error_code ec;
+  fs::remove(opt.abort_file, ec);  // the request that stopped it, as `fracflow resume` does
   const ThreadsAndQuiet scoped(opt.threads, run.quiet);
   return l->driver->run(l->config, opt);
 }

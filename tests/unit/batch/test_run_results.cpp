@@ -226,7 +226,7 @@ TEST(RunResults, CalibrationRefusesARunWithoutPeakOrFit) {
 }
 
 // batch::run_in_process stopped by max_steps leaves a checkpoint; batch::resume_in_process continues
-// it (as `fracflow resume`) to the same series.csv as an uninterrupted run, byte for byte
+// it (as `fracflow resume`, an old ABORT request removed) to the same series.csv as an uninterrupted run, byte for byte
 // (validate-saturated --resume continues interrupted runs this way).
 TEST(RunResults, InProcessRunStoppedAndResumedEqualsTheWholeRun) {
   const std::vector<std::string> tiny = {"sample.diameter=5e-3", "sample.height=8e-3", "sample.porosity=0.45",
@@ -252,6 +252,7 @@ TEST(RunResults, InProcessRunStoppedAndResumedEqualsTheWholeRun) {
   ASSERT_TRUE(fs::exists(parts / "checkpoint"));
   EXPECT_FALSE(fs::exists(parts / "summary.json"));
   r.max_steps = 0;
+  std::ofstream(parts / "ABORT") << "stop\n";  // a stop request of the earlier run is not repeated
   ASSERT_EQ(ff::batch::resume_in_process(parts, r), ff::RunStatus::Finished);
   std::ifstream a(whole / "series.csv"), b(parts / "series.csv");
   std::stringstream sa, sb;
