@@ -11,10 +11,16 @@
 // --quick: 200^2 with about 400 disks and 32^3 with about 700 spheres, a few steps (seconds).
 // Motion: the block turns as a rigid body about the borehole axis (bonds unstrained), with the rim
 // moving `slow` 0.002 cells per LBM step (bonded rock under load: few cells change per step) or
-// `fast` 0.05 cells per step (every particle's rim cells change within a few steps). The DEM
-// runs its full step (contacts, bonds, integration) n_sub times per LBM step.
+// `fast` 0.05 cells per step (every particle's rim cells change within a few steps), both with
+// moving walls (the particles' velocities in the fluid's walls, the set handed over every step); or
+// `creep`, the hydrofrac LBM fluid's own mode (drivers/hydrofrac/lbm_load.cpp): quasi-static walls
+// (zero wall velocities), the rim moving 1e-4 cells per step (the rock's creep measured there), the
+// set handed to the fluid again only once a particle has moved 0.02 cells (CouplerSettings::
+// wall_motion = 0, set_refresh = 0.02). The DEM runs its full step (contacts, bonds, integration)
+// n_sub times per LBM step.
 //
-// The split (ms per coupled step, median over blocks):
+// The split (ms per coupled step, median over blocks; creep: the mean over all blocks, so that the
+// rebuilds every ~200 steps count):
 //   LBM   the stream-collide of the same lattice with no particles (a second solver, its blocks
 //         interleaved with the coupled ones, so a noisy period hits both alike);
 //   DEM   the n_sub DEM steps (DemLbmCoupler::times.dem);
@@ -32,7 +38,7 @@
 // gave bit-identical results.
 //
 // Usage: coupled [--quick] [--threads 1,2] [--steps N] [--block N] [--dim 2|3] [--scheme psm|psm-r|stair|interp]
-//                [--motion slow|fast] [--sub N]
+//                [--motion slow|fast|creep] [--sub N]
 #include <fmt/core.h>
 #include <omp.h>
 
@@ -59,6 +65,12 @@ namespace {
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
+double mean(const std::vector<double>& v) {
+  double s = 0;
+  for (const double x : v) s += x;
+  return v.empty() ? 0 : s / double(v.size());
+}
+
 double median(std::vector<double> v) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
@@ -77,7 +89,7 @@ struct Options {
 [[noreturn]] void usage(const std::string& what) {
   fmt::print(stderr,
              "coupled: {}\nUsage: coupled [--quick] [--threads 1,2] [--steps N] [--block N] [--dim 2|3]\n"
-             "               [--scheme psm|psm-r|stair|interp] [--motion slow|fast] [--sub N]\n",
+             "               [--scheme psm|psm-r|stair|interp] [--motion slow|fast|creep] [--sub N]\n",
              what);
   std::exit(2);
 }
@@ -225,13 +237,16 @@ Result run_config(const Rock& rock, const std::string& scheme, const std::string
   lbm::Solver<L, double> fluid(g, st), bare(g, st);
   for (auto* f : {&fluid, &bare}) {
     f->finalize();
-    f->initialize([](int, int, int, double& rho, Vec3& u) {
+    // A gentle shear flow, so that the fluid moves (creep's walls are at rest) and the hash checks
+    // more than a fluid at rest.
+    f->initialize([n](int x, int y, int, double& rho, Vec3& u) {
       rho = 1;
-      u = Vec3::Zero();
+      u = 1e-3 * Vec3(std::sin(2 * M_PI * y / n), std::sin(2 * M_PI * x / n), 0);
     });
   }
   // Rigid rotation about the borehole axis: rim speed U cells per LBM step.
-  const double U = motion == "fast" ? 0.05 : 0.002;
+  const bool creep = motion == "creep";
+  const double U = motion == "fast" ? 0.05 : creep ? 1e-4 : 0.002;
   double rim = 0;
   for (const Vec3& x : dem.particles.pos) rim = std::max(rim, std::hypot(x.x() / dx - rock.centre.x(), x.y() / dx - rock.centre.y()));
   const double w = U / rim / sc.dt();  // rad/s
@@ -242,6 +257,10 @@ Result run_config(const Rock& rock, const std::string& scheme, const std::string
   }
   coupling::CouplerSettings cs;
   cs.buoyancy = false;
+  if (creep) {
+    cs.wall_motion = 0;
+    cs.set_refresh = kPsmRefresh;
+  }
   coupling::DemLbmCoupler<L, double> cp(dem, fluid, sc, cs);
   for (int k = 0; k < 2; ++k) {  // warm-up: the first set covers every cell
     cp.step();
@@ -255,9 +274,10 @@ Result run_config(const Rock& rock, const std::string& scheme, const std::string
     const long nb = std::min(block, steps - done);
     const coupling::CouplerTimes t0 = cp.times;
     for (long k = 0; k < nb; ++k) {
+      const long h0 = cp.handovers();
       cp.step();
       if (const auto* mb = fluid.moving_boundary()) {
-        changed += double(mb->stats().covered + mb->stats().uncovered);
+        if (cp.handovers() > h0) changed += double(mb->stats().covered + mb->stats().uncovered);
         cells += double(mb->num_cells());
         links += double(mb->num_links());
       } else if (const auto* ps = fluid.psm()) {
@@ -275,11 +295,12 @@ Result run_config(const Rock& rock, const std::string& scheme, const std::string
     vd.push_back((cp.times.dem - t0.dem) / double(nb));
     done += nb;
   }
-  r.lbm = median(vl);
-  r.lbm_part = median(vp);
-  r.set = median(vs);
-  r.coup = median(vc);
-  r.dem = median(vd);
+  auto pick = [&](const std::vector<double>& v) { return creep ? mean(v) : median(v); };
+  r.lbm = pick(vl);
+  r.lbm_part = pick(vp);
+  r.set = pick(vs);
+  r.coup = pick(vc);
+  r.dem = pick(vd);
   r.cells = cells / double(steps);
   r.changed = changed / double(steps);
   r.links = links / double(steps);
@@ -321,11 +342,11 @@ int main(int argc, char** argv) {
         usage("--scheme: psm, psm-r, stair or interp");
     } else if (a == "--motion") {
       o.motion = value();
-      if (o.motion != "slow" && o.motion != "fast") usage("--motion: slow or fast");
+      if (o.motion != "slow" && o.motion != "fast" && o.motion != "creep") usage("--motion: slow, fast or creep");
     } else if (a == "-h" || a == "--help") {
       fmt::print(
           "Usage: coupled [--quick] [--threads 1,2] [--steps N] [--block N] [--dim 2|3]\n"
-          "               [--scheme psm|psm-r|stair|interp] [--motion slow|fast] [--sub N]\n"
+          "               [--scheme psm|psm-r|stair|interp] [--motion slow|fast|creep] [--sub N]\n"
           "Times the coupled DEM-LBM step of a bonded block with a borehole (2D: 1000^2 D2Q9, ~10,000 disks;\n"
           "3D: 96^3 D3Q19, ~18,500 spheres; --quick: small lattices) for each particle scheme, split into\n"
           "LBM (the same lattice without particles), coup (everything the particles add), set (its part\n"
@@ -336,10 +357,12 @@ int main(int argc, char** argv) {
       usage("unknown option " + a);
     }
   }
-  const long steps = o.steps ? o.steps : (o.quick ? 4 : 20);
-  const long block = o.block ? o.block : (o.quick ? 2 : 5);
-  fmt::print("coupled DEM-LBM step, ms per coupled step (median of blocks of {} steps, {} steps per row){}\n", block,
-             steps, o.quick ? ", --quick lattices" : "");
+  // creep re-hands its set every ~200 steps: its rows run long enough to include rebuilds.
+  auto steps_of = [&](const std::string& m) { return o.steps ? o.steps : m == "creep" ? (o.quick ? 8 : 400) : (o.quick ? 4 : 20); };
+  auto block_of = [&](const std::string& m) { return o.block ? o.block : m == "creep" ? (o.quick ? 4 : 50) : (o.quick ? 2 : 5); };
+  fmt::print("coupled DEM-LBM step, ms per coupled step (median of blocks of {} steps, {} steps per row; creep: mean of "
+             "blocks of {}, {} steps){}\n",
+             block_of("slow"), steps_of("slow"), block_of("creep"), steps_of("creep"), o.quick ? ", --quick lattices" : "");
   fmt::print("coup = coupler work + (LBM step with particles - LBM step without); c/L = coup / LBM (target <= 1)\n");
   for (int dim : {2, 3}) {
     if (o.dim && dim != o.dim) continue;
@@ -353,10 +376,11 @@ int main(int argc, char** argv) {
                "links", "hash", "same");
     for (const std::string scheme : {"psm", "psm-r", "stair", "interp"}) {
       if (!o.scheme.empty() && scheme != o.scheme) continue;
-      for (const std::string motion : {"slow", "fast"}) {
+      for (const std::string motion : {"slow", "fast", "creep"}) {
         if (!o.motion.empty() && motion != o.motion) continue;
         std::uint64_t first = 0;
         for (std::size_t ti = 0; ti < o.threads.size(); ++ti) {
+          const long steps = steps_of(motion), block = block_of(motion);
           const Result r = dim == 2 ? run_config<lbm::D2Q9>(rock, scheme, motion, o.threads[ti], o, steps, block)
                                     : run_config<lbm::D3Q19>(rock, scheme, motion, o.threads[ti], o, steps, block);
           if (ti == 0) first = r.hash;

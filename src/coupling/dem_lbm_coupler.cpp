@@ -61,6 +61,12 @@ template <class L, class T>
 DemLbmCoupler<L, T>::DemLbmCoupler(dem::DemSystem& dem, lbm::Solver<L, T>& fluid, const FluidScales& scales,
                                    const CouplerSettings& s)
     : dem_(dem), fluid_(fluid), scales_(scales), cs_(s), dx_(scales.units.dx()) {
+  if (!(s.wall_motion >= 0 && s.wall_motion <= 1) || !(s.set_refresh >= 0 && s.set_refresh < 1))
+    throw InputError(fmt::format("coupling: wall_motion {} must lie in [0, 1] and set_refresh {} in [0, 1) cells",
+                                 s.wall_motion, s.set_refresh));
+  if (s.set_refresh > 0 && s.wall_motion != 0)
+    throw InputError("coupling: set_refresh > 0 keeps the particles' velocities of the last hand-over for many steps; "
+                     "it needs quasi-static walls (wall_motion = 0)");
   if (dem.settings.dim != L::D)
     throw InputError(fmt::format("coupling: the DEM is {}D but the lattice {} is {}D", dem.settings.dim, L::name, L::D));
   if (std::abs(fluid.settings().tau - scales.units.tau()) > 1e-12 * scales.units.tau())
@@ -141,7 +147,16 @@ bool DemLbmCoupler<L, T>::dry(const Vec3& xl) const {
 
 template <class L, class T>
 void DemLbmCoupler<L, T>::build_set() {
-  fill_particle_set(dem_.particles, cs_.origin, scales_.units, L::D, set_);
+  fill_particle_set(dem_.particles, cs_.origin, scales_.units, L::D, set_, cs_.wall_motion);
+}
+
+template <class L, class T>
+bool DemLbmCoupler<L, T>::set_stale() const {
+  if (!(cs_.set_refresh > 0) || handed_.size() != set_.size()) return true;
+  const double lim = cs_.set_refresh * cs_.set_refresh;
+  for (std::size_t i = 0; i < set_.size(); ++i)
+    if (set_.radius[i] != handed_r_[i] || (set_.position[i] - handed_[i]).squaredNorm() > lim) return true;
+  return false;
 }
 
 template <class L, class T>
@@ -212,7 +227,14 @@ void DemLbmCoupler<L, T>::step(bool sample_fluid) {
       has_dry_[i] = d;
       any_dry = any_dry || d;
     }
-  fluid_.set_particles(set_);
+  if (set_stale()) {
+    fluid_.set_particles(set_);
+    ++handovers_;
+    if (cs_.set_refresh > 0) {
+      handed_ = set_.position;
+      handed_r_ = set_.radius;
+    }
+  }
   times.coupling += seconds_since(t0);
   t0 = Clock::now();
   fluid_.step(sample_fluid || any_dry);

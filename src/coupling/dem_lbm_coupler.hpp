@@ -40,6 +40,14 @@ struct CouplerSettings {
   // Surface points of the dry-side pressure: 2D: this many angles; 3D: quadrature / 8 Gauss-Legendre
   // latitudes times twice as many longitudes (64: 8 x 16 = 128 points).
   int quadrature = 64;
+  // The particles' velocities in the fluid's walls: 1 moving walls; 0 quasi-static walls (the
+  // hydrofrac LBM fluid's default, drivers/hydrofrac/lbm_load.cpp).
+  double wall_motion = 1.0;
+  // > 0: the set is handed to the fluid again only once a particle has moved this many cells since
+  // the last hand-over (and the fluid steps with the set it has in between), as the hydrofrac LBM
+  // fluid does with quasi-static walls; 0: every step (needed with moving walls: their velocities
+  // change every step).
+  double set_refresh = 0.0;
 };
 
 struct CouplerTimes {  // wall-clock seconds spent in each part of step()
@@ -58,6 +66,7 @@ class DemLbmCoupler {
   void step(bool sample_fluid = false);
 
   long sub_steps() const { return n_sub_; }
+  long handovers() const { return handovers_; }  // steps that handed the set to the fluid
   double dem_dt() const { return dem_.settings.dt; }
   double dt() const { return scales_.dt(); }
   const FluidScales& scales() const { return scales_; }
@@ -78,6 +87,7 @@ class DemLbmCoupler {
 
  private:
   void build_set();
+  bool set_stale() const;  // a particle moved set_refresh cells since the last hand-over
   void pressure_loads();
   void resize(std::size_t n);
 
@@ -87,7 +97,10 @@ class DemLbmCoupler {
   CouplerSettings cs_;
   double dx_;
   long n_sub_ = 1;
+  long handovers_ = 0;
   lbm::ParticleSet set_;
+  std::vector<Vec3> handed_;  // positions of the set last handed to the fluid (set_refresh > 0)
+  std::vector<double> handed_r_;
   std::vector<char> has_dry_;  // per particle: a surface point lies in a dry cell
   // Per particle: no dry cell within reach of its surface points while it stays within kDryMove
   // (per axis) of dry_x_ (lattice units; the lattice's geometry is fixed once the coupler exists).

@@ -401,3 +401,62 @@ TEST(Coupler, PressureDifferenceAcrossParticleWallInWalledChannelLoadsTheDisks) 
   }
   EXPECT_GT(s.back()[2], 0.2 * s.front()[2]) << "the difference is held";
 }
+
+// Quasi-static walls with a set refresh (CouplerSettings::wall_motion = 0, set_refresh; the
+// hydrofrac LBM fluid's mode, benchmarks/coupled --motion creep): the fluid sees the particle at
+// rest, and gets its set again exactly when the particle has moved more than set_refresh cells since
+// the last hand-over (checked step by step against the set's positions); settings out of range are
+// input errors.
+TEST(Coupler, QuasiStaticWallsHandTheSetOverAfterTheRefreshDistance) {
+  FluidSpec fs;
+  fs.density = 1000;
+  fs.viscosity = 1e-3;
+  fs.dx = 1e-3;
+  fs.tau = 0.7;
+  const FluidScales sc = derive_scales(fs);
+  auto fluid = make_fluid<lbm::D2Q9>(sc, 40, 30, 1, {true, true, true});
+  fluid.finalize();
+  fluid.initialize([](int, int, int, double& rho, Vec3& u) {
+    rho = 1;
+    u = Vec3::Zero();
+  });
+  auto dem = free_particles(2, 1e7);  // heavy: the fluid hardly slows it
+  const double U = 0.007 * sc.units.velocity_factor();  // 0.007 cells per LBM step
+  add_particle(dem, Vec3(12.3e-3, 15.1e-3, 0), 4e-3, Vec3(U, 0.4 * U, 0), Vec3(0, 0, 3));
+  dem.settings.dt = 0.5 * sc.dt();
+  dem.initialise();
+  CouplerSettings cs;
+  cs.origin = Vec3::Constant(0.5e-3);
+  cs.buoyancy = false;
+  cs.wall_motion = 0;
+  cs.set_refresh = 0.02;
+  DemLbmCoupler<lbm::D2Q9, double> c(dem, fluid, sc, cs);
+  c.step();
+  ASSERT_EQ(c.handovers(), 1);
+  Vec3 handed = c.particle_set().position[0];
+  int handovers = 1;
+  for (int t = 0; t < 60; ++t) {
+    const long h0 = c.handovers();
+    c.step();
+    const Vec3 x = c.particle_set().position[0];  // the set built at the start of the step
+    const bool moved = (x - handed).norm() > 0.02;
+    EXPECT_EQ(c.handovers() - h0, moved ? 1 : 0) << "step " << t << ", moved " << (x - handed).norm();
+    if (c.handovers() > h0) {
+      handed = x;
+      ++handovers;
+    }
+    EXPECT_EQ(c.particle_set().velocity[0], Vec3::Zero());
+    EXPECT_EQ(c.particle_set().omega[0], Vec3::Zero());
+  }
+  // 60 steps at 0.0075 cells a step: a hand-over every third step.
+  EXPECT_GE(handovers, 15);
+  EXPECT_LE(handovers, 25);
+  std::printf("%d hand-overs in 61 steps\n", handovers);
+  for (const auto& [motion, refresh] : {std::pair{1.0, 0.02}, std::pair{-0.5, 0.0}, std::pair{0.0, 1.5}}) {
+    CouplerSettings bad = cs;
+    bad.wall_motion = motion;
+    bad.set_refresh = refresh;
+    EXPECT_THROW((DemLbmCoupler<lbm::D2Q9, double>(dem, fluid, sc, bad)), InputError)
+        << "wall_motion " << motion << ", set_refresh " << refresh;
+  }
+}
