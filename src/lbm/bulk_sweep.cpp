@@ -63,7 +63,7 @@ void Solver<L, T>::bulk_sweep(bool odd, bool sample) {
   // Cells covered by particles (lbm/psm.hpp): their spans run the fused PSM kernel.
   Psm<L, T>* psm = psm_ && psm_->active() ? psm_.get() : nullptr;
   const PsmSpanFn<T> fn_psm =
-      psm ? psm_span_kernel<L, T>(settings_.collision, force, sample, settings_.incompressible) : nullptr;
+      psm ? psm_span_kernel<L, T>(settings_.collision, force, sample, settings_.incompressible, psm->moving()) : nullptr;
   const PsmCells<T> cells = psm ? psm->bulk_cells() : PsmCells<T>{};
   // Small lattices run serially: a parallel region costs more than it saves there.
 #pragma omp parallel for schedule(static) if (num_bulk_cells_ > kParallelMinCells)

@@ -114,13 +114,15 @@ void Psm<L, T>::set_particles(const ParticleSet& p) {
 template <class L, class T>
 void Psm<L, T>::take_kinematics(const ParticleSet& p) {
   const std::size_t np = p.size();
-  bool same = true;
+  bool same = true, moving = false;
   for (std::size_t s = 0; s < np; ++s) {
     const Kinematics k = kinematics(p, s);
     same = same && k.v == kin_[s].v && k.w == kin_[s].w;
+    moving = moving || k.v != Vec3::Zero() || k.w != Vec3::Zero();
     kin_[s] = k;
   }
-  if (same) return;  // (quasi-static walls: nothing moves)
+  moving_ = moving;
+  if (same || !moving) return;  // (quasi-static walls: nothing moves; V and S not read)
   const std::int64_t ncell = std::int64_t(cells_.size());
 #pragma omp parallel for schedule(static) if (ncell > 16384)
   for (std::int64_t i = 0; i < ncell; ++i) {
@@ -201,7 +203,11 @@ void Psm<L, T>::build(const ParticleSet& p) {
   fused_spans_.clear();
   // (cells_ and entries_ are overwritten below: resized, not cleared, so that only new elements are built)
   kin_.resize(np);
-  for (std::size_t s = 0; s < np; ++s) kin_[s] = kinematics(p, s);
+  moving_ = false;
+  for (std::size_t s = 0; s < np; ++s) {
+    kin_[s] = kinematics(p, s);
+    moving_ = moving_ || kin_[s].v != Vec3::Zero() || kin_[s].w != Vec3::Zero();
+  }
   // 1. Each particle into the lattice rows (y, z) its reach crosses, in particle order (a counting
   //    sort by row; with the unwrapped y, z for its arms).
   const std::size_t nrows = std::size_t(n[1]) * std::size_t(n[2]);
@@ -351,9 +357,9 @@ void Psm<L, T>::build(const ParticleSet& p) {
     if (c.count == 1) entries_[std::size_t(c.first)].Bs = T(B);  // (most cells: no division)
     else
       for (std::int32_t k = c.first; k < c.first + c.count; ++k) entries_[std::size_t(k)].Bs = T(B * entries_[std::size_t(k)].eps / c.eps);
-    if (!c.boundary) {  // the fused kernel's per-cell B, V and S
+    if (!c.boundary) {  // the fused kernel's per-cell B, V and S (S and V only if something moves)
       cell_B_[std::size_t(c.cell)] = T(B);
-      cell_velocity_sums(c);
+      if (moving_) cell_velocity_sums(c);
     }
   }
   // Spans that run the fused kernel.
@@ -365,6 +371,7 @@ void Psm<L, T>::build(const ParticleSet& p) {
       fused_spans_.push_back(sp);
     }
   }
+  runs_built_ = false;  // (built by the first reduce() that needs them)
   entry_force_.resize(3 * entries_.size());  // every boundary entry is written by its cell's update
   force_.assign(np, Vec3::Zero());
   torque_.assign(np, Vec3::Zero());
@@ -381,6 +388,8 @@ void Psm<L, T>::set_cell_spans(std::vector<std::int32_t> span_of_cell, std::size
   fused_spans_.clear();
   cells_.clear();
   entries_.clear();
+  runs_.clear();
+  runs_built_ = false;
   ref_pos_.clear();  // no fractions to keep: the next set_particles() rebuilds
   ref_radius_.clear();
   span_of_ = std::move(span_of_cell);
@@ -442,8 +451,8 @@ void Psm<L, T>::apply(std::int32_t sl, const T* gpre, T* g, const Relax<T>& r, b
 
 template <class L, class T>
 void Psm<L, T>::reduce(const Vec3& body_force) {
-  // One pass over the covered cells in lattice order, each entry adding to its particle: a fixed
-  // order, the same on any thread count (serial: per particle in parallel, the reads of the cells'
+  // One pass over the covered cells in lattice order (runs_: build_runs), each item adding to its
+  // particle: a fixed order, the same on any thread count (serial: per particle in parallel, the reads of the cells'
   // moments scattered over the lattice cost 3-5 times this pass). Bulk cells:
   // F_s = -B_s sum_q c_q Omega^s_q(u_s) = B_s (rho (u - u_s) - f_body), by the lattice's isotropy
   // (sum_q c_q f^eq_q(rho, w) = rho w; rho u = j + f_body / 2 with j the pre-collision momentum,
@@ -452,16 +461,31 @@ void Psm<L, T>::reduce(const Vec3& body_force) {
   std::fill(force_.begin(), force_.end(), Vec3::Zero());
   std::fill(torque_.begin(), torque_.end(), Vec3::Zero());
   std::fill(wall_force_.begin(), wall_force_.end(), Vec3::Zero());
-  for (const Cell& c : cells_) {
+  // A particle's entries come in runs: its sums are carried in registers over a run and stored at
+  // its end (a chain through memory per entry cost twice the arithmetic).
+  std::int32_t cur = -1;
+  Vec3 F = Vec3::Zero(), M = Vec3::Zero();
+  auto take = [&](std::int32_t s) FF_LBM_LAMBDA_INLINE {
+    if (s == cur) return;
+    if (cur >= 0) {
+      force_[std::size_t(cur)] = F;
+      torque_[std::size_t(cur)] = M;
+    }
+    cur = s;
+    F = force_[std::size_t(s)];
+    M = torque_[std::size_t(s)];
+  };
+  auto cell_force = [&](const Cell& c) FF_LBM_LAMBDA_INLINE {
     if (c.boundary) {
       for (std::int32_t k = c.first; k < c.first + c.count; ++k) {
         const Entry& e = entries_[std::size_t(k)];
         const std::size_t kk = std::size_t(k);
         const Vec3 Fk(entry_force_[3 * kk], entry_force_[3 * kk + 1], entry_force_[3 * kk + 2]);
-        force_[std::size_t(e.particle)] += Fk;
-        torque_[std::size_t(e.particle)] += e.arm.cross(Fk);
+        take(e.particle);
+        F += Fk;
+        M += e.arm.cross(Fk);
       }
-      continue;
+      return;
     }
     const std::size_t x = std::size_t(c.cell);
     const double rho = double(cell_rho_[x]);
@@ -470,10 +494,118 @@ void Psm<L, T>::reduce(const Vec3& body_force) {
       const Entry& e = entries_[std::size_t(k)];
       const Kinematics& m = kin_[std::size_t(e.particle)];
       const Vec3 Fk = double(e.Bs) * (rho * (u - (m.v + m.w.cross(e.arm))) - fb);
-      force_[std::size_t(e.particle)] += Fk;
-      torque_[std::size_t(e.particle)] += e.arm.cross(Fk);
+      take(e.particle);
+      F += Fk;
+      M += e.arm.cross(Fk);
+    }
+  };
+  if (moving_) {
+    // Moving walls hand a new set over every step: each cell's force from its entries (building the
+    // runs below would cost more than they save).
+    for (const Cell& c : cells_) cell_force(c);
+  } else {
+    // Quasi-static walls (u_s = 0) keep a set for many steps: its runs, built once per set.
+    if (!runs_built_) {
+      build_runs();
+      runs_built_ = true;
+    }
+    for (const Run& run : runs_) {
+      if (run.particle < 0) {  // a boundary cell
+        cell_force(cells_[std::size_t(run.slot)]);
+        continue;
+      }
+      const std::size_t x0 = std::size_t(run.cell);
+      if (run.count == 1) {  // F_s = B_s (rho u - f_b)
+        const Vec3 j{double(cell_rho_[x0]) * double(cell_u_[0][x0]), double(cell_rho_[x0]) * double(cell_u_[1][x0]),
+                     L::D == 3 ? double(cell_rho_[x0]) * double(cell_u_[2][x0]) : 0.0};
+        const Vec3 Fk = double(run.Bs) * (j - fb);
+        take(run.particle);
+        F += Fk;
+        M += run.arm.cross(Fk);
+        continue;
+      }
+      // A run of n cells of one particle along x (B_s = B), k = 0 .. n-1, arms a_k = a_0 + k e_x:
+      // the cell forces F_k = B_k (rho_k u_k - f_b) sum to F = J0 - f_b B0, and
+      // sum_k k F_k = J1 - f_b B1 (J_m = sum k^m B rho u, B_m = sum k^m B); the torque
+      // sum_k a_k x F_k = a_0 x F + e_x x sum_k k F_k. A few contiguous sums per run instead of a
+      // force per cell: the cells' B, rho and u are read in order, nothing else per cell.
+      const T* Bp = cell_B_.data() + x0;
+      const T* rp = cell_rho_.data() + x0;
+      const T* up[3] = {cell_u_[0].data() + x0, cell_u_[1].data() + x0, L::D == 3 ? cell_u_[2].data() + x0 : nullptr};
+      double B0 = 0, B1 = 0, J0[3] = {0, 0, 0}, J1[3] = {0, 0, 0};
+      for (std::int32_t k = 0; k < run.count; ++k) {
+        const double b = double(Bp[k]), br = b * double(rp[k]), kk = double(k);
+        B0 += b;
+        B1 += kk * b;
+        for (int a = 0; a < L::D; ++a) {
+          const double j = br * double(up[a][k]);
+          J0[a] += j;
+          J1[a] += kk * j;
+        }
+      }
+      const Vec3 Fr = Vec3(J0[0], J0[1], J0[2]) - fb * B0;
+      const Vec3 F1 = Vec3(J1[0], J1[1], J1[2]) - fb * B1;
+      take(run.particle);
+      F += Fr;
+      M += run.arm.cross(Fr) + Vec3(1, 0, 0).cross(F1);
     }
   }
+  if (cur >= 0) {
+    force_[std::size_t(cur)] = F;
+    torque_[std::size_t(cur)] = M;
+  }
+}
+
+template <class L, class T>
+void Psm<L, T>::build_runs() {
+  // Runs never cross a row: each row's items are counted, then written, in parallel (rows in
+  // lattice order, the same items on any thread count).
+  const std::int64_t nrows = std::int64_t(row_out_.size());
+  auto row_items = [&](std::int64_t row, Run* out) {  // the row's item count; written where out is not null
+    const RowOut& ro = row_out_[std::size_t(row)];
+    std::int64_t n = 0;
+    bool open = false;  // the last item is a run that the next cell may extend
+    std::int32_t run_particle = -1;
+    CellIndex run_next = -1;  // the cell that would extend it
+    for (std::int64_t i = ro.cell_dest; i < ro.cell_dest + ro.cells; ++i) {
+      const Cell& c = cells_[std::size_t(i)];
+      if (c.boundary || c.count > 1) {
+        if (c.boundary) {
+          if (out) out[n] = Run{i, c.cell, 1, -1, Vec3::Zero(), T(0)};
+          ++n;
+        } else {
+          for (std::int32_t k = c.first; k < c.first + c.count; ++k, ++n) {
+            const Entry& e = entries_[std::size_t(k)];
+            if (out) out[n] = Run{i, c.cell, 1, e.particle, e.arm, e.Bs};
+          }
+        }
+        open = false;
+        continue;
+      }
+      const Entry& e = entries_[std::size_t(c.first)];
+      // The next cell in memory of the same particle alone: x + 1 in this row (ghost cells pad every
+      // row, so a run never wraps round a periodic edge, and its arms grow by e_x from cell to cell).
+      if (open && run_particle == e.particle && run_next == c.cell) {
+        if (out) ++out[n - 1].count;
+        ++run_next;
+        continue;
+      }
+      if (out) out[n] = Run{i, c.cell, 1, e.particle, e.arm, e.Bs};
+      ++n;
+      open = true;
+      run_particle = e.particle;
+      run_next = c.cell + 1;
+    }
+    return n;
+  };
+  row_runs_.resize(std::size_t(nrows) + 1);
+  row_runs_[0] = 0;
+#pragma omp parallel for schedule(dynamic, 64) if (cells_.size() > 16384)
+  for (std::int64_t row = 0; row < nrows; ++row) row_runs_[std::size_t(row) + 1] = row_items(row, nullptr);
+  for (std::int64_t row = 0; row < nrows; ++row) row_runs_[std::size_t(row) + 1] += row_runs_[std::size_t(row)];
+  runs_.resize(std::size_t(row_runs_[std::size_t(nrows)]));
+#pragma omp parallel for schedule(dynamic, 64) if (cells_.size() > 16384)
+  for (std::int64_t row = 0; row < nrows; ++row) row_items(row, runs_.data() + row_runs_[std::size_t(row)]);
 }
 
 template <class L, class T>

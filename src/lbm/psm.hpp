@@ -39,9 +39,11 @@
 // reading per cell B, V = sum_s B_s u_s and S = sum_s B_s u_s u_s^T (exact for any number of
 // particles on the cell: f^eq is quadratic in the velocity) and writing the cell's rho and u; spans
 // without covered cells keep the bulk kernel (its speed away from particles). Boundary cells apply
-// the same update inside their own path. Every cell owns its slots (AA pattern), so cells are
-// independent; the particles' forces are summed in one pass over the covered cells in lattice
-// order: results are the same on any thread count.
+// the same update inside their own path; with every particle at rest (quasi-static walls) the
+// kernel reads B alone. Every cell owns its slots (AA pattern), so cells are independent; the
+// particles' forces are summed in one pass over the covered cells in lattice order (with every
+// particle at rest, a particle's consecutive cells along a row as one run: a few contiguous sums of
+// B, rho and u; Psm::reduce): results are the same on any thread count.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -106,7 +108,7 @@ template <class T>
 using PsmSpanFn = void (*)(const Grid&, T*, CellIndex, int, int, int, int, bool, const Relax<T>&, T*, T* const*,
                            const PsmCells<T>&);
 template <class L, class T>
-PsmSpanFn<T> psm_span_kernel(CollisionModel model, bool force, bool moments, bool incomp);
+PsmSpanFn<T> psm_span_kernel(CollisionModel model, bool force, bool moments, bool incomp, bool moving);
 
 template <class L, class T>
 class Psm {
@@ -142,6 +144,9 @@ class Psm {
   // of the bulk kernel.
   bool span_covered(std::int64_t span) const { return span_fused_[std::size_t(span)] != 0; }
   PsmCells<T> bulk_cells();
+  // Some particle moves (nonzero velocity or spin): the fused kernel reads the cells' V and S;
+  // otherwise they are zero, neither kept nor read.
+  bool moving() const { return moving_; }
   // One boundary cell: g holds its post-collision populations, gpre the pre-collision ones.
   void apply(std::int32_t slot, const T* gpre, T* g, const Relax<T>& r, bool force, bool incomp);
   // Per-particle force and torque of the step (one pass over the covered cells in lattice order);
@@ -184,6 +189,7 @@ class Psm {
   double tau_;
   double refresh_ = 0;
   long rebuilds_ = 0;
+  bool moving_ = false;
   std::vector<Vec3> ref_pos_;
   std::vector<double> ref_radius_;
   PsmWeighting weighting_ = PsmWeighting::TauDependent;
@@ -232,6 +238,22 @@ class Psm {
     return {Vec3(p.velocity[s][0], p.velocity[s][1], 0), Vec3(0, 0, p.omega[s][2])};
   }
   std::vector<double> entry_force_;  // 3 per entry of a boundary cell
+  // The covered cells in lattice order as reduce() visits them, each item self-contained (read in
+  // order, no look-up of cells_ and entries_): a run of `count` consecutive bulk cells of one
+  // particle alone (the same row, x ascending; B_s = B read per cell), one particle's entry of a bulk
+  // cell (count 1, B_s here: cells of one particle alone and each particle of a shared cell), or a
+  // boundary cell (particle -1: its entries' forces from apply()).
+  struct Run {
+    std::int64_t slot;       // its first cell in cells_
+    CellIndex cell;          // that cell's lattice index
+    std::int32_t count, particle;
+    Vec3 arm;                // the first cell's arm
+    T Bs;                    // count 1: B_s
+  };
+  std::vector<Run> runs_;
+  bool runs_built_ = false;  // runs_ belong to the current cells (built once a static set is reduced)
+  std::vector<std::int64_t> row_runs_;  // per lattice row, its first item in runs_ (build_runs)
+  void build_runs();
   std::vector<Vec3> force_, torque_, wall_force_;
 };
 

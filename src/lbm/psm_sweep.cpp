@@ -5,7 +5,9 @@
 //   Omega^s_q = g_{-q} - g_q + f^eq_q(rho, u_s) - f^eq_{-q}(rho, u),
 // with B and the covering particles' velocity sums read from Psm's per-cell arrays, and the cell's
 // rho and u written to them (each particle's force follows from those, Psm::reduce). Cells with
-// B = 0 get g* unchanged. One pass per covered cell, whatever the number of particles on it.
+// B = 0 get g* unchanged. One pass per covered cell, whatever the number of particles on it. With
+// every particle at rest (quasi-static walls: the hydrofrac's default) V and S are zero and not read
+// (kMoving false): the pass then reads B alone besides the populations.
 // Compiled like the bulk kernel: one clone per vector width, -ffp-contract=off.
 #include "lbm/psm.hpp"
 #include "lbm/span_slots.hpp"
@@ -30,7 +32,7 @@ namespace {
 // moves). One particle: V = B u_s, S = B u_s u_s^T. rho and u are the collision's own moments (Guo's
 // half force included; rho_0 = 1 in the momentum terms when incompressible), written out for the
 // particles' forces (Psm::reduce). The term costs about one more equilibrium per cell.
-template <class L, class T, CollisionModel M, bool kForce, bool kMoments, bool kIncomp>
+template <class L, class T, CollisionModel M, bool kForce, bool kMoments, bool kIncomp, bool kMoving>
 FF_LBM_INLINE void psm_cells(T* const* p, std::int64_t i0, std::int64_t i1, const Relax<T>& r, const MomentOut<T>& m,
                              const PsmCells<T>& d) {
   constexpr int Q = L::Q, D = L::D;
@@ -47,10 +49,12 @@ FF_LBM_INLINE void psm_cells(T* const* p, std::int64_t i0, std::int64_t i1, cons
     const T rho_u = kIncomp ? T(1) : T(1) + drho;
     const T B = d.B[i], fluid = T(1) - B;
     const bool covered = B != T(0);
-    const T V[3] = {d.V[0][i], d.V[1][i], D == 3 ? d.V[2][i] : T(0)};
+    const T V[3] = {kMoving ? d.V[0][i] : T(0), kMoving ? d.V[1][i] : T(0), kMoving && D == 3 ? d.V[2][i] : T(0)};
     // S: xx, xy, yy (2D); xx, xy, xz, yy, yz, zz (3D)
-    const T Sxx = d.S[0][i], Sxy = d.S[1][i], Syy = D == 3 ? d.S[3][i] : d.S[2][i];
-    const T Sxz = D == 3 ? d.S[2][i] : T(0), Syz = D == 3 ? d.S[4][i] : T(0), Szz = D == 3 ? d.S[5][i] : T(0);
+    const T Sxx = kMoving ? d.S[0][i] : T(0), Sxy = kMoving ? d.S[1][i] : T(0);
+    const T Syy = !kMoving ? T(0) : D == 3 ? d.S[3][i] : d.S[2][i];
+    const T Sxz = kMoving && D == 3 ? d.S[2][i] : T(0), Syz = kMoving && D == 3 ? d.S[4][i] : T(0);
+    const T Szz = kMoving && D == 3 ? d.S[5][i] : T(0);
     const T uu = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
     const T dsq15 = T(1.5) * (((Sxx + Syy) + Szz) - B * uu);
     const T om_0 = -(T(L::w[0]) * rho_u) * dsq15;
@@ -88,7 +92,7 @@ FF_LBM_INLINE void psm_cells(T* const* p, std::int64_t i0, std::int64_t i1, cons
   }
 }
 
-template <class L, class T, CollisionModel M, bool kForce, bool kMoments, bool kIncomp>
+template <class L, class T, CollisionModel M, bool kForce, bool kMoments, bool kIncomp, bool kMoving>
 FF_PSM_SWEEP_CLONES void psm_span(const Grid& g, T* f, CellIndex N, int x0, int y, int z, int n, bool odd,
                                   const Relax<T>& r, T* drho, T* const* u, const PsmCells<T>& d) {
   with_span_slots<L, T>(g, f, N, x0, y, z, n, odd, [&](T* const* p, CellIndex base) FF_LBM_LAMBDA_INLINE {
@@ -111,33 +115,39 @@ FF_PSM_SWEEP_CLONES void psm_span(const Grid& g, T* f, CellIndex N, int x0, int 
     for (; i + kLine <= n; i += kLine) {
       static_for<L::Q>(
           [&](auto q) FF_LBM_LAMBDA_INLINE { __builtin_prefetch(p[q] + i + kPrefetchLines * kLine, 0, 3); });
-      psm_cells<L, T, M, kForce, kMoments, kIncomp>(p, i, i + kLine, rl, m, c);
+      psm_cells<L, T, M, kForce, kMoments, kIncomp, kMoving>(p, i, i + kLine, rl, m, c);
     }
-    psm_cells<L, T, M, kForce, kMoments, kIncomp>(p, i, n, rl, m, c);
+    psm_cells<L, T, M, kForce, kMoments, kIncomp, kMoving>(p, i, n, rl, m, c);
   });
 }
 
-template <class L, class T, CollisionModel M, bool kIncomp>
+template <class L, class T, CollisionModel M, bool kIncomp, bool kMoving>
 PsmSpanFn<T> pick_forcing(bool force, bool moments) {
-  if (force) return moments ? &psm_span<L, T, M, true, true, kIncomp> : &psm_span<L, T, M, true, false, kIncomp>;
-  return moments ? &psm_span<L, T, M, false, true, kIncomp> : &psm_span<L, T, M, false, false, kIncomp>;
+  if (force)
+    return moments ? &psm_span<L, T, M, true, true, kIncomp, kMoving> : &psm_span<L, T, M, true, false, kIncomp, kMoving>;
+  return moments ? &psm_span<L, T, M, false, true, kIncomp, kMoving> : &psm_span<L, T, M, false, false, kIncomp, kMoving>;
+}
+
+template <class L, class T, CollisionModel M, bool kIncomp>
+PsmSpanFn<T> pick_motion(bool force, bool moments, bool moving) {
+  return moving ? pick_forcing<L, T, M, kIncomp, true>(force, moments) : pick_forcing<L, T, M, kIncomp, false>(force, moments);
 }
 
 }  // namespace
 
 template <class L, class T>
-PsmSpanFn<T> psm_span_kernel(CollisionModel model, bool force, bool moments, bool incomp) {
+PsmSpanFn<T> psm_span_kernel(CollisionModel model, bool force, bool moments, bool incomp, bool moving) {
   const bool trt = model == CollisionModel::Trt;
   if (incomp)
-    return trt ? pick_forcing<L, T, CollisionModel::Trt, true>(force, moments)
-               : pick_forcing<L, T, CollisionModel::Bgk, true>(force, moments);
-  return trt ? pick_forcing<L, T, CollisionModel::Trt, false>(force, moments)
-             : pick_forcing<L, T, CollisionModel::Bgk, false>(force, moments);
+    return trt ? pick_motion<L, T, CollisionModel::Trt, true>(force, moments, moving)
+               : pick_motion<L, T, CollisionModel::Bgk, true>(force, moments, moving);
+  return trt ? pick_motion<L, T, CollisionModel::Trt, false>(force, moments, moving)
+             : pick_motion<L, T, CollisionModel::Bgk, false>(force, moments, moving);
 }
 
-template PsmSpanFn<double> psm_span_kernel<D2Q9, double>(CollisionModel, bool, bool, bool);
-template PsmSpanFn<float> psm_span_kernel<D2Q9, float>(CollisionModel, bool, bool, bool);
-template PsmSpanFn<double> psm_span_kernel<D3Q19, double>(CollisionModel, bool, bool, bool);
-template PsmSpanFn<float> psm_span_kernel<D3Q19, float>(CollisionModel, bool, bool, bool);
+template PsmSpanFn<double> psm_span_kernel<D2Q9, double>(CollisionModel, bool, bool, bool, bool);
+template PsmSpanFn<float> psm_span_kernel<D2Q9, float>(CollisionModel, bool, bool, bool, bool);
+template PsmSpanFn<double> psm_span_kernel<D3Q19, double>(CollisionModel, bool, bool, bool, bool);
+template PsmSpanFn<float> psm_span_kernel<D3Q19, float>(CollisionModel, bool, bool, bool, bool);
 
 }  // namespace ff::lbm
