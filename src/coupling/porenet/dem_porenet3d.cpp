@@ -92,7 +92,7 @@ void DemPorenet3D::retriangulate() {
   const auto t0 = std::chrono::steady_clock::now();
   flow_->init(prm_.initial_pressure, prm_.saturation);
   set_boundaries(*flow_, *net_);
-  porenet::remap_two_phase(*old_net, *old_flow, *net_, *flow_);
+  stats_.remap_liquid_change += porenet::remap_two_phase(*old_net, *old_flow, *net_, *flow_, prm_.remap).liquid;
   stats_.t_triangulation += seconds_since(t0);
   ++stats_.retriangulations;
 }

@@ -29,6 +29,7 @@
 #include "dem/dem_system.hpp"
 #include "io/checkpoint.hpp"
 #include "porenet/network.hpp"
+#include "porenet/remap.hpp"
 #include "porenet/two_phase.hpp"
 
 namespace ff::coupling {
@@ -41,6 +42,7 @@ struct Porenet3DParams {
   Real ambient_pressure = 1e5;  // outside the sample [Pa]; forces use p - ambient
   Real saturation = 1.0;        // initial liquid saturation, 0..1
   Real retriangulation_tolerance = 0.25;  // x mean radius (cf. YADE defTolerance)
+  porenet::RemapConserve remap = porenet::RemapConserve::Mass;  // what a retriangulation carries (remap.hpp)
   bool implicit = true;
   Real dt_safety = 0.9;       // explicit: flow sub-step <= safety x stable step
   long max_substeps = 100000;
@@ -73,6 +75,7 @@ struct Porenet3DStats {
   long flow_steps = 0;   // flow steps so far
   long until_choice = 0;  // DEM steps before the stiffness bound is evaluated again (flow_every = 0)
   long stiffness_every = 1;  // N allowed by the fluid's stiffness (flow_every = 0)
+  Real remap_liquid_change = 0;  // sum over retriangulations of new - old liquid mass [kg] (remap = pressure)
 };
 
 class DemPorenet3D {

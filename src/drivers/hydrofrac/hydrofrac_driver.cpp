@@ -102,6 +102,15 @@ void declare(ParamTable& t) {
   t.real("network.retriangulation_tolerance", 0.25, "-",
          "network: retriangulate when a particle moved this many mean radii since the last triangulation")
       .positive();
+  t.string("network.remap", "mass",
+           "network: what a retriangulation carries over: mass (each phase's mass; every pore's pressure then shifts by "
+           "the bulk modulus x the relative change of the network's total void) or pressure (each pore's pressure; the "
+           "mass change is reported in summary.json's network.mass_budget_kg.remap_change; docs/saturated.md)")
+      .one_of({"mass", "pressure"});
+  t.string("network.pressure_forces", "surface",
+           "network: the pores' push on the grains: surface (2D: the pressure on each disc's arc in the pore, seed 004 "
+           "B26-B27; 3D: on each sphere's patches) or void_gradient (p dV/dx: conservative; docs/saturated.md)")
+      .one_of({"surface", "void_gradient"});
   t.integer("network.flow_every", 0, "steps",
             "network: DEM steps per implicit flow step (0: from the fluid-grain stiffness, see docs/hydrofrac.md)")
       .non_negative();
@@ -421,6 +430,9 @@ void HydrofracRun::make_fluid() {
     n.network.max_cond_ratio = cfg.real("network.max_conductance_ratio");
     n.pfv_factor = cfg.real("network.throat_factor");
     n.retriangulation_tolerance = cfg.real("network.retriangulation_tolerance");
+    n.remap = cfg.string("network.remap") == "pressure" ? porenet::RemapConserve::Pressure : porenet::RemapConserve::Mass;
+    n.pressure_force = cfg.string("network.pressure_forces") == "void_gradient" ? coupling::PressureForce::VoidGradient
+                                                                                : coupling::PressureForce::Surface;
     n.flow_every = cfg.integer("network.flow_every");
     const std::string faces = cfg.string("network.faces");
     n.drained_faces = faces == "drained" || (faces == "auto" && sys.settings.dim == 3);
@@ -1020,8 +1032,10 @@ void HydrofracRun::finish(const std::string& stop) {
                      {{"injected", b.injected_mass},
                       {"pore_mass_start", b.pore_mass0},
                       {"pore_mass_end", b.pore_mass},
+                      {"remap_change", b.remap_change},
                       {"residual", b.residual},
-                      {"definition", "(pore_mass_end - pore_mass_start) - injected; rate mode: injected = rho Q t (a "
+                      {"definition", "(pore_mass_end - pore_mass_start) - injected - remap_change (the mass the "
+                                     "retriangulations added: network.remap = pressure); rate mode: injected = rho Q t (a "
                                      "closed block: the residual is the scheme's mass error; drained faces: plus what the "
                                      "hull pores exchanged with the far field); ramp mode: injected is defined as the "
                                      "change (residual 0)"}}},

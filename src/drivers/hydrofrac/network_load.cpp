@@ -38,6 +38,8 @@ coupling::PorenetCouplingParams params_2d(const NetworkSettings& s) {
   p.initial_pressure = p.ambient_pressure = s.pore_pressure;
   p.saturation = 1.0;
   p.retriangulation_tolerance = s.retriangulation_tolerance;
+  p.remap = s.remap;
+  p.pressure_force = s.pressure_force;
   p.shear_forces = s.shear_forces;
   p.cavitation_pressure = 0;  // not used by the staged calls: the forces clamp instead
   p.force_height = coupling::ForceHeight::Thickness;
@@ -53,6 +55,8 @@ coupling::Porenet3DParams params_3d(const NetworkSettings& s) {
   p.initial_pressure = p.ambient_pressure = s.pore_pressure;
   p.saturation = 1.0;
   p.retriangulation_tolerance = s.retriangulation_tolerance;
+  p.remap = s.remap;
+  p.pressure_force = s.pressure_force;
   p.implicit = true;
   p.drained = s.drained_faces;
   return p;
@@ -328,7 +332,7 @@ void NetworkLoad::measure(const dem::DemSystem& sys) {
   st_.volume = v;
   st_.pressure = pv / v - s_.pore_pressure;
   st_.mass = total_mass();
-  if (!s_.rate_mode) st_.injected_mass = st_.mass - st_.mass0;
+  if (!s_.rate_mode) st_.injected_mass = st_.mass - st_.mass0 - remap_change();
   st_.wetted = 0;
   if (!(st_.pressure > 0)) return;
   const auto mean_gauge = [&](Index q) {
@@ -355,12 +359,17 @@ FluidState NetworkLoad::state() const {
   return f;
 }
 
+Real NetworkLoad::remap_change() const {
+  return c2_ ? c2_->stats().remap_liquid_change : c3_ ? c3_->stats().remap_liquid_change : 0.0;
+}
+
 NetworkBudget NetworkLoad::budget() const {
   NetworkBudget b;
   b.injected_mass = st_.injected_mass;
   b.pore_mass0 = st_.mass0;
   b.pore_mass = st_.mass;
-  b.residual = (st_.mass - st_.mass0) - st_.injected_mass;
+  b.remap_change = remap_change();
+  b.residual = (st_.mass - st_.mass0) - st_.injected_mass - b.remap_change;
   b.flow_steps = st_.flow_steps;
   b.retriangulations = st_.retriangulations;
   b.max_cg_iterations = st_.max_cg;

@@ -34,6 +34,8 @@
 #include "drivers/hydrofrac/borehole.hpp"
 #include "drivers/hydrofrac/fluid_load.hpp"
 #include "porenet/network.hpp"
+#include "coupling/porenet/pressure_force.hpp"
+#include "porenet/remap.hpp"
 
 namespace ff::coupling {
 class DemPorenetCoupling;
@@ -59,6 +61,13 @@ struct NetworkSettings {
   porenet::NetworkParams network;  // apertures (B1, B2), floors; thickness 1 m
   Real pfv_factor = 1.0;           // 3D throat conductance factor
   Real retriangulation_tolerance = 0.25;  // x mean radius
+  // What a retriangulation carries over (porenet/remap.hpp): each phase's mass (the pressures then
+  // shift by K x the change of the network's total void) or the pores' pressures (the mass change
+  // reported: NetworkBudget::remap_change).
+  porenet::RemapConserve remap = porenet::RemapConserve::Mass;
+  // The pores' push on the grains: the surface (2D: arcs, B26-B27; 3D: patches) or the gradient of
+  // the pores' void (conservative: coupling/porenet/pressure_force.hpp).
+  coupling::PressureForce pressure_force = coupling::PressureForce::Surface;
   bool shear_forces = true;               // 2D: channel shear B25/B28
   bool drained_faces = true;              // network.faces = "drained": hull pores held at p0
   long flow_every = 0;                    // DEM steps per flow step; 0: from the fluid-grain stiffness
@@ -82,7 +91,8 @@ struct NetworkInfo {
 struct NetworkBudget {
   Real injected_mass = 0;    // rate: integral of rho_ref Q dt; ramp: = the mass change [kg]
   Real pore_mass0 = 0, pore_mass = 0;  // fluid in all pores at the start and now [kg]
-  Real residual = 0;         // (pore_mass - pore_mass0) - injected_mass [kg]
+  Real remap_change = 0;     // mass the retriangulations added (network.remap = pressure; 0 with mass) [kg]
+  Real residual = 0;         // (pore_mass - pore_mass0) - injected_mass - remap_change [kg]
   long flow_steps = 0, retriangulations = 0;
   int max_cg_iterations = 0, max_substeps = 0;
   long cavitations = 0;      // pore-steps that cavitated
@@ -126,6 +136,7 @@ class NetworkLoad final : public FluidLoad {
   };
   porenet::TwoPhaseFlow& flow();
   const porenet::TwoPhaseFlow& flow() const;
+  Real remap_change() const;  // liquid mass the retriangulations added so far [kg]
   void make_coupling();
   void find_hole_pores(const porenet::Network2D& net);
   void drain_faces(porenet::TwoPhaseFlow& f, const porenet::Network2D& net) const;

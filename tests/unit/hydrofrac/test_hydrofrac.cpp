@@ -275,7 +275,9 @@ TEST(Hydrofrac, CheckRefusesBadInputNamingTheKey) {
                         Case{"injection.fluid=\"lbm\"", "fluid.tau"}, Case{"measure.radii=[1.1]", "measure.radii"},
                         Case{"borehole.perforation_length=8e-3", "borehole.perforation_length"},
                         Case{"dfn.file=\"missing.csv\"", "dfn.file"},
-                        Case{"dfn.count=3 --set dfn.length_max=1e-3", "dfn.length_max"}}) {
+                        Case{"dfn.count=3 --set dfn.length_max=1e-3", "dfn.length_max"},
+                        Case{"network.remap=\"volume\"", "network.remap"},
+                        Case{"network.pressure_forces=\"arc\"", "network.pressure_forces"}}) {
     const auto r = fracflow("check " + file.string() + " --set " + c.set);
     EXPECT_EQ(r.code, 2) << c.set << "\n" << r.output;
     EXPECT_NE(r.output.find(c.key), std::string::npos) << c.set << "\n" << r.output;

@@ -167,6 +167,22 @@ TEST(HydrofracNetwork, TwoDimensionalBlockBreaksFromTheHole) {
   ASSERT_EQ(d.size(), 3u);
   const double a = j["borehole"]["effective_radius_m"].get<double>();
   for (double x : d) EXPECT_LT(x, a + 4 * 0.6e-3) << "a first crack away from the hole";
+  // network.remap = pressure: the retriangulations carry the pores' pressures (no jump of K x the
+  // total void's change in every pore) and report the mass that adds. Measured 2026-11-28: the same
+  // breakdown (23.18 MPa: it comes before the first retriangulation), 9 retriangulations against 11,
+  // +1.5e-5 kg/m added against 9.1e-3 kg/m injected (0.16 %).
+  const auto jp = run_scenario(file, s / "network_pressure_remap", " --set network.remap=pressure");
+  ASSERT_FALSE(jp["breakdown"]["pressure_Pa"].is_null());
+  EXPECT_NEAR(jp["breakdown"]["pressure_Pa"].get<double>(), pn, 0.02 * pn);
+  const auto& bp = jp["network"]["mass_budget_kg"];
+  const double added = bp["remap_change"].get<double>(), injected = bp["injected"].get<double>();
+  std::printf("pressure remap: breakdown %.2f MPa, %ld retriangulations, remap added %.3g kg/m, injected %.3g kg/m\n",
+              1e-6 * jp["breakdown"]["pressure_Pa"].get<double>(), jp["network"]["retriangulations"].get<long>(), added,
+              injected);
+  EXPECT_GT(jp["network"]["retriangulations"].get<long>(), 0);
+  EXPECT_NE(added, 0.0);
+  EXPECT_LT(std::abs(added), 0.05 * injected);
+  EXPECT_LT(std::abs(j["network"]["mass_budget_kg"]["remap_change"].get<double>()), 1e-12) << "mass remap: no mass added";
 }
 
 // 3. Mass budget (rate mode, the block closed): what was pumped (rho Q t) equals what the pores
