@@ -109,13 +109,15 @@ void declare(ParamTable& t) {
       .one_of({"mass", "pressure"});
   t.string("network.pressure_forces", "surface",
            "network: the pores' push on the grains: surface (2D: the pressure on each disc's arc in the pore, seed 004 "
-           "B26-B27; 3D: on each sphere's patches) or void_gradient (p dV/dx: conservative; docs/saturated.md)")
+           "B26-B27; 3D: on each sphere's patches) or void_gradient (p dV/dx: conservative; use it with "
+           "network.faces = drained: with closed faces the block breaks at its faces, docs/hydrofrac.md)")
       .one_of({"surface", "void_gradient"});
   t.integer("network.flow_every", 0, "steps",
             "network: DEM steps per implicit flow step (0: from the fluid-grain stiffness, see docs/hydrofrac.md)")
       .non_negative();
   t.string("network.faces", "auto",
-           "network: the pores on the block's hull: drained (held at network.pore_pressure, the far field), closed "
+           "network: the pores on the block's hull: drained (held at network.pore_pressure, the far field, with every "
+           "pore within one largest radius of the outermost centres), closed "
            "(undrained) or auto (drained in 3D, closed in 2D). Closed 3D hulls fail: the flat tetrahedra between grains "
            "pressed on a wall reach 0.1-1 GPa as the grains move and break bonds at the faces (docs/hydrofrac.md)")
       .one_of({"auto", "drained", "closed"});
