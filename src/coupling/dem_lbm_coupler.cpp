@@ -152,11 +152,7 @@ void DemLbmCoupler<L, T>::build_set() {
 
 template <class L, class T>
 bool DemLbmCoupler<L, T>::set_stale() const {
-  if (!(cs_.set_refresh > 0) || handed_.size() != set_.size()) return true;
-  const double lim = cs_.set_refresh * cs_.set_refresh;
-  for (std::size_t i = 0; i < set_.size(); ++i)
-    if (set_.radius[i] != handed_r_[i] || (set_.position[i] - handed_[i]).squaredNorm() > lim) return true;
-  return false;
+  return !(cs_.set_refresh > 0) || !lbm::within_refresh(set_, handed_, handed_r_, cs_.set_refresh, L::D);
 }
 
 template <class L, class T>

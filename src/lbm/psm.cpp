@@ -95,20 +95,23 @@ void Psm<L, T>::set_particles(const ParticleSet& p) {
                                    s, p.id.empty() ? s : p.id[s], r, X[0], X[1], X[2]));
   }
   // Fractions kept: every particle within refresh_ cells of where they were computed.
-  if (refresh_ > 0 && !ref_radius_.empty() && ref_radius_.size() == np) {
-    const double lim2 = refresh_ * refresh_;
-    bool keep = true;
-    for (std::size_t s = 0; s < np && keep; ++s) {
-      Vec3 d = p.position[s] - ref_pos_[s];
-      if (D == 2) d[2] = 0;
-      keep = p.radius[s] == ref_radius_[s] && d.squaredNorm() <= lim2;
-    }
-    if (keep) {
-      take_kinematics(p);
-      return;
-    }
+  if (refresh_ > 0 && !ref_radius_.empty() && within_refresh(p, ref_pos_, ref_radius_, refresh_, D)) {
+    take_kinematics(p);
+    return;
   }
   build(p);
+}
+
+bool within_refresh(const ParticleSet& p, const std::vector<Vec3>& positions, const std::vector<double>& radii,
+                    double cells, int dim) {
+  if (positions.size() != p.size() || radii.size() != p.size()) return false;
+  const double lim2 = cells * cells;
+  for (std::size_t s = 0; s < p.size(); ++s) {
+    Vec3 d = p.position[s] - positions[s];
+    if (dim == 2) d[2] = 0;
+    if (p.radius[s] != radii[s] || d.squaredNorm() > lim2) return false;
+  }
+  return true;
 }
 
 template <class L, class T>
@@ -118,7 +121,7 @@ void Psm<L, T>::take_kinematics(const ParticleSet& p) {
   for (std::size_t s = 0; s < np; ++s) {
     const Kinematics k = kinematics(p, s);
     same = same && k.v == kin_[s].v && k.w == kin_[s].w;
-    moving = moving || k.v != Vec3::Zero() || k.w != Vec3::Zero();
+    moving = moving || k.moves();
     kin_[s] = k;
   }
   moving_ = moving;
@@ -206,7 +209,7 @@ void Psm<L, T>::build(const ParticleSet& p) {
   moving_ = false;
   for (std::size_t s = 0; s < np; ++s) {
     kin_[s] = kinematics(p, s);
-    moving_ = moving_ || kin_[s].v != Vec3::Zero() || kin_[s].w != Vec3::Zero();
+    moving_ = moving_ || kin_[s].moves();
   }
   // 1. Each particle into the lattice rows (y, z) its reach crosses, in particle order (a counting
   //    sort by row; with the unwrapped y, z for its arms).

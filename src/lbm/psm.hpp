@@ -72,6 +72,12 @@ struct ParticleSet {
   }
 };
 
+// Every particle of `p` lies within `cells` of `positions` with the radius in `radii` (the same
+// count; z ignored on D2Q9): a set that a refresh distance lets stand (Psm::set_refresh; the
+// coupler's CouplerSettings::set_refresh).
+bool within_refresh(const ParticleSet& p, const std::vector<Vec3>& positions, const std::vector<double>& radii,
+                    double cells, int dim);
+
 // Noble & Torczynski's (1998) two weightings of a cell's solid operator: the tau-dependent
 // B(eps, tau) = eps (tau - 1/2) / ((1 - eps) + (tau - 1/2)) (their preferred one, the default), and the
 // linear B = eps. The tau-dependent one is below eps in partly covered cells: narrow throats resist too
@@ -230,6 +236,7 @@ class Psm {
   std::vector<RowScratch> scratch_;
   struct Kinematics {
     Vec3 v, w;
+    bool moves() const { return v != Vec3::Zero() || w != Vec3::Zero(); }
   };
   std::vector<Kinematics> kin_;
   // Particle s's velocity and angular velocity; disks: (vx, vy, 0) and (0, 0, wz), the rest ignored.

@@ -47,4 +47,14 @@ lbm::Solver<L, double> make_fluid(const FluidScales& sc, int nx, int ny, int nz,
   return lbm::Solver<L, double>(g, st);
 }
 
+// Finalizes the lattice and starts the fluid at rest at lattice density rho everywhere.
+template <class L>
+void start_at_rest(lbm::Solver<L, double>& fluid, double rho = 1) {
+  fluid.finalize();
+  fluid.initialize([rho](int, int, int, double& r, Vec3& u) {
+    r = rho;
+    u = Vec3::Zero();
+  });
+}
+
 }  // namespace ff::coupling::test

@@ -113,11 +113,7 @@ double momentum_drift(int threads, lbm::PsmWeighting w = lbm::PsmWeighting::TauD
   const FluidScales sc = derive_scales(fs);
   const bool d3 = L::D == 3;
   auto fluid = make_fluid<L>(sc, 36, 30, d3 ? 24 : 1, {true, true, true}, w);
-  fluid.finalize();
-  fluid.initialize([](int, int, int, double& rho, Vec3& u) {
-    rho = 1;
-    u = Vec3::Zero();
-  });
+  start_at_rest(fluid);
   auto dem = free_particles(L::D, 1500);
   const double z = d3 ? 12e-3 : 0;
   const double U = 0.05 * sc.units.velocity_factor();  // lattice speed 0.05
@@ -196,11 +192,7 @@ std::pair<Vec3, double> dry_wall_load(double p0, double delta, double d, int thr
   const int obj = fluid.add_object("dry rock", lbm::WallScheme::HalfwayBounceBack, Vec3::Zero());
   for (int y = 0; y < ny; ++y)
     for (int x = xd; x < nx; ++x) fluid.set_solid(x, y, 0, obj);
-  fluid.finalize();
-  fluid.initialize([&](int, int, int, double& rho, Vec3& u) {
-    rho = 1 + delta;
-    u = Vec3::Zero();
-  });
+  start_at_rest(fluid, 1 + delta);
   auto dem = free_particles(2, 2600);
   const double dx = fs.dx;
   for (int k = 0; k < 4; ++k)  // touching disks, 2r apart, away from the channel walls
@@ -256,11 +248,7 @@ TEST(Coupler, ImmersedParticleFeelsNoBackgroundPressure) {
   fs.background_pressure = 3e7;
   const FluidScales sc = derive_scales(fs);
   auto fluid = make_fluid<lbm::D3Q19>(sc, 20, 20, 20, {true, true, true});
-  fluid.finalize();
-  fluid.initialize([](int, int, int, double& rho, Vec3& u) {
-    rho = 1.002;
-    u = Vec3::Zero();
-  });
+  start_at_rest(fluid, 1.002);
   auto dem = free_particles(3, 2600);
   add_particle(dem, Vec3(9.3e-3, 10.1e-3, 10.7e-3), 4e-3);
   dem.settings.dt = sc.dt();
@@ -284,11 +272,7 @@ TEST(Coupler, OneAndTwoThreadsIdentical) {
     fs.tau = 0.7;
     const FluidScales sc = derive_scales(fs);
     auto fluid = make_fluid<lbm::D3Q19>(sc, 64, 64, 24, {true, true, true});  // enough cells for two threads
-    fluid.finalize();
-    fluid.initialize([](int, int, int, double& rho, Vec3& u) {
-      rho = 1;
-      u = Vec3::Zero();
-    });
+    start_at_rest(fluid);
     auto dem = free_particles(3, 1500);
     dem.settings.gravity = Vec3(0, -9.81, 0);
     add_particle(dem, Vec3(20.3e-3, 30.1e-3, 12e-3), 5e-3);
@@ -415,11 +399,7 @@ TEST(Coupler, QuasiStaticWallsHandTheSetOverAfterTheRefreshDistance) {
   fs.tau = 0.7;
   const FluidScales sc = derive_scales(fs);
   auto fluid = make_fluid<lbm::D2Q9>(sc, 40, 30, 1, {true, true, true});
-  fluid.finalize();
-  fluid.initialize([](int, int, int, double& rho, Vec3& u) {
-    rho = 1;
-    u = Vec3::Zero();
-  });
+  start_at_rest(fluid);
   auto dem = free_particles(2, 1e7);  // heavy: the fluid hardly slows it
   const double U = 0.007 * sc.units.velocity_factor();  // 0.007 cells per LBM step
   add_particle(dem, Vec3(12.3e-3, 15.1e-3, 0), 4e-3, Vec3(U, 0.4 * U, 0), Vec3(0, 0, 3));

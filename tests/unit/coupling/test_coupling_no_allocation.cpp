@@ -47,11 +47,7 @@ TEST(CouplerNoAllocation, StepAllocatesNothing) {
   const int obj = fluid.add_object("dry", lbm::WallScheme::HalfwayBounceBack, Vec3::Zero());
   for (int z = 0; z < 24; ++z)
     for (int y = 0; y < 24; ++y) fluid.set_solid(21, y, z, obj);
-  fluid.finalize();
-  fluid.initialize([](int, int, int, double& rho, Vec3& u) {
-    rho = 1;
-    u = Vec3::Zero();
-  });
+  start_at_rest(fluid);
   auto dem = free_particles(3, 3000);
   dem.settings.gravity = Vec3(0, 0, -30);
   add_particle(dem, Vec3(8.5e-3, 12e-3, 14e-3), 4e-3, Vec3(0.3, 0, 0));
