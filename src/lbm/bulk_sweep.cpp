@@ -8,6 +8,9 @@
 // operations per cell (the project builds with -ffp-contract=off), and within one run every
 // cell always goes through the same code path: results do not depend on the thread count.
 #include "lbm/solver.hpp"
+
+#include <omp.h>
+
 #include "lbm/span_slots.hpp"
 #include "lbm/stream_collide.hpp"
 
@@ -65,6 +68,33 @@ void Solver<L, T>::bulk_sweep(bool odd, bool sample) {
   const PsmSpanFn<T> fn_psm =
       psm ? psm_span_kernel<L, T>(settings_.collision, force, sample, settings_.incompressible, psm->moving()) : nullptr;
   const PsmCells<T> cells = psm ? psm->bulk_cells() : PsmCells<T>{};
+  mb_inline_rows_.clear();
+  MovingBoundary<L, T>* mb = !psm && mb_ && mb_->rows_ready() ? mb_.get() : nullptr;
+  if (mb) {
+    // Particle links inside the sweep (moving_boundary.hpp, "Links inside the bulk sweep"): each
+    // thread sweeps its own block of rows and applies the links of row r - lag after row r; the
+    // first and last lag rows of each block wait for MovingBoundary::apply().
+    mb->prepare_rows();
+    const std::int64_t nrows = std::int64_t(row_span_.size()) - 1, lag = mb->row_lag();
+    const bool par = num_bulk_cells_ > kParallelMinCells;
+    const int nt = par ? omp_get_max_threads() : 1;
+    mb_inline_rows_.assign(std::size_t(nt), {0, 0});
+    const std::int64_t* rs = row_span_.data();
+#pragma omp parallel num_threads(nt) if (par)
+    {
+      const std::int64_t t = omp_get_thread_num(), nth = omp_get_num_threads();
+      const std::int64_t r0 = nrows * t / nth, r1 = nrows * (t + 1) / nth;
+      for (std::int64_t row = r0; row < r1; ++row) {
+        for (std::int64_t s = rs[row]; s < rs[row + 1]; ++s) {
+          const Span& sp = spans[s];
+          fn(g, f, N, sp.x0, sp.y, sp.z, sp.n, odd, r, drho, u);
+        }
+        if (row - lag >= r0 + lag) mb->apply_rows(f, odd, row - lag, row - lag + 1);
+      }
+      if (r1 - lag > r0 + lag) mb_inline_rows_[std::size_t(t)] = {r0 + lag, r1 - lag};
+    }
+    return;
+  }
   // Small lattices run serially: a parallel region costs more than it saves there.
 #pragma omp parallel for schedule(static) if (num_bulk_cells_ > kParallelMinCells)
   for (std::int64_t s = 0; s < ns; ++s) {

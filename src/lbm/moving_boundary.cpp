@@ -48,6 +48,7 @@ void MovingBoundary<L, T>::set_fluid_mask(std::vector<std::uint8_t> fluid) {
   pending_.clear();
   ncells_ = nlinks_ = 0;
   links_valid_ = false;
+  ++links_epoch_;
 }
 
 // AA pattern (bulk_sweep.cpp): even steps read g_q from f[q][x] and write g*_q to f[opp q][x];
@@ -106,6 +107,7 @@ void MovingBoundary<L, T>::release_all() {
   eoff_.clear();
   links_.clear();
   ncells_ = nlinks_ = 0;
+  ++links_epoch_;
 }
 
 // Room for `need` entries in particle self's slice of arr (and of par, parallel to it): in place,
@@ -311,6 +313,7 @@ void MovingBoundary<L, T>::set_particles(const ParticleSet& p, T* f, bool odd, b
     links_.reserve(2 * links_.size() + 1024);
   }
   links_valid_ = true;
+  if (rows_epoch_ != links_epoch_) build_rows();
   stats_.solid_cells = long(ncells_);
   stats_.links = long(nlinks_);
   force_.assign(np, Vec3::Zero());
@@ -466,14 +469,15 @@ double MovingBoundary<L, T>::link_delta(const MovingLink& k, const Motion& m, do
 
 // The Bouzidi fractions of particle s's links at its current position and radius (once per move).
 template <class L, class T>
-void MovingBoundary<L, T>::update_delta(std::size_t s) {
-  if (scheme_ != ParticleScheme::InterpolatedBounceBack) return;
-  if (mot_[s].x == delta_x_[s] && radius_[s] == delta_r_[s]) return;
+bool MovingBoundary<L, T>::update_delta(std::size_t s) {
+  if (scheme_ != ParticleScheme::InterpolatedBounceBack) return false;
+  if (mot_[s].x == delta_x_[s] && radius_[s] == delta_r_[s]) return false;
   const Slice& sl = ls_[s];
   for (std::int32_t l = sl.first; l < sl.first + sl.count; ++l)
     links_[std::size_t(l)].delta = link_delta(links_[std::size_t(l)], mot_[s], radius_[s]);
   delta_x_[s] = mot_[s].x;
   delta_r_[s] = radius_[s];
+  return true;
 }
 
 // Links from the fluid cells around every solid cell of particle s, in cell order then direction
@@ -515,6 +519,7 @@ void MovingBoundary<L, T>::build_links(std::size_t s, const ParticleSet&) {
   Slice& ll = ls_[s];
   nlinks_ += new_links_.size();
   nlinks_ -= std::size_t(ll.count);
+  ++links_epoch_;
   place(links_, ll, std::int32_t(new_links_.size()), ls_, links_spare_, nullptr);
   std::copy(new_links_.begin(), new_links_.end(), links_.begin() + ll.first);
   ll.count = std::int32_t(new_links_.size());
@@ -539,92 +544,216 @@ void MovingBoundary<L, T>::reset_cell(T* f, CellIndex c, bool edge, const Vec3& 
 }
 
 template <class L, class T>
-void MovingBoundary<L, T>::apply(T* f, bool odd) {
+FF_LBM_INLINE Vec3 MovingBoundary<L, T>::link_arm(const RowLink& k, const Motion& m) const {
+  const int q = k.q;
+  const Vec3 c(L::c[q][0], L::c[q][1], L::D == 3 ? L::c[q][2] : 0);
+  const Vec3 ay(k.xu[0] - m.x[0], k.xu[1] - m.x[1], L::D == 3 ? k.xu[2] - m.x[2] : 0.0);
+  const Vec3 ax = ay + c;
+  return ax - k.delta * c;
+}
+
+// One link's bounce-back: the reflected population into the slot its fluid node reads next step,
+// and the momentum it exchanges along c_o, g*_o(x, t) + g_q(x, t + 1).
+template <class L, class T>
+template <bool kMoving>
+FF_LBM_INLINE double MovingBoundary<L, T>::exchange(T* f, bool odd, const RowLink& k, const Motion& m) const {
   const bool next = !odd;
   const WallScheme ws =
       scheme_ == ParticleScheme::InterpolatedBounceBack ? WallScheme::Bouzidi : WallScheme::HalfwayBounceBack;
+  const int q = k.q, o = L::opp[q];
+  CellIndex sa, sb, sc, sd;
+  if (!k.edge) {
+    sa = k.node + post_off_[odd][o];
+    sb = k.node + post_off_[odd][q];
+    sc = k.node + cq_off_[q] + post_off_[odd][o];
+    sd = k.node + pre_off_[next][q];
+  } else {
+    const auto xs = grid_.coords(k.node);
+    const int kx[3] = {xs[0], xs[1], xs[2]};
+    const int x2[3] = {grid_.step(kx[0], L::c[q][0], 0), grid_.step(kx[1], L::c[q][1], 1),
+                       grid_.step(kx[2], L::c[q][2], 2)};
+    sa = post(kx, o, odd);
+    sb = post(kx, q, odd);
+    sc = post(x2, o, odd);
+    sd = pre(kx, q, next);
+  }
+  const T A = f[sa];  // g*_o(x, t), sent into the wall
+  T B = 0, C = 0;
+  if (ws == WallScheme::Bouzidi && k.has_second) {
+    B = f[sb];  // g*_q(x, t)
+    C = f[sc];  // g*_o(x + c_q, t)
+  }
+  T mw = 0, geq = 0;  // a particle at rest: no moving-wall term, g^eq_o(1, 0) = 0
+  if constexpr (kMoving) {
+    // The wall point x_w - X and its velocity u_w = v + omega x (x_w - X).
+    const Vec3 arm = link_arm(k, m);
+    const Vec3 ay(k.xu[0] - m.x[0], k.xu[1] - m.x[1], L::D == 3 ? k.xu[2] - m.x[2] : 0.0);
+    const Vec3 uw = m.v + m.w.cross(arm);
+    const T cu = T(L::c[q][0]) * T(uw[0]) + T(L::c[q][1]) * T(uw[1]) + T(L::c[q][2]) * T(L::D == 3 ? uw[2] : 0.0);
+    mw = T(6 * L::w[q]) * cu;
+    const Vec3 us = m.v + m.w.cross(ay);
+    const T u0 = T(us[0]), u1 = T(us[1]), u2 = T(L::D == 3 ? us[2] : 0.0);
+    const T cuo = L::c[o][0] * u0 + L::c[o][1] * u1 + L::c[o][2] * u2;
+    geq = T(L::w[o]) * (T(0) + T(1) * (T(3) * cuo + T(4.5) * cuo * cuo - T(1.5) * (u0 * u0 + u1 * u1 + u2 * u2)));
+  }
+  const T g = reflect<T>(ws, T(k.delta), k.has_second, A, B, C, mw);
+  f[sd] = g;
+  // Slot A is also what the solid cell y = x - c_q reads from x next step (AA pattern): it
+  // gets g^eq_o(1, u_s(y)) instead of the fluid's population (equilibrium(), one direction).
+  f[sa] = geq;
+  return double(A) + double(g);
+}
+
+// The links by the lattice row of their fluid node; within a row by particle, each particle's in
+// its link order (a group); groups with a cell that is not a bulk cell or a link across a periodic
+// edge are late (left to apply()). Per particle, its groups in row order.
+template <class L, class T>
+void MovingBoundary<L, T>::build_rows() {
+  const std::int64_t nrows = std::int64_t(grid_.ny) * grid_.nz;
+  auto bulk = [&](CellIndex c) { return fluid_[std::size_t(c)] == 2; };
+  // The fluid node's row from the solid cell's unwrapped coordinates (no division per link).
+  auto row_of = [&](const MovingLink& k) {
+    const int y = wrap_axis(k.xu[1] + L::c[k.q][1], grid_.ny, grid_.periodic[1]);
+    const int z = L::D == 3 ? wrap_axis(k.xu[2] + L::c[k.q][2], grid_.nz, grid_.periodic[2]) : 0;
+    return std::int64_t(y) + std::int64_t(grid_.ny) * z;
+  };
+  std::vector<std::int64_t>& count = row_count_;
+  count.assign(std::size_t(nrows) + 1, 0);
+  link_row_.resize(links_.size());
+  for (std::size_t s = 0; s < np_; ++s) {
+    const Slice& sl = ls_[s];
+    for (std::int32_t l = sl.first; l < sl.first + sl.count; ++l) {
+      const std::int64_t r = row_of(links_[std::size_t(l)]);
+      link_row_[std::size_t(l)] = r;
+      ++count[std::size_t(r) + 1];
+    }
+  }
+  for (std::int64_t r = 0; r < nrows; ++r) count[std::size_t(r) + 1] += count[std::size_t(r)];
+  row_item_.resize(std::size_t(count[std::size_t(nrows)]));
+  row_pos_.resize(links_.size());
+  row_fill_.assign(count.begin(), count.end() - 1);
+  for (std::size_t s = 0; s < np_; ++s) {
+    const Slice& sl = ls_[s];
+    for (std::int32_t l = sl.first; l < sl.first + sl.count; ++l) {
+      const MovingLink& k = links_[std::size_t(l)];
+      const std::int64_t i = row_fill_[std::size_t(link_row_[std::size_t(l)])]++;
+      const bool late = k.edge || !bulk(k.node) || !bulk(k.node - cq_off_[k.q]) ||
+                        (k.has_second && !bulk(k.node + cq_off_[k.q]));
+      row_pos_[std::size_t(l)] = std::int32_t(i);
+      row_item_[std::size_t(i)] = RowLink{k.node, k.delta, {k.xu[0], k.xu[1], k.xu[2]}, std::int32_t(s), k.q,
+                                          k.has_second, k.edge, late};
+    }
+  }
+  // Groups: runs of one particle's items within a row.
+  groups_.clear();
+  row_group_.assign(std::size_t(nrows) + 1, 0);
+  for (std::int64_t r = 0; r < nrows; ++r) {
+    for (std::int64_t i = count[std::size_t(r)]; i < count[std::size_t(r) + 1]; ++i) {
+      const RowLink& k = row_item_[std::size_t(i)];
+      if (i == count[std::size_t(r)] || k.particle != groups_.back().particle)
+        groups_.push_back(Group{i, 0, k.particle, false});
+      ++groups_.back().count;
+      groups_.back().late = groups_.back().late || k.late;
+    }
+    row_group_[std::size_t(r) + 1] = std::int64_t(groups_.size());
+  }
+  part_group_first_.assign(np_ + 1, 0);
+  for (const Group& g : groups_) ++part_group_first_[std::size_t(g.particle) + 1];
+  for (std::size_t s = 0; s < np_; ++s) part_group_first_[s + 1] += part_group_first_[s];
+  part_group_.resize(groups_.size());
+  row_fill_.assign(part_group_first_.begin(), part_group_first_.end() - 1);
+  for (std::size_t g = 0; g < groups_.size(); ++g)
+    part_group_[std::size_t(row_fill_[std::size_t(groups_[g].particle)]++)] = std::int32_t(g);
+  group_force_.assign(groups_.size(), Vec3::Zero());
+  group_torque_.assign(groups_.size(), Vec3::Zero());
+  rows_epoch_ = links_epoch_;
+}
+
+template <class L, class T>
+void MovingBoundary<L, T>::prepare_rows() {
+#pragma omp parallel for schedule(static) if (nlinks_ > 8192)
+  for (std::int64_t s = 0; s < std::int64_t(np_); ++s) {
+    if (!update_delta(std::size_t(s))) continue;
+    const Slice& sl = ls_[std::size_t(s)];  // the rows' copies of its new fractions
+    for (std::int32_t l = sl.first; l < sl.first + sl.count; ++l)
+      row_item_[std::size_t(row_pos_[std::size_t(l)])].delta = links_[std::size_t(l)].delta;
+  }
+}
+
+template <class L, class T>
+template <bool kMoving>
+FF_LBM_INLINE void MovingBoundary<L, T>::apply_group_as(T* f, bool odd, std::int64_t g) const {
+  const Group& gr = groups_[std::size_t(g)];
+  const Motion& m = mot_[std::size_t(gr.particle)];
+  Vec3 F = Vec3::Zero(), M = Vec3::Zero();
+  for (std::int64_t i = gr.first; i < gr.first + gr.count; ++i) {
+    const RowLink& k = row_item_[std::size_t(i)];
+    const int o = L::opp[k.q];
+    const double ag = exchange<kMoving>(f, odd, k, m);
+    const Vec3 Fl(L::c[o][0] * ag, L::c[o][1] * ag, L::D == 3 ? L::c[o][2] * ag : 0.0);
+    F += Fl;
+    M += link_arm(k, m).cross(Fl);
+  }
+  // Each group its own entry (const: called from the sweep's threads).
+  const_cast<Vec3&>(group_force_[std::size_t(g)]) = F;
+  const_cast<Vec3&>(group_torque_[std::size_t(g)]) = M;
+}
+
+template <class L, class T>
+FF_LBM_INLINE void MovingBoundary<L, T>::apply_group(T* f, bool odd, std::int64_t g) const {
+  const Motion& m = mot_[std::size_t(groups_[std::size_t(g)].particle)];
+  if (m.v != Vec3::Zero() || m.w != Vec3::Zero()) apply_group_as<true>(f, odd, g);
+  else apply_group_as<false>(f, odd, g);  // a particle at rest: no moving-wall term
+}
+
+template <class L, class T>
+void MovingBoundary<L, T>::apply_rows(T* f, bool odd, std::int64_t r0, std::int64_t r1) const {
+  for (std::int64_t g = row_group_[std::size_t(r0)]; g < row_group_[std::size_t(r1)]; ++g)
+    if (!groups_[std::size_t(g)].late) apply_group(f, odd, g);
+}
+
+template <class L, class T>
+void MovingBoundary<L, T>::apply(T* f, bool odd, const std::vector<std::pair<std::int64_t, std::int64_t>>& inline_rows) {
+  const bool next = !odd;
   const std::int64_t np = std::int64_t(np_);
-  // Links first: they read the post-collision populations of step t, some of which lie in slots
-  // that the solid cells' reset below overwrites. Each link writes a slot its fluid cell owns; each
-  // particle sums its own links' loads (in link order: the same result on any thread count).
-  // Parallel only above 8192 items (a link or a reset costs about a cell update): on a loaded
-  // machine a parallel region per step made a 24^3 case with 3000 links 35 times slower.
+  if (rows_epoch_ != links_epoch_) build_rows();
+  if (inline_rows.empty()) prepare_rows();  // (the sweep did when it applied rows)
+  // 1. The links the sweep did not apply (apply_rows): every group of the rows outside
+  //    inline_rows, the late groups inside them. Each link writes slots only it touches.
+  std::vector<std::pair<std::int64_t, std::int64_t>> done;
+  for (const auto& d : inline_rows)
+    if (d.first < d.second) done.push_back(d);
+  std::sort(done.begin(), done.end());
+  const std::int64_t nrows = std::int64_t(row_group_.size()) - 1;
+  todo_.clear();
+  std::int64_t r = 0;
+  auto all_of = [&](std::int64_t a, std::int64_t b) {
+    for (std::int64_t g = row_group_[std::size_t(a)]; g < row_group_[std::size_t(b)]; ++g) todo_.push_back(g);
+  };
+  for (const auto& [a, b] : done) {
+    if (r < a) all_of(r, a);
+    for (std::int64_t g = row_group_[std::size_t(a)]; g < row_group_[std::size_t(b)]; ++g)
+      if (groups_[std::size_t(g)].late) todo_.push_back(g);
+    r = std::max(r, b);
+  }
+  if (r < nrows) all_of(r, nrows);
+  const std::int64_t nt = std::int64_t(todo_.size());
+#pragma omp parallel for schedule(dynamic, 256) if (nt > 4096)
+  for (std::int64_t i = 0; i < nt; ++i) apply_group(f, odd, todo_[std::size_t(i)]);
+  // 2. Each particle's load: its groups' sums in row order (the same on any thread count and
+  //    whichever rows the sweep applied).
 #pragma omp parallel for schedule(static) if (nlinks_ > 8192)
   for (std::int64_t s = 0; s < np; ++s) {
-    update_delta(std::size_t(s));
-    const Motion& m = mot_[std::size_t(s)];
-    const bool at_rest = m.v == Vec3::Zero() && m.w == Vec3::Zero();
-    const Slice& sl = ls_[std::size_t(s)];
     Vec3 F = Vec3::Zero(), M = Vec3::Zero();
-    const std::int32_t end = sl.first + sl.count;
-    for (std::int32_t l = sl.first; l < end; ++l) {
-      // The populations are far from cache (the sweep streamed the lattice since): fetch the two
-      // slots of a link some links ahead (they are the solid cell's and the fluid node's).
-      constexpr std::int32_t kAhead = 12;
-      if (l + kAhead < end) {
-        const MovingLink& a = links_[std::size_t(l + kAhead)];
-        if (!a.edge) {
-          __builtin_prefetch(f + a.node + post_off_[odd][L::opp[a.q]], 1);
-          __builtin_prefetch(f + a.node + pre_off_[next][a.q], 1);
-          if (ws == WallScheme::Bouzidi && a.has_second) {
-            __builtin_prefetch(f + a.node + post_off_[odd][a.q], 0);
-            __builtin_prefetch(f + a.node + cq_off_[a.q] + post_off_[odd][L::opp[a.q]], 0);
-          }
-        }
-      }
-      const MovingLink& k = links_[std::size_t(l)];
-      const int q = k.q, o = L::opp[q];
-      CellIndex sa, sb, sc, sd;
-      if (!k.edge) {
-        sa = k.node + post_off_[odd][o];
-        sb = k.node + post_off_[odd][q];
-        sc = k.node + cq_off_[q] + post_off_[odd][o];
-        sd = k.node + pre_off_[next][q];
-      } else {
-        const auto xs = grid_.coords(k.node);
-        const int kx[3] = {xs[0], xs[1], xs[2]};
-        const int x2[3] = {grid_.step(kx[0], L::c[q][0], 0), grid_.step(kx[1], L::c[q][1], 1),
-                           grid_.step(kx[2], L::c[q][2], 2)};
-        sa = post(kx, o, odd);
-        sb = post(kx, q, odd);
-        sc = post(x2, o, odd);
-        sd = pre(kx, q, next);
-      }
-      const T A = f[sa];  // g*_o(x, t), sent into the wall
-      T B = 0, C = 0;
-      if (ws == WallScheme::Bouzidi && k.has_second) {
-        B = f[sb];  // g*_q(x, t)
-        C = f[sc];  // g*_o(x + c_q, t)
-      }
-      // The wall point x_w - X and its velocity u_w = v + omega x (x_w - X).
-      const Vec3 c(L::c[q][0], L::c[q][1], L::D == 3 ? L::c[q][2] : 0);
-      const Vec3 ay(k.xu[0] - m.x[0], k.xu[1] - m.x[1], L::D == 3 ? k.xu[2] - m.x[2] : 0.0);
-      const Vec3 ax = ay + c;
-      const Vec3 arm = ax - k.delta * c;
-      T mw = 0, geq = 0;  // a particle at rest: no moving-wall term, g^eq_o(1, 0) = 0
-      if (!at_rest) {
-        const Vec3 uw = m.v + m.w.cross(arm);
-        const T cu = T(L::c[q][0]) * T(uw[0]) + T(L::c[q][1]) * T(uw[1]) + T(L::c[q][2]) * T(L::D == 3 ? uw[2] : 0.0);
-        mw = T(6 * L::w[q]) * cu;
-        const Vec3 us = m.v + m.w.cross(ay);
-        const T u0 = T(us[0]), u1 = T(us[1]), u2 = T(L::D == 3 ? us[2] : 0.0);
-        const T cuo = L::c[o][0] * u0 + L::c[o][1] * u1 + L::c[o][2] * u2;
-        geq = T(L::w[o]) * (T(0) + T(1) * (T(3) * cuo + T(4.5) * cuo * cuo - T(1.5) * (u0 * u0 + u1 * u1 + u2 * u2)));
-      }
-      const T g = reflect<T>(ws, T(k.delta), k.has_second, A, B, C, mw);
-      f[sd] = g;
-      // Slot A is also what the solid cell y = x - c_q reads from x next step (AA pattern): it
-      // gets g^eq_o(1, u_s(y)) instead of the fluid's population (equilibrium(), one direction).
-      f[sa] = geq;
-      const double ag = double(A) + double(g);
-      const Vec3 Fl(L::c[o][0] * ag, L::c[o][1] * ag, L::D == 3 ? L::c[o][2] * ag : 0.0);
-      F += Fl;
-      M += arm.cross(Fl);
+    for (std::int64_t j = part_group_first_[std::size_t(s)]; j < part_group_first_[std::size_t(s) + 1]; ++j) {
+      F += group_force_[std::size_t(part_group_[std::size_t(j)])];
+      M += group_torque_[std::size_t(part_group_[std::size_t(j)])];
     }
     lforce_[std::size_t(s)] = F;
     ltorque_[std::size_t(s)] = M;
   }
-  // Exposed solid cells: f^eq(1, u_s) in all the slots they read next step.
+  // 3. Exposed solid cells: f^eq(1, u_s) in all the slots they read next step (after the links:
+  //    they read slots that this overwrites).
 #pragma omp parallel for schedule(static) if (ncells_ > 8192)
   for (std::int64_t s = 0; s < np; ++s) {
     const Slice& sl = cs_[std::size_t(s)];

@@ -30,18 +30,21 @@
 // conserved by covering and refill: MovingBoundaryStats reports what each change of the set adds
 // and removes.
 //
-// Cost and the bulk kernel: nothing changes in the bulk sweep. Solid cells stay in their bulk span
+// Cost and the bulk kernel: the bulk kernel is unchanged. Solid cells stay in their bulk span
 // and are streamed and collided like fluid (garbage in, garbage out), which keeps the kernel
-// branch-free; after the sweeps of a step a post-pass writes each link's reflected population into
-// the slot its fluid cell reads in the next step and replaces the population the fluid cell sent
-// into the wall, which the solid cell reads next, by g^eq_o(1, u_s) (cost proportional to links);
+// branch-free; each link writes its reflected population into the slot its fluid cell reads in the
+// next step and replaces the population the fluid cell sent into the wall, which the solid cell
+// reads next, by g^eq_o(1, u_s) (cost proportional to links). The links are applied by lattice row
+// inside the bulk sweep, a few rows behind it, while those rows' populations are still in cache
+// (apply_rows; a post-pass after the sweep found them in memory and cost 3 LBM steps on the 2D
+// benchmark's 593,000 links); the rest in apply();
 // the cells just covered, and those next to a static solid or the lattice's edge, get f^eq(1, u_s)
 // in every slot (with a body force, every solid cell: set_reset_all()). The other inputs of a
 // solid cell come from solid cells, near f^eq(1, u_s)
 // (exactly f^eq(1, 0) for particles at rest), so the solid cells hold finite values near the
 // particle's velocity without a reset of every covered cell; no fluid cell ever reads a solid cell
 // (the links overwrite those slots). This works because in the AA pattern every slot a fluid cell
-// reads at t+1 is written by the post-pass after every cell of step t has run.
+// reads at t+1 is written by its link after every cell that touches that slot in step t has run.
 //
 // Incremental set (the particles move ~0.002 cells per step): each particle keeps its solid cells
 // and its links in its own slice of two arrays (with room to grow). set_particles() rescans a
@@ -93,15 +96,31 @@ class MovingBoundary {
   static constexpr int Q = L::Q;
   MovingBoundary(const Grid& grid, ParticleScheme scheme, bool incompressible);
 
-  // Static fluid cells (1) per padded cell, set by the solver once per geometry; forgets the set.
+  // Static fluid cells per padded cell (1: updated by the solver's boundary sweep, 2: by the bulk
+  // sweep; 0: not fluid), set by the solver once per geometry; forgets the set.
   void set_fluid_mask(std::vector<std::uint8_t> fluid);
   // New particle set before a step of parity `odd` on populations f. bookkeeping = false only
   // rebuilds the solid cells and links of a set (resume): no covering, no refill.
   void set_particles(const ParticleSet& p, T* f, bool odd, bool bookkeeping);
   // Post-pass after the sweeps of a step of parity `odd`: reflected populations of every link,
   // then the solid cells' reset. Then reduce() sums the per-particle loads in a fixed order.
-  void apply(T* f, bool odd);
+  // `inline_rows`: the lattice rows whose links the bulk sweep already applied (apply_rows), one
+  // range per thread; empty when it applied none (then every link is applied here).
+  void apply(T* f, bool odd, const std::vector<std::pair<std::int64_t, std::int64_t>>& inline_rows = {});
   void reduce();
+
+  // ---- Links inside the bulk sweep (Solver::bulk_sweep). A link reads and writes only slots that
+  // its fluid node x and the cells x -+ c_q own in this step (AA pattern), so once rows
+  // row(x) - lag .. row(x) + lag are swept nothing else touches them (lattice row = y + ny z; lag 1
+  // in 2D, ny + 1 in 3D). Links are grouped per row and particle (a group: one particle's links in
+  // one row); groups with a cell that is not a bulk cell (boundary cells are updated after the
+  // sweep) or a link round a periodic edge wait for apply(), as do the rows at the ends of each
+  // thread's block. Each particle's load is the sum of its groups' in row order: the same on any
+  // thread count, whichever rows the sweep applied, and after a resume.
+  bool rows_ready() const { return active() && rows_epoch_ == links_epoch_; }  // (set_particles builds them)
+  std::int64_t row_lag() const { return L::D == 3 ? std::int64_t(grid_.ny) + 1 : 1; }
+  void prepare_rows();                                             // before the sweep: Bouzidi fractions
+  void apply_rows(T* f, bool odd, std::int64_t r0, std::int64_t r1) const;  // links of rows [r0, r1)
   // With a body force the solid cells' own collision drives them: every solid cell is then reset
   // each step (as the links alone keep them near f^eq(1, u_s) only without one). Set by the solver.
   void set_reset_all(bool all) { reset_all_ = all; }
@@ -147,18 +166,53 @@ class MovingBoundary {
   void scan(std::size_t s, const ParticleSet& p);
   void claim(std::size_t s);  // ownership of scan_ for particle s; updates its slice when it changed
   void build_links(std::size_t s, const ParticleSet& p);  // links and exposed cells of particle s
-  void update_delta(std::size_t s);  // in apply(): per particle, in parallel
+  bool update_delta(std::size_t s);  // per particle, in parallel; true if the fractions changed
   double link_delta(const MovingLink& k, const Motion& m, double r) const;
   void mark_dirty(CellIndex changed);  // particles whose links may see a changed cell
   template <class V>
   void place(V& arr, Slice& sl, std::int32_t need, std::vector<Slice>& all, V& spare, std::vector<std::int32_t>* par);
   void reset_cell(T* f, CellIndex c, bool edge, const Vec3& arm, const Motion& m, bool next) const;
+  // Links by lattice row (Solver::bulk_sweep applies them row by row): per row a copy of what each
+  // link reads (links_ in row order would be a cache miss per link) and the particle it loads.
+  struct RowLink {
+    CellIndex node;
+    double delta;
+    std::int32_t xu[3];  // the solid cell's unwrapped coordinates
+    std::int32_t particle;
+    std::uint8_t q;
+    bool has_second, edge, late;
+  };
+  // Consecutive links of one particle in one row: the unit the sweep applies and whose force and
+  // torque it sums (items [first, first + count) of row_item_). Late: left to apply().
+  struct Group {
+    std::int64_t first;
+    std::int32_t count, particle;
+    bool late;
+  };
+  Vec3 link_arm(const RowLink& k, const Motion& m) const;  // wall point minus particle centre
+  template <bool kMoving>
+  double exchange(T* f, bool odd, const RowLink& k, const Motion& m) const;
+  template <bool kMoving>
+  void apply_group_as(T* f, bool odd, std::int64_t g) const;
+  void apply_group(T* f, bool odd, std::int64_t g) const;
+  void build_rows();  // row_item_, groups_ and their indices from the current links
+  std::vector<std::int64_t> row_count_;   // per row, its first item (nrows + 1)
+  std::vector<RowLink> row_item_;
+  std::vector<std::int32_t> row_pos_;     // per link index, its item
+  std::vector<std::int64_t> link_row_, row_fill_;  // build_rows() scratch
+  std::vector<Group> groups_;
+  std::vector<std::int64_t> row_group_;   // per row, its first group (nrows + 1)
+  std::vector<std::int64_t> part_group_first_;  // per particle its groups in part_group_ (row order)
+  std::vector<std::int32_t> part_group_;
+  std::vector<Vec3> group_force_, group_torque_;
+  std::vector<std::int64_t> todo_;        // apply(): the groups left to it
+  std::uint64_t links_epoch_ = 1, rows_epoch_ = 0;
 
   Grid grid_;
   ParticleScheme scheme_;
   bool incompressible_;
   std::int64_t pre_off_[2][Q], post_off_[2][Q], cq_off_[Q];
-  std::vector<std::uint8_t> fluid_;   // per padded cell: static fluid
+  std::vector<std::uint8_t> fluid_;   // per padded cell: static fluid (1: a boundary cell, 2: a bulk cell)
   // Per padded cell: the particle that owns it (-1: fluid; -2 - s: released by s in this set).
   std::vector<std::int32_t> owner_;
   std::size_t np_ = 0;

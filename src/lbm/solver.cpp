@@ -226,7 +226,7 @@ void Solver<L, T>::step(bool sample) {
   if (psm) psm_->reduce(Vec3(double(relax_.force[0]), double(relax_.force[1]), double(relax_.force[2])));
   // Solid particle cells: the links' bounce-back into the slots of the next step, then the reset.
   if (mb_) {
-    if (mb_->active()) mb_->apply(f_.data(), odd);
+    if (mb_->active()) mb_->apply(f_.data(), odd, mb_inline_rows_);
     mb_->reduce();
   }
   reduce_forces();
@@ -431,6 +431,8 @@ void Solver<L, T>::moving_particles(const ParticleSet& p, bool bookkeeping) {
   if (psm_kinds_stale_) {
     std::vector<std::uint8_t> fluid(std::size_t(n_()), 0);
     for (std::size_t i = 0; i < fluid.size(); ++i) fluid[i] = type_[i] == CellType::Fluid;
+    for (const Span& s : spans_)
+      for (int k = 0; k < s.n; ++k) fluid[std::size_t(grid_.index(s.x0 + k, s.y, s.z))] = 2;  // bulk cells
     mb_->set_fluid_mask(std::move(fluid));
     psm_kinds_stale_ = false;
   }

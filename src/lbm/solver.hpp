@@ -234,6 +234,9 @@ class Solver {
   std::array<T, kNumFaces> convective_u_{};
   std::unique_ptr<Psm<L, T>> psm_;     // created by the first set_particles()
   std::unique_ptr<MovingBoundary<L, T>> mb_;  // the same for the bounce-back schemes
+  // The rows whose particle links the last bulk sweep applied (MovingBoundary::apply_rows), per thread.
+  std::vector<std::pair<std::int64_t, std::int64_t>> mb_inline_rows_;
+  std::vector<std::int64_t> row_span_;  // per lattice row (y + ny z), its first span; nrows + 1 entries
   void moving_particles(const ParticleSet& p, bool bookkeeping);
   void prepare_psm();  // creates the PSM and (re)classifies its cells
   bool psm_kinds_stale_ = true;        // finalize() changed the cell classification

@@ -172,6 +172,11 @@ void Solver<L, T>::finalize() {
     }
   num_bulk_cells_ = 0;
   for (auto& sp : spans_) num_bulk_cells_ += sp.n;
+  // Spans come in lattice order: each row's are consecutive (the sweep with particle links, by row).
+  const std::int64_t nrows = std::int64_t(g.ny) * g.nz;
+  row_span_.assign(std::size_t(nrows) + 1, 0);
+  for (auto& sp : spans_) ++row_span_[std::size_t(sp.y + std::int64_t(g.ny) * sp.z) + 1];
+  for (std::int64_t r = 0; r < nrows; ++r) row_span_[std::size_t(r) + 1] += row_span_[std::size_t(r)];
   link_saved_.assign(links_.size(), T(0));
   donor_g_.assign(std::size_t(Q) * donor_row.size(), T(0));
   convective_u_.fill(T(0));
