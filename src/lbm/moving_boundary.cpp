@@ -544,31 +544,59 @@ void MovingBoundary<L, T>::reset_cell(T* f, CellIndex c, bool edge, const Vec3& 
 }
 
 template <class L, class T>
-FF_LBM_INLINE Vec3 MovingBoundary<L, T>::link_arm(const RowLink& k, const Motion& m) const {
-  const int q = k.q;
+FF_LBM_INLINE Vec3 MovingBoundary<L, T>::link_arm(const RowGeometry& k, int q, const Motion& m) const {
   const Vec3 c(L::c[q][0], L::c[q][1], L::D == 3 ? L::c[q][2] : 0);
   const Vec3 ay(k.xu[0] - m.x[0], k.xu[1] - m.x[1], L::D == 3 ? k.xu[2] - m.x[2] : 0.0);
   const Vec3 ax = ay + c;
   return ax - k.delta * c;
 }
 
+// A link's constants while its particle keeps its place: reflect()'s with u_w = 0 written as
+// g = a A + b X (X = A, B or C; the same operations, so the same values), and the torque lever
+// (x_w - X) x c_o per unit of exchanged momentum.
+template <class L, class T>
+void MovingBoundary<L, T>::set_constants(RowLink& h, const RowGeometry& k, const Motion& m) const {
+  const T delta = T(k.delta);
+  if (scheme_ != ParticleScheme::InterpolatedBounceBack || !k.has_second) {
+    h.a = T(1);
+    h.b = T(0);
+    h.second = 0;
+  } else if (delta < T(0.5)) {  // Bouzidi et al. (2001), boundary.hpp reflect()
+    h.a = T(2) * delta;
+    h.b = T(1) - T(2) * delta;
+    h.second = 2;
+  } else {
+    const T inv2d = T(0.5) / delta;
+    h.a = inv2d;
+    h.b = (T(2) * delta - T(1)) * inv2d;
+    h.second = 1;
+  }
+  const int o = L::opp[h.q];
+  const Vec3 lever = link_arm(k, h.q, m).cross(Vec3(L::c[o][0], L::c[o][1], L::D == 3 ? L::c[o][2] : 0));
+  if constexpr (L::D == 3) {
+    for (int a = 0; a < 3; ++a) h.lever[a] = lever[a];
+  } else {
+    h.lever[0] = lever[2];
+  }
+}
+
 // One link's bounce-back: the reflected population into the slot its fluid node reads next step,
-// and the momentum it exchanges along c_o, g*_o(x, t) + g_q(x, t + 1).
+// and the momentum it exchanges along c_o, g*_o(x, t) + g_q(x, t + 1). At rest (kMoving false)
+// from the link's constants; moving, reflect() with the wall's velocity.
 template <class L, class T>
 template <bool kMoving>
-FF_LBM_INLINE double MovingBoundary<L, T>::exchange(T* f, bool odd, const RowLink& k, const Motion& m) const {
+FF_LBM_INLINE double MovingBoundary<L, T>::exchange(T* f, bool odd, const RowLink& h, const RowGeometry& k,
+                                                   const Motion& m) const {
   const bool next = !odd;
-  const WallScheme ws =
-      scheme_ == ParticleScheme::InterpolatedBounceBack ? WallScheme::Bouzidi : WallScheme::HalfwayBounceBack;
-  const int q = k.q, o = L::opp[q];
+  const int q = h.q, o = L::opp[q];
   CellIndex sa, sb, sc, sd;
-  if (!k.edge) {
-    sa = k.node + post_off_[odd][o];
-    sb = k.node + post_off_[odd][q];
-    sc = k.node + cq_off_[q] + post_off_[odd][o];
-    sd = k.node + pre_off_[next][q];
+  if (!h.edge) {
+    sa = h.node + post_off_[odd][o];
+    sb = h.node + post_off_[odd][q];
+    sc = h.node + cq_off_[q] + post_off_[odd][o];
+    sd = h.node + pre_off_[next][q];
   } else {
-    const auto xs = grid_.coords(k.node);
+    const auto xs = grid_.coords(h.node);
     const int kx[3] = {xs[0], xs[1], xs[2]};
     const int x2[3] = {grid_.step(kx[0], L::c[q][0], 0), grid_.step(kx[1], L::c[q][1], 1),
                        grid_.step(kx[2], L::c[q][2], 2)};
@@ -578,25 +606,30 @@ FF_LBM_INLINE double MovingBoundary<L, T>::exchange(T* f, bool odd, const RowLin
     sd = pre(kx, q, next);
   }
   const T A = f[sa];  // g*_o(x, t), sent into the wall
-  T B = 0, C = 0;
-  if (ws == WallScheme::Bouzidi && k.has_second) {
-    B = f[sb];  // g*_q(x, t)
-    C = f[sc];  // g*_o(x + c_q, t)
-  }
-  T mw = 0, geq = 0;  // a particle at rest: no moving-wall term, g^eq_o(1, 0) = 0
-  if constexpr (kMoving) {
+  T g, geq = 0;       // a particle at rest: g^eq_o(1, 0) = 0 into slot A
+  if constexpr (!kMoving) {
+    const T X = h.second == 0 ? A : f[h.second == 1 ? sb : sc];  // B = g*_q(x, t), C = g*_o(x + c_q, t)
+    g = h.a * A + h.b * X;
+  } else {
+    const WallScheme ws =
+        scheme_ == ParticleScheme::InterpolatedBounceBack ? WallScheme::Bouzidi : WallScheme::HalfwayBounceBack;
+    T B = 0, C = 0;
+    if (ws == WallScheme::Bouzidi && k.has_second) {
+      B = f[sb];  // g*_q(x, t)
+      C = f[sc];  // g*_o(x + c_q, t)
+    }
     // The wall point x_w - X and its velocity u_w = v + omega x (x_w - X).
-    const Vec3 arm = link_arm(k, m);
+    const Vec3 arm = link_arm(k, q, m);
     const Vec3 ay(k.xu[0] - m.x[0], k.xu[1] - m.x[1], L::D == 3 ? k.xu[2] - m.x[2] : 0.0);
     const Vec3 uw = m.v + m.w.cross(arm);
     const T cu = T(L::c[q][0]) * T(uw[0]) + T(L::c[q][1]) * T(uw[1]) + T(L::c[q][2]) * T(L::D == 3 ? uw[2] : 0.0);
-    mw = T(6 * L::w[q]) * cu;
+    const T mw = T(6 * L::w[q]) * cu;
     const Vec3 us = m.v + m.w.cross(ay);
     const T u0 = T(us[0]), u1 = T(us[1]), u2 = T(L::D == 3 ? us[2] : 0.0);
     const T cuo = L::c[o][0] * u0 + L::c[o][1] * u1 + L::c[o][2] * u2;
     geq = T(L::w[o]) * (T(0) + T(1) * (T(3) * cuo + T(4.5) * cuo * cuo - T(1.5) * (u0 * u0 + u1 * u1 + u2 * u2)));
+    g = reflect<T>(ws, T(k.delta), k.has_second, A, B, C, mw);
   }
-  const T g = reflect<T>(ws, T(k.delta), k.has_second, A, B, C, mw);
   f[sd] = g;
   // Slot A is also what the solid cell y = x - c_q reads from x next step (AA pattern): it
   // gets g^eq_o(1, u_s(y)) instead of the fluid's population (equilibrium(), one direction).
@@ -620,6 +653,7 @@ void MovingBoundary<L, T>::build_rows() {
   std::vector<std::int64_t>& count = row_count_;
   count.assign(std::size_t(nrows) + 1, 0);
   link_row_.resize(links_.size());
+  for (std::size_t s = 0; s < np_; ++s) update_delta(s);
   for (std::size_t s = 0; s < np_; ++s) {
     const Slice& sl = ls_[s];
     for (std::int32_t l = sl.first; l < sl.first + sl.count; ++l) {
@@ -630,6 +664,7 @@ void MovingBoundary<L, T>::build_rows() {
   }
   for (std::int64_t r = 0; r < nrows; ++r) count[std::size_t(r) + 1] += count[std::size_t(r)];
   row_item_.resize(std::size_t(count[std::size_t(nrows)]));
+  row_geo_.resize(row_item_.size());
   row_pos_.resize(links_.size());
   row_fill_.assign(count.begin(), count.end() - 1);
   for (std::size_t s = 0; s < np_; ++s) {
@@ -640,20 +675,31 @@ void MovingBoundary<L, T>::build_rows() {
       const bool late = k.edge || !bulk(k.node) || !bulk(k.node - cq_off_[k.q]) ||
                         (k.has_second && !bulk(k.node + cq_off_[k.q]));
       row_pos_[std::size_t(l)] = std::int32_t(i);
-      row_item_[std::size_t(i)] = RowLink{k.node, k.delta, {k.xu[0], k.xu[1], k.xu[2]}, std::int32_t(s), k.q,
-                                          k.has_second, k.edge, late};
+      RowLink& h = row_item_[std::size_t(i)];
+      RowGeometry& geo = row_geo_[std::size_t(i)];
+      geo = RowGeometry{k.delta, {k.xu[0], k.xu[1], k.xu[2]}, std::int32_t(s), k.has_second};
+      h.node = k.node;
+      h.q = k.q;
+      h.edge = k.edge;
+      h.late = late;
+      set_constants(h, geo, mot_[s]);
     }
+  }
+  const_x_.resize(np_);
+  const_r_.resize(np_);
+  for (std::size_t s = 0; s < np_; ++s) {
+    const_x_[s] = mot_[s].x;
+    const_r_[s] = radius_[s];
   }
   // Groups: runs of one particle's items within a row.
   groups_.clear();
   row_group_.assign(std::size_t(nrows) + 1, 0);
   for (std::int64_t r = 0; r < nrows; ++r) {
     for (std::int64_t i = count[std::size_t(r)]; i < count[std::size_t(r) + 1]; ++i) {
-      const RowLink& k = row_item_[std::size_t(i)];
-      if (i == count[std::size_t(r)] || k.particle != groups_.back().particle)
-        groups_.push_back(Group{i, 0, k.particle, false});
+      const std::int32_t particle = row_geo_[std::size_t(i)].particle;
+      if (i == count[std::size_t(r)] || particle != groups_.back().particle) groups_.push_back(Group{i, 0, particle, false});
       ++groups_.back().count;
-      groups_.back().late = groups_.back().late || k.late;
+      groups_.back().late = groups_.back().late || row_item_[std::size_t(i)].late;
     }
     row_group_[std::size_t(r) + 1] = std::int64_t(groups_.size());
   }
@@ -671,12 +717,21 @@ void MovingBoundary<L, T>::build_rows() {
 
 template <class L, class T>
 void MovingBoundary<L, T>::prepare_rows() {
+  // A particle that moved since its links' constants were set: its Bouzidi fractions, then the
+  // constants (arms, levers) of its links.
 #pragma omp parallel for schedule(static) if (nlinks_ > 8192)
-  for (std::int64_t s = 0; s < std::int64_t(np_); ++s) {
-    if (!update_delta(std::size_t(s))) continue;
-    const Slice& sl = ls_[std::size_t(s)];  // the rows' copies of its new fractions
-    for (std::int32_t l = sl.first; l < sl.first + sl.count; ++l)
-      row_item_[std::size_t(row_pos_[std::size_t(l)])].delta = links_[std::size_t(l)].delta;
+  for (std::int64_t si = 0; si < std::int64_t(np_); ++si) {
+    const std::size_t s = std::size_t(si);
+    if (mot_[s].x == const_x_[s] && radius_[s] == const_r_[s]) continue;
+    update_delta(s);
+    const Slice& sl = ls_[s];
+    for (std::int32_t l = sl.first; l < sl.first + sl.count; ++l) {
+      const std::size_t i = std::size_t(row_pos_[std::size_t(l)]);
+      row_geo_[i].delta = links_[std::size_t(l)].delta;
+      set_constants(row_item_[i], row_geo_[i], mot_[s]);
+    }
+    const_x_[s] = mot_[s].x;
+    const_r_[s] = radius_[s];
   }
 }
 
@@ -686,13 +741,24 @@ FF_LBM_INLINE void MovingBoundary<L, T>::apply_group_as(T* f, bool odd, std::int
   const Group& gr = groups_[std::size_t(g)];
   const Motion& m = mot_[std::size_t(gr.particle)];
   Vec3 F = Vec3::Zero(), M = Vec3::Zero();
+  const RowLink* items = row_item_.data();
+  const std::int64_t n_items = std::int64_t(row_item_.size());
   for (std::int64_t i = gr.first; i < gr.first + gr.count; ++i) {
-    const RowLink& k = row_item_[std::size_t(i)];
-    const int o = L::opp[k.q];
-    const double ag = exchange<kMoving>(f, odd, k, m);
+    // The sweep's streams crowd out the hardware prefetcher's: fetch the links some items ahead.
+    __builtin_prefetch(items + std::min(i + 12, n_items - 1), 0, 3);
+    const RowLink& h = items[i];
+    const RowGeometry& k = row_geo_[std::size_t(i)];  // (read only when moving)
+    const int o = L::opp[h.q];
+    const double ag = exchange<kMoving>(f, odd, h, k, m);
     const Vec3 Fl(L::c[o][0] * ag, L::c[o][1] * ag, L::D == 3 ? L::c[o][2] * ag : 0.0);
     F += Fl;
-    M += link_arm(k, m).cross(Fl);
+    if constexpr (kMoving) {
+      M += link_arm(k, h.q, m).cross(Fl);
+    } else if constexpr (L::D == 3) {
+      M += ag * Vec3(h.lever[0], h.lever[1], h.lever[2]);
+    } else {
+      M[2] += ag * h.lever[0];
+    }
   }
   // Each group its own entry (const: called from the sweep's threads).
   const_cast<Vec3&>(group_force_[std::size_t(g)]) = F;

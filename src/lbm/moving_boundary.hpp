@@ -173,14 +173,20 @@ class MovingBoundary {
   void place(V& arr, Slice& sl, std::int32_t need, std::vector<Slice>& all, V& spare, std::vector<std::int32_t>* par);
   void reset_cell(T* f, CellIndex c, bool edge, const Vec3& arm, const Motion& m, bool next) const;
   // Links by lattice row (Solver::bulk_sweep applies them row by row): per row a copy of what each
-  // link reads (links_ in row order would be a cache miss per link) and the particle it loads.
+  // link reads (links_ in row order would be a cache miss per link), in two parts: what a link of a
+  // particle at rest needs (RowLink: its constants, set_constants), and the geometry for the rest.
   struct RowLink {
     CellIndex node;
+    T a, b;                                // at rest: g_q(x, t + 1) = a A + b X
+    double lever[L::D == 3 ? 3 : 1];       // (x_w - X) x c_o (2D: its z)
+    std::uint8_t q, second;                // X: 0 = A, 1 = B = g*_q(x, t), 2 = C = g*_o(x + c_q, t)
+    bool edge, late;
+  };
+  struct RowGeometry {
     double delta;
     std::int32_t xu[3];  // the solid cell's unwrapped coordinates
     std::int32_t particle;
-    std::uint8_t q;
-    bool has_second, edge, late;
+    bool has_second;
   };
   // Consecutive links of one particle in one row: the unit the sweep applies and whose force and
   // torque it sums (items [first, first + count) of row_item_). Late: left to apply().
@@ -189,15 +195,19 @@ class MovingBoundary {
     std::int32_t count, particle;
     bool late;
   };
-  Vec3 link_arm(const RowLink& k, const Motion& m) const;  // wall point minus particle centre
+  Vec3 link_arm(const RowGeometry& k, int q, const Motion& m) const;  // wall point minus particle centre
+  void set_constants(RowLink& h, const RowGeometry& k, const Motion& m) const;
   template <bool kMoving>
-  double exchange(T* f, bool odd, const RowLink& k, const Motion& m) const;
+  double exchange(T* f, bool odd, const RowLink& h, const RowGeometry& k, const Motion& m) const;
   template <bool kMoving>
   void apply_group_as(T* f, bool odd, std::int64_t g) const;
   void apply_group(T* f, bool odd, std::int64_t g) const;
   void build_rows();  // row_item_, groups_ and their indices from the current links
   std::vector<std::int64_t> row_count_;   // per row, its first item (nrows + 1)
   std::vector<RowLink> row_item_;
+  std::vector<RowGeometry> row_geo_;      // parallel to row_item_
+  std::vector<Vec3> const_x_;             // per particle, the position and radius its links'
+  std::vector<double> const_r_;           // constants were set at
   std::vector<std::int32_t> row_pos_;     // per link index, its item
   std::vector<std::int64_t> link_row_, row_fill_;  // build_rows() scratch
   std::vector<Group> groups_;
