@@ -313,7 +313,6 @@ void MovingBoundary<L, T>::set_particles(const ParticleSet& p, T* f, bool odd, b
     links_.reserve(2 * links_.size() + 1024);
   }
   links_valid_ = true;
-  if (rows_epoch_ != links_epoch_) build_rows();
   stats_.solid_cells = long(ncells_);
   stats_.links = long(nlinks_);
   force_.assign(np, Vec3::Zero());
@@ -513,6 +512,17 @@ void MovingBoundary<L, T>::build_links(std::size_t s, const ParticleSet&) {
     }
     if (exposed) new_eoff_.push_back(i);
   }
+  // In node-row order (stable: scan order within a row): a particle's links in one lattice row are
+  // then one range of its slice, which apply() sums as the sweep's groups (build_rows).
+  // Insertion sort: stable, no allocation, and linear here (the scan is in cell rows, a node lies at
+  // most one row off its cell's).
+  for (std::size_t i = 1; i < new_links_.size(); ++i) {
+    const MovingLink k = new_links_[i];
+    const std::int64_t r = node_row(k);
+    std::size_t j = i;
+    for (; j > 0 && node_row(new_links_[j - 1]) > r; --j) new_links_[j] = new_links_[j - 1];
+    new_links_[j] = k;
+  }
   // Exposed cells: offsets into the cell slice, stored in eoff_ alongside it.
   ecount_[s] = std::int32_t(new_eoff_.size());
   std::copy(new_eoff_.begin(), new_eoff_.end(), eoff_.begin() + cl.first);
@@ -543,8 +553,18 @@ void MovingBoundary<L, T>::reset_cell(T* f, CellIndex c, bool edge, const Vec3& 
   }
 }
 
+// The lattice row (y + ny z) of a link's fluid node, from the solid cell's unwrapped coordinates
+// (no division).
 template <class L, class T>
-FF_LBM_INLINE Vec3 MovingBoundary<L, T>::link_arm(const RowGeometry& k, int q, const Motion& m) const {
+std::int64_t MovingBoundary<L, T>::node_row(const MovingLink& k) const {
+  const int y = wrap_axis(k.xu[1] + L::c[k.q][1], grid_.ny, grid_.periodic[1]);
+  const int z = L::D == 3 ? wrap_axis(k.xu[2] + L::c[k.q][2], grid_.nz, grid_.periodic[2]) : 0;
+  return std::int64_t(y) + std::int64_t(grid_.ny) * z;
+}
+
+template <class L, class T>
+template <class K>
+FF_LBM_INLINE Vec3 MovingBoundary<L, T>::link_arm(const K& k, int q, const Motion& m) const {
   const Vec3 c(L::c[q][0], L::c[q][1], L::D == 3 ? L::c[q][2] : 0);
   const Vec3 ay(k.xu[0] - m.x[0], k.xu[1] - m.x[1], L::D == 3 ? k.xu[2] - m.x[2] : 0.0);
   const Vec3 ax = ay + c;
@@ -555,7 +575,8 @@ FF_LBM_INLINE Vec3 MovingBoundary<L, T>::link_arm(const RowGeometry& k, int q, c
 // g = a A + b X (X = A, B or C; the same operations, so the same values), and the torque lever
 // (x_w - X) x c_o per unit of exchanged momentum.
 template <class L, class T>
-void MovingBoundary<L, T>::set_constants(RowLink& h, const RowGeometry& k, const Motion& m) const {
+template <class K>
+void MovingBoundary<L, T>::set_constants(RowLink& h, const K& k, const Motion& m) const {
   const T delta = T(k.delta);
   if (scheme_ != ParticleScheme::InterpolatedBounceBack || !k.has_second) {
     h.a = T(1);
@@ -584,9 +605,9 @@ void MovingBoundary<L, T>::set_constants(RowLink& h, const RowGeometry& k, const
 // and the momentum it exchanges along c_o, g*_o(x, t) + g_q(x, t + 1). At rest (kMoving false)
 // from the link's constants; moving, reflect() with the wall's velocity.
 template <class L, class T>
-template <bool kMoving>
-FF_LBM_INLINE double MovingBoundary<L, T>::exchange(T* f, bool odd, const RowLink& h, const RowGeometry& k,
-                                                   const Motion& m) const {
+template <bool kMoving, class H, class K>
+FF_LBM_INLINE double MovingBoundary<L, T>::exchange(T* f, bool odd, const H& h, const K& k, const Motion& m,
+                                                   const Vec3& arm) const {
   const bool next = !odd;
   const int q = h.q, o = L::opp[q];
   CellIndex sa, sb, sc, sd;
@@ -618,8 +639,7 @@ FF_LBM_INLINE double MovingBoundary<L, T>::exchange(T* f, bool odd, const RowLin
       B = f[sb];  // g*_q(x, t)
       C = f[sc];  // g*_o(x + c_q, t)
     }
-    // The wall point x_w - X and its velocity u_w = v + omega x (x_w - X).
-    const Vec3 arm = link_arm(k, q, m);
+    // The wall point x_w - X (arm) and its velocity u_w = v + omega x (x_w - X).
     const Vec3 ay(k.xu[0] - m.x[0], k.xu[1] - m.x[1], L::D == 3 ? k.xu[2] - m.x[2] : 0.0);
     const Vec3 uw = m.v + m.w.cross(arm);
     const T cu = T(L::c[q][0]) * T(uw[0]) + T(L::c[q][1]) * T(uw[1]) + T(L::c[q][2]) * T(L::D == 3 ? uw[2] : 0.0);
@@ -644,12 +664,7 @@ template <class L, class T>
 void MovingBoundary<L, T>::build_rows() {
   const std::int64_t nrows = std::int64_t(grid_.ny) * grid_.nz;
   auto bulk = [&](CellIndex c) { return fluid_[std::size_t(c)] == 2; };
-  // The fluid node's row from the solid cell's unwrapped coordinates (no division per link).
-  auto row_of = [&](const MovingLink& k) {
-    const int y = wrap_axis(k.xu[1] + L::c[k.q][1], grid_.ny, grid_.periodic[1]);
-    const int z = L::D == 3 ? wrap_axis(k.xu[2] + L::c[k.q][2], grid_.nz, grid_.periodic[2]) : 0;
-    return std::int64_t(y) + std::int64_t(grid_.ny) * z;
-  };
+  auto row_of = [&](const MovingLink& k) { return node_row(k); };
   std::vector<std::int64_t>& count = row_count_;
   count.assign(std::size_t(nrows) + 1, 0);
   link_row_.resize(links_.size());
@@ -735,6 +750,27 @@ void MovingBoundary<L, T>::prepare_rows() {
   }
 }
 
+// One link's share of its group's force and torque (the same operations in apply_group_as and in
+// apply()'s pass by particle: the results do not depend on which of them ran).
+template <class L, class T>
+template <bool kMoving, class H, class K>
+FF_LBM_INLINE void MovingBoundary<L, T>::add_link(T* f, bool odd, const H& h, const K& k, const Motion& m, Vec3& F,
+                                                  Vec3& M) const {
+  const int o = L::opp[h.q];
+  Vec3 arm = Vec3::Zero();
+  if constexpr (kMoving) arm = link_arm(k, h.q, m);
+  const double ag = exchange<kMoving, H, K>(f, odd, h, k, m, arm);
+  const Vec3 Fl(L::c[o][0] * ag, L::c[o][1] * ag, L::D == 3 ? L::c[o][2] * ag : 0.0);
+  F += Fl;
+  if constexpr (kMoving) {
+    M += arm.cross(Fl);
+  } else if constexpr (L::D == 3) {
+    M += ag * Vec3(h.lever[0], h.lever[1], h.lever[2]);
+  } else {
+    M[2] += ag * h.lever[0];
+  }
+}
+
 template <class L, class T>
 template <bool kMoving>
 FF_LBM_INLINE void MovingBoundary<L, T>::apply_group_as(T* f, bool odd, std::int64_t g) const {
@@ -746,23 +782,68 @@ FF_LBM_INLINE void MovingBoundary<L, T>::apply_group_as(T* f, bool odd, std::int
   for (std::int64_t i = gr.first; i < gr.first + gr.count; ++i) {
     // The sweep's streams crowd out the hardware prefetcher's: fetch the links some items ahead.
     __builtin_prefetch(items + std::min(i + 12, n_items - 1), 0, 3);
-    const RowLink& h = items[i];
-    const RowGeometry& k = row_geo_[std::size_t(i)];  // (read only when moving)
-    const int o = L::opp[h.q];
-    const double ag = exchange<kMoving>(f, odd, h, k, m);
-    const Vec3 Fl(L::c[o][0] * ag, L::c[o][1] * ag, L::D == 3 ? L::c[o][2] * ag : 0.0);
-    F += Fl;
-    if constexpr (kMoving) {
-      M += link_arm(k, h.q, m).cross(Fl);
-    } else if constexpr (L::D == 3) {
-      M += ag * Vec3(h.lever[0], h.lever[1], h.lever[2]);
-    } else {
-      M[2] += ag * h.lever[0];
-    }
+    add_link<kMoving>(f, odd, items[i], row_geo_[std::size_t(i)], m, F, M);
   }
   // Each group its own entry (const: called from the sweep's threads).
   const_cast<Vec3&>(group_force_[std::size_t(g)]) = F;
   const_cast<Vec3&>(group_torque_[std::size_t(g)]) = M;
+}
+
+// Particle s's links one node row at a time, after the sweep (no row index: a set that changed
+// within the last steps): each row's sum from zero in link order, the particle's the sum of the
+// rows' in row order, as apply_group_as and apply() do with the index.
+template <class L, class T>
+template <bool kMoving>
+void MovingBoundary<L, T>::particle_links(T* f, bool odd, std::size_t s, Vec3& F, Vec3& M) const {
+  const bool next = !odd;
+  const Motion& m = mot_[s];
+  const Slice& sl = ls_[s];
+  const std::int32_t end = sl.first + sl.count;
+  F = Vec3::Zero();
+  M = Vec3::Zero();
+  std::int64_t row = -1;
+  Vec3 Fg = Vec3::Zero(), Mg = Vec3::Zero();
+  for (std::int32_t l = sl.first; l < end; ++l) {
+    // The populations are far from cache (the sweep streamed the lattice since): fetch the two
+    // slots of a link some links ahead (they are the solid cell's and the fluid node's).
+    constexpr std::int32_t kAhead = 12;
+    if (l + kAhead < end) {
+      const MovingLink& a = links_[std::size_t(l + kAhead)];
+      if (!a.edge) {
+        __builtin_prefetch(f + a.node + post_off_[odd][L::opp[a.q]], 1);
+        __builtin_prefetch(f + a.node + pre_off_[next][a.q], 1);
+        if (scheme_ == ParticleScheme::InterpolatedBounceBack && a.has_second) {
+          __builtin_prefetch(f + a.node + post_off_[odd][a.q], 0);
+          __builtin_prefetch(f + a.node + cq_off_[a.q] + post_off_[odd][L::opp[a.q]], 0);
+        }
+      }
+    }
+    const MovingLink& k = links_[std::size_t(l)];
+    const std::int64_t r = node_row(k);
+    if (r != row) {
+      if (row >= 0) {
+        F += Fg;
+        M += Mg;
+      }
+      Fg = Vec3::Zero();
+      Mg = Vec3::Zero();
+      row = r;
+    }
+    if constexpr (kMoving) {
+      add_link<true>(f, odd, k, k, m, Fg, Mg);  // (a moving link reads no constants)
+    } else {
+      RowLink h;
+      h.node = k.node;
+      h.q = k.q;
+      h.edge = k.edge;
+      set_constants(h, k, m);
+      add_link<false>(f, odd, h, k, m, Fg, Mg);
+    }
+  }
+  if (row >= 0) {
+    F += Fg;
+    M += Mg;
+  }
 }
 
 template <class L, class T>
@@ -782,7 +863,53 @@ template <class L, class T>
 void MovingBoundary<L, T>::apply(T* f, bool odd, const std::vector<std::pair<std::int64_t, std::int64_t>>& inline_rows) {
   const bool next = !odd;
   const std::int64_t np = std::int64_t(np_);
-  if (rows_epoch_ != links_epoch_) build_rows();
+  if (!rows_ready()) {
+    // No row index (the links changed within the last steps): particle by particle.
+    // Parallel only above 8192 items (a link or a reset costs about a cell update): on a loaded
+    // machine a parallel region per step made a 24^3 case with 3000 links 35 times slower.
+#pragma omp parallel for schedule(static) if (nlinks_ > 8192)
+    for (std::int64_t s = 0; s < np; ++s) {
+      update_delta(std::size_t(s));
+      const Motion& m = mot_[std::size_t(s)];
+      if (m.v != Vec3::Zero() || m.w != Vec3::Zero())
+        particle_links<true>(f, odd, std::size_t(s), lforce_[std::size_t(s)], ltorque_[std::size_t(s)]);
+      else
+        particle_links<false>(f, odd, std::size_t(s), lforce_[std::size_t(s)], ltorque_[std::size_t(s)]);
+    }
+  } else {
+    apply_groups(f, odd, inline_rows);
+  }
+  // Exposed solid cells: f^eq(1, u_s) in all the slots they read next step (after the links: they
+  // read slots that this overwrites).
+#pragma omp parallel for schedule(static) if (ncells_ > 8192)
+  for (std::int64_t s = 0; s < np; ++s) {
+    const Slice& sl = cs_[std::size_t(s)];
+    const Motion& m = mot_[std::size_t(s)];
+    const std::int32_t ne = reset_all_ ? sl.count : ecount_[std::size_t(s)];
+    for (std::int32_t e = 0; e < ne; ++e) {
+      const SolidCell& sc = cells_[std::size_t(sl.first + (reset_all_ ? e : eoff_[std::size_t(sl.first + e)]))];
+      const Vec3 arm(sc.xu[0] - m.x[0], sc.xu[1] - m.x[1], L::D == 3 ? sc.xu[2] - m.x[2] : 0.0);
+      reset_cell(f, sc.cell, sc.edge, arm, m, next);
+    }
+  }
+  // Cells covered since the last step: once (they held fluid).
+  for (const CellIndex c : pending_) {
+    const std::int32_t o = owner_[std::size_t(c)];
+    if (o >= 0) reset_cell(f, c, on_edge(c), arm_of(c, std::size_t(o), mot_), mot_[std::size_t(o)], next);
+  }
+  pending_.clear();
+  applied_ = true;
+  // Links that stood for two steps get their row index (its build costs a few steps' links; a set
+  // that changes every step never pays it): the sweep applies them from the next step on.
+  stood_ = applied_epoch_ == links_epoch_ ? stood_ + 1 : 0;
+  applied_epoch_ = links_epoch_;
+  if (stood_ >= 2 && !rows_ready()) build_rows();
+}
+
+// With the row index: the groups the sweep did not apply, then each particle's sum.
+template <class L, class T>
+void MovingBoundary<L, T>::apply_groups(T* f, bool odd, const std::vector<std::pair<std::int64_t, std::int64_t>>& inline_rows) {
+  const std::int64_t np = std::int64_t(np_);
   if (inline_rows.empty()) prepare_rows();  // (the sweep did when it applied rows)
   // 1. The links the sweep did not apply (apply_rows): every group of the rows outside
   //    inline_rows, the late groups inside them. Each link writes slots only it touches.
@@ -818,26 +945,6 @@ void MovingBoundary<L, T>::apply(T* f, bool odd, const std::vector<std::pair<std
     lforce_[std::size_t(s)] = F;
     ltorque_[std::size_t(s)] = M;
   }
-  // 3. Exposed solid cells: f^eq(1, u_s) in all the slots they read next step (after the links:
-  //    they read slots that this overwrites).
-#pragma omp parallel for schedule(static) if (ncells_ > 8192)
-  for (std::int64_t s = 0; s < np; ++s) {
-    const Slice& sl = cs_[std::size_t(s)];
-    const Motion& m = mot_[std::size_t(s)];
-    const std::int32_t ne = reset_all_ ? sl.count : ecount_[std::size_t(s)];
-    for (std::int32_t e = 0; e < ne; ++e) {
-      const SolidCell& sc = cells_[std::size_t(sl.first + (reset_all_ ? e : eoff_[std::size_t(sl.first + e)]))];
-      const Vec3 arm(sc.xu[0] - m.x[0], sc.xu[1] - m.x[1], L::D == 3 ? sc.xu[2] - m.x[2] : 0.0);
-      reset_cell(f, sc.cell, sc.edge, arm, m, next);
-    }
-  }
-  // Cells covered since the last step: once (they held fluid).
-  for (const CellIndex c : pending_) {
-    const std::int32_t o = owner_[std::size_t(c)];
-    if (o >= 0) reset_cell(f, c, on_edge(c), arm_of(c, std::size_t(o), mot_), mot_[std::size_t(o)], next);
-  }
-  pending_.clear();
-  applied_ = true;
 }
 
 template <class L, class T>

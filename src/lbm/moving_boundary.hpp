@@ -117,7 +117,8 @@ class MovingBoundary {
   // sweep) or a link round a periodic edge wait for apply(), as do the rows at the ends of each
   // thread's block. Each particle's load is the sum of its groups' in row order: the same on any
   // thread count, whichever rows the sweep applied, and after a resume.
-  bool rows_ready() const { return active() && rows_epoch_ == links_epoch_; }  // (set_particles builds them)
+  // The row index is built (apply(), once the links stood for two steps): the sweep may apply them.
+  bool rows_ready() const { return active() && rows_epoch_ == links_epoch_; }
   std::int64_t row_lag() const { return L::D == 3 ? std::int64_t(grid_.ny) + 1 : 1; }
   void prepare_rows();                                             // before the sweep: Bouzidi fractions
   void apply_rows(T* f, bool odd, std::int64_t r0, std::int64_t r1) const;  // links of rows [r0, r1)
@@ -195,10 +196,19 @@ class MovingBoundary {
     std::int32_t count, particle;
     bool late;
   };
-  Vec3 link_arm(const RowGeometry& k, int q, const Motion& m) const;  // wall point minus particle centre
-  void set_constants(RowLink& h, const RowGeometry& k, const Motion& m) const;
+  // K: a RowGeometry or a MovingLink (delta, xu, has_second); H: a RowLink or a MovingLink (node, q, edge).
+  template <class K>
+  Vec3 link_arm(const K& k, int q, const Motion& m) const;  // wall point minus particle centre
+  template <class K>
+  void set_constants(RowLink& h, const K& k, const Motion& m) const;
+  template <bool kMoving, class H, class K>
+  double exchange(T* f, bool odd, const H& h, const K& k, const Motion& m, const Vec3& arm) const;
+  template <bool kMoving, class H, class K>
+  void add_link(T* f, bool odd, const H& h, const K& k, const Motion& m, Vec3& F, Vec3& M) const;
   template <bool kMoving>
-  double exchange(T* f, bool odd, const RowLink& h, const RowGeometry& k, const Motion& m) const;
+  void particle_links(T* f, bool odd, std::size_t s, Vec3& F, Vec3& M) const;
+  void apply_groups(T* f, bool odd, const std::vector<std::pair<std::int64_t, std::int64_t>>& inline_rows);
+  std::int64_t node_row(const MovingLink& k) const;  // the lattice row of its fluid node
   template <bool kMoving>
   void apply_group_as(T* f, bool odd, std::int64_t g) const;
   void apply_group(T* f, bool odd, std::int64_t g) const;
@@ -216,7 +226,8 @@ class MovingBoundary {
   std::vector<std::int32_t> part_group_;
   std::vector<Vec3> group_force_, group_torque_;
   std::vector<std::int64_t> todo_;        // apply(): the groups left to it
-  std::uint64_t links_epoch_ = 1, rows_epoch_ = 0;
+  std::uint64_t links_epoch_ = 1, rows_epoch_ = 0, applied_epoch_ = 0;
+  int stood_ = 0;  // apply() calls in a row with the same links
 
   Grid grid_;
   ParticleScheme scheme_;
