@@ -31,8 +31,8 @@
 //   set   the part of coup before the LBM step (times.coupling alone);
 //   c/L   coup / LBM: the target is c/L <= 1.
 // "cells" is the cells the set covers (PSM: cells with a solid fraction; bounce-back: solid cells),
-// "chg" the cells that changed between solid and fluid per step and "links" the fluid-solid links
-// (bounce-back schemes).
+// "chg" the cells that changed between solid and fluid per step, "links" the fluid-solid links
+// (bounce-back schemes) and "sets" the sets handed over per 100 steps (every step but in creep).
 // Every configuration is run with the same number of steps on each thread count; "hash" combines
 // the DEM positions and the fluid populations at the end, and `same` says whether 1 and 2 threads
 // gave bit-identical results.
@@ -198,7 +198,7 @@ Rock make_rock(int dim, bool quick) {
 
 struct Result {
   double lbm = 0, lbm_part = 0, set = 0, coup = 0, dem = 0;
-  double cells = 0, changed = 0, links = 0;
+  double cells = 0, changed = 0, links = 0, sets = 0;
   std::uint64_t hash = 0;
   long sub = 0;
 };
@@ -270,6 +270,7 @@ Result run_config(const Rock& rock, const std::string& scheme, const std::string
   r.sub = cp.sub_steps();
   std::vector<double> vl, vp, vs, vc, vd;
   double cells = 0, changed = 0, links = 0;
+  const long sets0 = cp.handovers();
   for (long done = 0; done < steps;) {
     const long nb = std::min(block, steps - done);
     const coupling::CouplerTimes t0 = cp.times;
@@ -304,6 +305,7 @@ Result run_config(const Rock& rock, const std::string& scheme, const std::string
   r.cells = cells / double(steps);
   r.changed = changed / double(steps);
   r.links = links / double(steps);
+  r.sets = 100.0 * double(cp.handovers() - sets0) / double(steps);
   const auto& P = dem.particles.pos;
   r.hash = fnv(P.data(), P.size() * sizeof(Vec3));
   const auto& f = fluid.populations();
@@ -371,9 +373,9 @@ int main(int argc, char** argv) {
     fmt::print("\n{}D: {} lattice {}^{} cells, {} bonded particles, {} bonds (built in {:.1f} s)\n", dim,
                dim == 2 ? "D2Q9" : "D3Q19", rock.n, dim, rock.dem.particles.size(), rock.dem.bonds.size(),
                seconds_since(t0));
-    fmt::print("{:<7} {:<5} {:>3} {:>4} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9} {:>6} {:>9} {:>8} {:>9}  {:<16} {}\n",
+    fmt::print("{:<7} {:<5} {:>3} {:>4} {:>8} {:>8} {:>8} {:>8} {:>8} {:>9} {:>6} {:>9} {:>8} {:>9} {:>6}  {:<16} {}\n",
                "scheme", "move", "thr", "sub", "LBM", "coup", "set", "DEM", "total", "LBM+part", "c/L", "cells", "chg",
-               "links", "hash", "same");
+               "links", "sets", "hash", "same");
     for (const std::string scheme : {"psm", "psm-r", "stair", "interp"}) {
       if (!o.scheme.empty() && scheme != o.scheme) continue;
       for (const std::string motion : {"slow", "fast", "creep"}) {
@@ -385,9 +387,10 @@ int main(int argc, char** argv) {
                                     : run_config<lbm::D3Q19>(rock, scheme, motion, o.threads[ti], o, steps, block);
           if (ti == 0) first = r.hash;
           fmt::print("{:<7} {:<5} {:>3} {:>4} {:>8.2f} {:>8.2f} {:>8.2f} {:>8.2f} {:>8.2f} {:>9.2f} {:>6.2f} {:>9.0f} "
-                     "{:>8.0f} {:>9.0f}  {:016x} {}\n",
+                     "{:>8.0f} {:>9.0f} {:>6.1f}  {:016x} {}\n",
                      scheme, motion, o.threads[ti], r.sub, 1e3 * r.lbm, 1e3 * r.coup, 1e3 * r.set, 1e3 * r.dem,
-                     1e3 * (r.lbm + r.coup + r.dem), 1e3 * r.lbm_part, r.coup / r.lbm, r.cells, r.changed, r.links, r.hash,
+                     1e3 * (r.lbm + r.coup + r.dem), 1e3 * r.lbm_part, r.coup / r.lbm, r.cells, r.changed, r.links,
+                     r.sets, r.hash,
                      ti == 0 ? "-" : (r.hash == first ? "yes" : "NO"));
           std::fflush(stdout);
         }

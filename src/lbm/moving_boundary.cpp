@@ -514,14 +514,21 @@ void MovingBoundary<L, T>::build_links(std::size_t s, const ParticleSet&) {
   }
   // In node-row order (stable: scan order within a row): a particle's links in one lattice row are
   // then one range of its slice, which apply() sums as the sweep's groups (build_rows).
-  // Insertion sort: stable, no allocation, and linear here (the scan is in cell rows, a node lies at
-  // most one row off its cell's).
-  for (std::size_t i = 1; i < new_links_.size(); ++i) {
-    const MovingLink k = new_links_[i];
-    const std::int64_t r = node_row(k);
-    std::size_t j = i;
-    for (; j > 0 && node_row(new_links_[j - 1]) > r; --j) new_links_[j] = new_links_[j - 1];
-    new_links_[j] = k;
+  // A stable counting sort over the rows the particle's links span (scratch kept between calls: no
+  // allocation once grown; periodic wraps make that span the whole axis at worst).
+  if (!new_links_.empty()) {
+    std::int64_t lo = node_row(new_links_[0]), hi = lo;
+    for (const MovingLink& k : new_links_) {
+      const std::int64_t r = node_row(k);
+      lo = std::min(lo, r);
+      hi = std::max(hi, r);
+    }
+    sort_count_.assign(std::size_t(hi - lo + 2), 0);
+    for (const MovingLink& k : new_links_) ++sort_count_[std::size_t(node_row(k) - lo) + 1];
+    for (std::size_t i = 1; i < sort_count_.size(); ++i) sort_count_[i] += sort_count_[i - 1];
+    sorted_links_.resize(new_links_.size());
+    for (const MovingLink& k : new_links_) sorted_links_[std::size_t(sort_count_[std::size_t(node_row(k) - lo)]++)] = k;
+    new_links_.swap(sorted_links_);
   }
   // Exposed cells: offsets into the cell slice, stored in eoff_ alongside it.
   ecount_[s] = std::int32_t(new_eoff_.size());

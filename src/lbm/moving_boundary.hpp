@@ -34,10 +34,10 @@
 // and are streamed and collided like fluid (garbage in, garbage out), which keeps the kernel
 // branch-free; each link writes its reflected population into the slot its fluid cell reads in the
 // next step and replaces the population the fluid cell sent into the wall, which the solid cell
-// reads next, by g^eq_o(1, u_s) (cost proportional to links). The links are applied by lattice row
-// inside the bulk sweep, a few rows behind it, while those rows' populations are still in cache
-// (apply_rows; a post-pass after the sweep found them in memory and cost 3 LBM steps on the 2D
-// benchmark's 593,000 links); the rest in apply();
+// reads next, by g^eq_o(1, u_s) (cost proportional to links). Links that stood for two steps are
+// applied by lattice row inside the bulk sweep, a few rows behind it, while those rows' populations
+// are still in cache (apply_rows; after the sweep they are in memory: that pass cost 3 LBM steps on
+// the 2D benchmark's 593,000 links, the sweep's 1.5); the others, and a changing set's, in apply();
 // the cells just covered, and those next to a static solid or the lattice's edge, get f^eq(1, u_s)
 // in every slot (with a body force, every solid cell: set_reset_all()). The other inputs of a
 // solid cell come from solid cells, near f^eq(1, u_s)
@@ -102,9 +102,9 @@ class MovingBoundary {
   // New particle set before a step of parity `odd` on populations f. bookkeeping = false only
   // rebuilds the solid cells and links of a set (resume): no covering, no refill.
   void set_particles(const ParticleSet& p, T* f, bool odd, bool bookkeeping);
-  // Post-pass after the sweeps of a step of parity `odd`: reflected populations of every link,
-  // then the solid cells' reset. Then reduce() sums the per-particle loads in a fixed order.
-  // `inline_rows`: the lattice rows whose links the bulk sweep already applied (apply_rows), one
+  // After the sweeps of a step of parity `odd`: reflected populations of every link the sweep did
+  // not apply, then the solid cells' reset. Then reduce() sums the per-particle loads in a fixed
+  // order. `inline_rows`: the lattice rows whose links the bulk sweep applied (apply_rows), one
   // range per thread; empty when it applied none (then every link is applied here).
   void apply(T* f, bool odd, const std::vector<std::pair<std::int64_t, std::int64_t>>& inline_rows = {});
   void reduce();
@@ -115,12 +115,15 @@ class MovingBoundary {
   // in 2D, ny + 1 in 3D). Links are grouped per row and particle (a group: one particle's links in
   // one row); groups with a cell that is not a bulk cell (boundary cells are updated after the
   // sweep) or a link round a periodic edge wait for apply(), as do the rows at the ends of each
-  // thread's block. Each particle's load is the sum of its groups' in row order: the same on any
-  // thread count, whichever rows the sweep applied, and after a resume.
+  // thread's block. Each particle's load is the sum of its groups' in row order, each group's from
+  // zero in link order, and apply() without the index sums a particle's links the same way (its
+  // slice is in node-row order): the same on any thread count, whichever rows the sweep applied,
+  // and after a resume. A link of a particle at rest reads constants kept while the particle keeps
+  // its place (reflect()'s coefficients and the torque lever; apply() computes them the same way).
   // The row index is built (apply(), once the links stood for two steps): the sweep may apply them.
   bool rows_ready() const { return active() && rows_epoch_ == links_epoch_; }
   std::int64_t row_lag() const { return L::D == 3 ? std::int64_t(grid_.ny) + 1 : 1; }
-  void prepare_rows();                                             // before the sweep: Bouzidi fractions
+  void prepare_rows();  // before the sweep: fractions and constants of the particles that moved
   void apply_rows(T* f, bool odd, std::int64_t r0, std::int64_t r1) const;  // links of rows [r0, r1)
   // With a body force the solid cells' own collision drives them: every solid cell is then reset
   // each step (as the links alone keep them near f^eq(1, u_s) only without one). Set by the solver.
@@ -253,6 +256,8 @@ class MovingBoundary {
   std::vector<MovingLink> links_, links_spare_;
   std::vector<SolidCell> scan_;               // scratch: one particle's scan
   std::vector<MovingLink> new_links_;         // scratch: one particle's links
+  std::vector<MovingLink> sorted_links_;      // scratch: them in node-row order
+  std::vector<std::int32_t> sort_count_;      // scratch: per row of the particle's span
   std::vector<std::int32_t> new_eoff_;
   std::vector<CellIndex> covered_, released_, pending_;  // pending_: covered cells to reset once
   std::size_t ncells_ = 0, nlinks_ = 0;
