@@ -910,7 +910,7 @@ void MovingBoundary<L, T>::apply(T* f, bool odd, const std::vector<std::pair<std
   // that changes every step never pays it): the sweep applies them from the next step on.
   stood_ = applied_epoch_ == links_epoch_ ? stood_ + 1 : 0;
   applied_epoch_ = links_epoch_;
-  if (stood_ >= 2 && !rows_ready()) build_rows();
+  if (stood_ >= 2 && !rows_ready() && row_index_) build_rows();
 }
 
 // With the row index: the groups the sweep did not apply, then each particle's sum.

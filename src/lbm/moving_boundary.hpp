@@ -122,6 +122,11 @@ class MovingBoundary {
   // its place (reflect()'s coefficients and the torque lever; apply() computes them the same way).
   // The row index is built (apply(), once the links stood for two steps): the sweep may apply them.
   bool rows_ready() const { return active() && rows_epoch_ == links_epoch_; }
+  // false: no row index, every link after the sweep (the same results, slower: for tests).
+  void set_row_index(bool on) {
+    row_index_ = on;
+    if (!on) rows_epoch_ = 0;
+  }
   std::int64_t row_lag() const { return L::D == 3 ? std::int64_t(grid_.ny) + 1 : 1; }
   void prepare_rows();  // before the sweep: fractions and constants of the particles that moved
   void apply_rows(T* f, bool odd, std::int64_t r0, std::int64_t r1) const;  // links of rows [r0, r1)
@@ -231,6 +236,7 @@ class MovingBoundary {
   std::vector<std::int64_t> todo_;        // apply(): the groups left to it
   std::uint64_t links_epoch_ = 1, rows_epoch_ = 0, applied_epoch_ = 0;
   int stood_ = 0;  // apply() calls in a row with the same links
+  bool row_index_ = true;
 
   Grid grid_;
   ParticleScheme scheme_;

@@ -437,6 +437,7 @@ void Solver<L, T>::moving_particles(const ParticleSet& p, bool bookkeeping) {
     psm_kinds_stale_ = false;
   }
   mb_->set_reset_all(settings_.body_force.squaredNorm() > 0);
+  mb_->set_row_index(settings_.links_in_sweep);
   mb_->set_particles(p, f_.data(), (time_ & 1) != 0, bookkeeping);
 }
 

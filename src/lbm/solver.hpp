@@ -76,6 +76,10 @@ struct SolverSettings {
   // PSM: keep the solid fractions while every particle stays within this many cells of where they
   // were computed (0: recompute at every set_particles; Psm::set_particles).
   double psm_refresh = 0;
+  // Bounce-back schemes: links that stood for two steps are applied inside the bulk sweep
+  // (MovingBoundary, "Links inside the bulk sweep"); false: always after it (the same results,
+  // slower: for tests).
+  bool links_in_sweep = true;
 };
 
 // A solid body (or a wall of the box) and the hydrodynamic load on it.
