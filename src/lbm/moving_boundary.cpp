@@ -920,7 +920,8 @@ void MovingBoundary<L, T>::apply_groups(T* f, bool odd, const std::vector<std::p
   if (inline_rows.empty()) prepare_rows();  // (the sweep did when it applied rows)
   // 1. The links the sweep did not apply (apply_rows): every group of the rows outside
   //    inline_rows, the late groups inside them. Each link writes slots only it touches.
-  std::vector<std::pair<std::int64_t, std::int64_t>> done;
+  std::vector<std::pair<std::int64_t, std::int64_t>>& done = done_rows_;  // (kept: no allocation per step)
+  done.clear();
   for (const auto& d : inline_rows)
     if (d.first < d.second) done.push_back(d);
   std::sort(done.begin(), done.end());

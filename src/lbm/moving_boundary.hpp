@@ -234,6 +234,7 @@ class MovingBoundary {
   std::vector<std::int32_t> part_group_;
   std::vector<Vec3> group_force_, group_torque_;
   std::vector<std::int64_t> todo_;        // apply(): the groups left to it
+  std::vector<std::pair<std::int64_t, std::int64_t>> done_rows_;  // apply(): the sweep's rows, sorted
   std::uint64_t links_epoch_ = 1, rows_epoch_ = 0, applied_epoch_ = 0;
   int stood_ = 0;  // apply() calls in a row with the same links
   bool row_index_ = true;
