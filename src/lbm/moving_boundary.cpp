@@ -1,5 +1,5 @@
-// Moving solid cells: covering, refill, links and the bounce-back post-pass (moving_boundary.hpp
-// has the equations and their sources).
+// Moving solid cells: covering, refill, links and their bounce-back, in the sweep by row or after it
+// (moving_boundary.hpp has the equations and their sources).
 #include "lbm/moving_boundary.hpp"
 
 #include <fmt/format.h>
