@@ -468,15 +468,14 @@ double MovingBoundary<L, T>::link_delta(const MovingLink& k, const Motion& m, do
 
 // The Bouzidi fractions of particle s's links at its current position and radius (once per move).
 template <class L, class T>
-bool MovingBoundary<L, T>::update_delta(std::size_t s) {
-  if (scheme_ != ParticleScheme::InterpolatedBounceBack) return false;
-  if (mot_[s].x == delta_x_[s] && radius_[s] == delta_r_[s]) return false;
+void MovingBoundary<L, T>::update_delta(std::size_t s) {
+  if (scheme_ != ParticleScheme::InterpolatedBounceBack) return;
+  if (mot_[s].x == delta_x_[s] && radius_[s] == delta_r_[s]) return;
   const Slice& sl = ls_[s];
   for (std::int32_t l = sl.first; l < sl.first + sl.count; ++l)
     links_[std::size_t(l)].delta = link_delta(links_[std::size_t(l)], mot_[s], radius_[s]);
   delta_x_[s] = mot_[s].x;
   delta_r_[s] = radius_[s];
-  return true;
 }
 
 // Links from the fluid cells around every solid cell of particle s, in cell order then direction
@@ -671,7 +670,6 @@ template <class L, class T>
 void MovingBoundary<L, T>::build_rows() {
   const std::int64_t nrows = std::int64_t(grid_.ny) * grid_.nz;
   auto bulk = [&](CellIndex c) { return fluid_[std::size_t(c)] == 2; };
-  auto row_of = [&](const MovingLink& k) { return node_row(k); };
   std::vector<std::int64_t>& count = row_count_;
   count.assign(std::size_t(nrows) + 1, 0);
   link_row_.resize(links_.size());
@@ -679,7 +677,7 @@ void MovingBoundary<L, T>::build_rows() {
   for (std::size_t s = 0; s < np_; ++s) {
     const Slice& sl = ls_[s];
     for (std::int32_t l = sl.first; l < sl.first + sl.count; ++l) {
-      const std::int64_t r = row_of(links_[std::size_t(l)]);
+      const std::int64_t r = node_row(links_[std::size_t(l)]);
       link_row_[std::size_t(l)] = r;
       ++count[std::size_t(r) + 1];
     }
@@ -856,7 +854,7 @@ void MovingBoundary<L, T>::particle_links(T* f, bool odd, std::size_t s, Vec3& F
 template <class L, class T>
 FF_LBM_INLINE void MovingBoundary<L, T>::apply_group(T* f, bool odd, std::int64_t g) const {
   const Motion& m = mot_[std::size_t(groups_[std::size_t(g)].particle)];
-  if (m.v != Vec3::Zero() || m.w != Vec3::Zero()) apply_group_as<true>(f, odd, g);
+  if (m.moves()) apply_group_as<true>(f, odd, g);
   else apply_group_as<false>(f, odd, g);  // a particle at rest: no moving-wall term
 }
 
@@ -878,7 +876,7 @@ void MovingBoundary<L, T>::apply(T* f, bool odd, const std::vector<std::pair<std
     for (std::int64_t s = 0; s < np; ++s) {
       update_delta(std::size_t(s));
       const Motion& m = mot_[std::size_t(s)];
-      if (m.v != Vec3::Zero() || m.w != Vec3::Zero())
+      if (m.moves())
         particle_links<true>(f, odd, std::size_t(s), lforce_[std::size_t(s)], ltorque_[std::size_t(s)]);
       else
         particle_links<false>(f, odd, std::size_t(s), lforce_[std::size_t(s)], ltorque_[std::size_t(s)]);
@@ -926,21 +924,21 @@ void MovingBoundary<L, T>::apply_groups(T* f, bool odd, const std::vector<std::p
     if (d.first < d.second) done.push_back(d);
   std::sort(done.begin(), done.end());
   const std::int64_t nrows = std::int64_t(row_group_.size()) - 1;
-  todo_.clear();
+  deferred_groups_.clear();
   std::int64_t r = 0;
   auto all_of = [&](std::int64_t a, std::int64_t b) {
-    for (std::int64_t g = row_group_[std::size_t(a)]; g < row_group_[std::size_t(b)]; ++g) todo_.push_back(g);
+    for (std::int64_t g = row_group_[std::size_t(a)]; g < row_group_[std::size_t(b)]; ++g) deferred_groups_.push_back(g);
   };
   for (const auto& [a, b] : done) {
     if (r < a) all_of(r, a);
     for (std::int64_t g = row_group_[std::size_t(a)]; g < row_group_[std::size_t(b)]; ++g)
-      if (groups_[std::size_t(g)].late) todo_.push_back(g);
+      if (groups_[std::size_t(g)].late) deferred_groups_.push_back(g);
     r = std::max(r, b);
   }
   if (r < nrows) all_of(r, nrows);
-  const std::int64_t nt = std::int64_t(todo_.size());
+  const std::int64_t nt = std::int64_t(deferred_groups_.size());
 #pragma omp parallel for schedule(dynamic, 256) if (nt > 4096)
-  for (std::int64_t i = 0; i < nt; ++i) apply_group(f, odd, todo_[std::size_t(i)]);
+  for (std::int64_t i = 0; i < nt; ++i) apply_group(f, odd, deferred_groups_[std::size_t(i)]);
   // 2. Each particle's load: its groups' sums in row order (the same on any thread count and
   //    whichever rows the sweep applied).
 #pragma omp parallel for schedule(static) if (nlinks_ > 8192)

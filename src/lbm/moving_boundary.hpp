@@ -164,6 +164,7 @@ class MovingBoundary {
   };
   struct Motion {
     Vec3 x, v, w;  // centre, velocity, angular velocity (2D: z only)
+    bool moves() const { return v != Vec3::Zero() || w != Vec3::Zero(); }  // (as Psm's Kinematics)
   };
   CellIndex pre(const int* x, int q, bool odd) const;   // slot g_q is read from in a step of parity odd
   CellIndex post(const int* x, int q, bool odd) const;  // slot g*_q is written to
@@ -175,7 +176,7 @@ class MovingBoundary {
   void scan(std::size_t s, const ParticleSet& p);
   void claim(std::size_t s);  // ownership of scan_ for particle s; updates its slice when it changed
   void build_links(std::size_t s, const ParticleSet& p);  // links and exposed cells of particle s
-  bool update_delta(std::size_t s);  // per particle, in parallel; true if the fractions changed
+  void update_delta(std::size_t s);  // per particle, in parallel
   double link_delta(const MovingLink& k, const Motion& m, double r) const;
   void mark_dirty(CellIndex changed);  // particles whose links may see a changed cell
   template <class V>
@@ -233,7 +234,7 @@ class MovingBoundary {
   std::vector<std::int64_t> part_group_first_;  // per particle its groups in part_group_ (row order)
   std::vector<std::int32_t> part_group_;
   std::vector<Vec3> group_force_, group_torque_;
-  std::vector<std::int64_t> todo_;        // apply(): the groups left to it
+  std::vector<std::int64_t> deferred_groups_;  // apply(): the groups the sweep left to it
   std::vector<std::pair<std::int64_t, std::int64_t>> done_rows_;  // apply(): the sweep's rows, sorted
   std::uint64_t links_epoch_ = 1, rows_epoch_ = 0, applied_epoch_ = 0;
   int stood_ = 0;  // apply() calls in a row with the same links

@@ -191,8 +191,7 @@ double Solver<L, T>::max_speed() const {
     if (std::isnan(u2) || std::isnan(double(drho_[i]))) nan = true;
     else m = std::max(m, u2);
   };
-  for (auto& s : spans_)
-    for (int k = 0; k < s.n; ++k) visit(grid_.index(s.x0 + k, s.y, s.z));
+  for_each_bulk_cell([&](CellIndex i, std::size_t) { visit(i); });
   for (auto& b : bcells_) visit(b.cell);
   return nan ? std::nan("") : std::sqrt(m);
 }
@@ -431,8 +430,7 @@ void Solver<L, T>::moving_particles(const ParticleSet& p, bool bookkeeping) {
   if (psm_kinds_stale_) {
     std::vector<std::uint8_t> fluid(std::size_t(n_()), 0);
     for (std::size_t i = 0; i < fluid.size(); ++i) fluid[i] = type_[i] == CellType::Fluid;
-    for (const Span& s : spans_)
-      for (int k = 0; k < s.n; ++k) fluid[std::size_t(grid_.index(s.x0 + k, s.y, s.z))] = 2;  // bulk cells
+    for_each_bulk_cell([&](CellIndex i, std::size_t) { fluid[std::size_t(i)] = 2; });  // bulk cells
     mb_->set_fluid_mask(std::move(fluid));
     psm_kinds_stale_ = false;
   }
@@ -470,9 +468,7 @@ void Solver<L, T>::prepare_psm() {
   }
   if (psm_kinds_stale_) {
     std::vector<std::int32_t> span_of(std::size_t(n_()), Psm<L, T>::kNotFluid);
-    for (std::size_t s = 0; s < spans_.size(); ++s)
-      for (int k = 0; k < spans_[s].n; ++k)
-        span_of[std::size_t(grid_.index(spans_[s].x0 + k, spans_[s].y, spans_[s].z))] = std::int32_t(s);
+    for_each_bulk_cell([&](CellIndex i, std::size_t s) { span_of[std::size_t(i)] = std::int32_t(s); });
     for (const BoundaryCell& b : bcells_) span_of[std::size_t(b.cell)] = Psm<L, T>::kBoundaryCell;
     psm_->set_cell_spans(std::move(span_of), spans_.size());
     psm_kinds_stale_ = false;

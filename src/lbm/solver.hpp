@@ -241,6 +241,12 @@ class Solver {
   // The rows whose particle links the last bulk sweep applied (MovingBoundary::apply_rows), per thread.
   std::vector<std::pair<std::int64_t, std::int64_t>> mb_inline_rows_;
   std::vector<std::int64_t> row_span_;  // per lattice row (y + ny z), its first span; nrows + 1 entries
+  // f(cell, span) for every bulk cell, span by span in lattice order.
+  template <class F>
+  void for_each_bulk_cell(F&& f) const {
+    for (std::size_t s = 0; s < spans_.size(); ++s)
+      for (int k = 0; k < spans_[s].n; ++k) f(grid_.index(spans_[s].x0 + k, spans_[s].y, spans_[s].z), s);
+  }
   void moving_particles(const ParticleSet& p, bool bookkeeping);
   void prepare_psm();  // creates the PSM and (re)classifies its cells
   bool psm_kinds_stale_ = true;        // finalize() changed the cell classification

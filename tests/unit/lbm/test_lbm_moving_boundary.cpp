@@ -67,6 +67,20 @@ Solver<L, double> box(int nx, int ny, int nz, ParticleScheme scheme, bool walls_
   return sol;
 }
 
+// a and b hold the same populations and particle loads, bit for bit.
+template <class L>
+void expect_identical(const Solver<L, double>& a, const Solver<L, double>& b, const std::string& what) {
+  const auto& fa = a.populations();
+  ASSERT_EQ(fa.size(), b.populations().size()) << what;
+  for (std::size_t i = 0; i < fa.size(); ++i) ASSERT_EQ(fa[i], b.populations()[i]) << what << ", slot " << i;
+  ASSERT_EQ(a.particle_forces().size(), b.particle_forces().size()) << what;
+  for (std::size_t s = 0; s < a.particle_forces().size(); ++s)
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_EQ(a.particle_forces()[s][k], b.particle_forces()[s][k]) << what << ", particle " << s;
+      ASSERT_EQ(a.particle_torques()[s][k], b.particle_torques()[s][k]) << what << ", particle " << s;
+    }
+}
+
 // Three particles, two of them overlapping (bonded grains touch), moving and spinning fast enough
 // to cover and uncover cells every few steps.
 ParticleSet moving_set(int dim, double t) {
@@ -249,17 +263,8 @@ TEST(MovingBoundary, ThreadsAndResumeBitIdentical) {
     ASSERT_GT(a.moving_boundary()->num_links(), 8192u);  // the parallel post-pass
     ASSERT_GT(a.moving_boundary()->num_cells(), 8192u);
     ASSERT_GT(a.moving_boundary()->stats().covered + a.moving_boundary()->stats().uncovered, 0);
-    const auto& fa = a.populations();
-    for (std::size_t i = 0; i < fa.size(); ++i) {
-      ASSERT_EQ(fa[i], b.populations()[i]) << particle_scheme_name(scheme) << " threads, slot " << i;
-      ASSERT_EQ(fa[i], c.populations()[i]) << particle_scheme_name(scheme) << " resume, slot " << i;
-    }
-    for (std::size_t s = 0; s < a.particle_forces().size(); ++s)
-      for (int k = 0; k < 3; ++k) {
-        ASSERT_EQ(a.particle_forces()[s][k], b.particle_forces()[s][k]);
-        ASSERT_EQ(a.particle_forces()[s][k], c.particle_forces()[s][k]);
-        ASSERT_EQ(a.particle_torques()[s][k], c.particle_torques()[s][k]);
-      }
+    expect_identical(a, b, std::string(particle_scheme_name(scheme)) + " threads");
+    expect_identical(a, c, std::string(particle_scheme_name(scheme)) + " resume");
     std::printf("%s: 1/2 threads and resume identical (%zu links, %zu solid cells)\n", particle_scheme_name(scheme),
                 a.moving_boundary()->num_links(), a.moving_boundary()->num_cells());
   }
@@ -316,18 +321,8 @@ void check_links_in_sweep(ParticleScheme scheme) {
   auto sweep2 = run(2, true);
   omp_set_num_threads(saved);
   EXPECT_EQ(after.moving_boundary()->stats().covered + after.moving_boundary()->stats().uncovered, 0);
-  const auto& fa = after.populations();
-  for (std::size_t i = 0; i < fa.size(); ++i) {
-    ASSERT_EQ(fa[i], sweep1.populations()[i]) << particle_scheme_name(scheme) << " slot " << i;
-    ASSERT_EQ(fa[i], sweep2.populations()[i]) << particle_scheme_name(scheme) << " 2 threads, slot " << i;
-  }
-  for (std::size_t s = 0; s < after.particle_forces().size(); ++s)
-    for (int k = 0; k < 3; ++k) {
-      ASSERT_EQ(after.particle_forces()[s][k], sweep1.particle_forces()[s][k]) << s;
-      ASSERT_EQ(after.particle_torques()[s][k], sweep1.particle_torques()[s][k]) << s;
-      ASSERT_EQ(after.particle_forces()[s][k], sweep2.particle_forces()[s][k]) << s;
-      ASSERT_EQ(after.particle_torques()[s][k], sweep2.particle_torques()[s][k]) << s;
-    }
+  expect_identical(after, sweep1, std::string(particle_scheme_name(scheme)) + " in the sweep");
+  expect_identical(after, sweep2, std::string(particle_scheme_name(scheme)) + " in the sweep, 2 threads");
   double fmax = 0;
   for (const Vec3& F : after.particle_forces()) fmax = std::max(fmax, F.norm());
   EXPECT_GT(fmax, 1e-4);  // the fluid loads the particles (the comparison is not of zeros)
