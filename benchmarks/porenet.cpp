@@ -8,8 +8,8 @@
 // per N DEM steps: its error and its cost per DEM step) and coupled DEM + flow runs.
 // Figures that are compared are measured interleaved (one round: each variant once; the median over
 // rounds): the machines are shared and their speed drifts. Threads: OMP_NUM_THREADS.
-// Usage: porenet [n2d] [n3d] [quick|nodem]   (defaults 10000, 30000; quick: no 3D implicit/coupled
-// runs; nodem: no DEM and coupled runs)
+// Usage: porenet [n2d] [n3d] [quick|nodem|geometry]   (defaults 10000, 30000; quick: no 3D implicit/
+// coupled runs; nodem: no DEM and coupled runs; geometry: stop after the 3D geometry update and forces)
 #include <omp.h>
 
 #include <algorithm>
@@ -232,13 +232,24 @@ int main(int argc, char** argv) {
   f3.init(1e5);
   const Real dt3 = 0.5 * f3.stable_dt();
   const double t_expl3 = median_ms(21, [&] { f3.step_explicit(dt3); });
+  // The per-step geometry (pores, throats) and the pressure on the spheres' patches: what a coupled
+  // step adds to the flow (DemPorenet3D::sync and compute_fluid_forces).
+  const Particles3D parts3{x3, y3, z3, pk3.radius, {}};
+  const double t_update3 = median_ms(11, [&] { update_network_3d(net3, parts3); });
+  std::vector<Real> p3(static_cast<std::size_t>(net3.n_pores()));
+  for (Index k = 0; k < net3.n_pores(); ++k) p3[static_cast<std::size_t>(k)] = 1e5 * (1 + 1e-3 * (k % 7));
+  std::vector<Real> fx3(x3.size()), fy3(x3.size()), fz3(x3.size());
+  const double t_force3 = median_ms(11, [&] { add_pressure_forces_3d(net3, parts3, p3, fx3, fy3, fz3); });
   const std::string mode = argc > 3 ? argv[3] : "";
   const bool quick = mode == "quick", nodem = mode == "nodem";
   std::printf("porenet 3D: %zu spheres (porosity %.3f, generated in %.1f s), %d pores, %d throats, %d hidden\n",
               x3.size(), pk3.achieved_porosity, t_pack3, net3.n_pores(), net3.n_channels(), net3.hidden_particles);
   std::printf("  regular triangulation + network %9.2f ms\n", t_build3);
   std::printf("  single-phase explicit step      %9.3f ms  (stable dt %.3e s, water)\n", t_expl3, 2 * dt3);
+  std::printf("  geometry update (pores, throats) %8.3f ms\n", t_update3);
+  std::printf("  pressure forces (patches)       %9.3f ms\n", t_force3);
   std::fflush(stdout);
+  if (mode == "geometry") return 0;  // the 3D network's per-step geometry and forces only
   // The DEM sample of the same size: its step is the reference (and interleaved with the flow steps).
   const Real v = 0.05;
   const Real side_dem3 = std::cbrt(target3 * 4.0 / 3 * kPi * 0.13e-9 / 0.55);
