@@ -44,7 +44,39 @@ Real solid_angle(V3 u, V3 v, V3 w) {
 
 Real angle(V3 u, V3 v) { return std::atan2(norm(cross(u, v)), dot(u, v)); }
 
-// Volume, void (METHODS §5.2) and centroid of pore k from its corners.
+// Facet f: its angle at each corner, its unit normal and, for a throat, the fluid area and hydraulic
+// radius (ch_aperture = 2 R_h; ch_cond = pfv_factor A_f R_h^2 until throat_conductance_3d divides by
+// 2 L). The pressure forces read the angles and normals (forces.cpp), so each is computed once a step.
+void facet_geometry_3d(Network2D& net, const Particles3D& p, Index f, Real pfv_factor) {
+  auto pos = [&](Index i) { return V3{p.x[i], p.y[i], p.z[i]}; };
+  const Index* v = net.facet_corners(f);
+  const V3 A = pos(v[0]), B = pos(v[1]), C = pos(v[2]);
+  const V3 N = cross(sub(B, A), sub(C, A));
+  const Real len = norm(N);
+  const Real area = 0.5 * len;
+  const Real inv = len > 0 ? 1 / len : 0;
+  Real* n = &net.face_normal[3 * static_cast<std::size_t>(f)];
+  n[0] = N.x * inv;
+  n[1] = N.y * inv;
+  n[2] = N.z * inv;
+  Real solid = 0, perim = 0;
+  for (int j = 0; j < 3; ++j) {
+    const V3 o = pos(v[j]);
+    const Real th = angle(sub(pos(v[(j + 1) % 3]), o), sub(pos(v[(j + 2) % 3]), o));
+    net.face_angle[3 * static_cast<std::size_t>(f) + j] = th;
+    const Real R = p.radius[v[j]];
+    solid += 0.5 * th * R * R;
+    perim += th * R;
+  }
+  if (f >= net.n_channels()) return;
+  const Real af = std::max(area - solid, net.params.min_void_fraction * area);
+  const Real rh = af / perim;
+  net.ch_aperture[f] = 2 * rh;
+  net.ch_cond[f] = pfv_factor * af * rh * rh;
+}
+
+// Volume, void (METHODS §5.2), centroid of pore k from its corners, and which of its facets' normals
+// point into it (after facet_geometry_3d).
 void pore_geometry_3d(Network2D& net, const Particles3D& p, Index k) {
   auto pos = [&](Index i) { return V3{p.x[i], p.y[i], p.z[i]}; };
   const Index* v = &net.pore_v[4 * static_cast<std::size_t>(k)];
@@ -52,42 +84,45 @@ void pore_geometry_3d(Network2D& net, const Particles3D& p, Index k) {
   const V3 u = sub(pos(v[1]), a), w = sub(pos(v[2]), a), s = sub(pos(v[3]), a);
   const Real vol = std::abs(dot(u, cross(w, s))) / 6;
   Real solid = 0;
+  std::uint8_t in = 0;
   for (int i = 0; i < 4; ++i) {
     const V3 o = pos(v[i]);
     const Real om = solid_angle(sub(pos(v[(i + 1) % 4]), o), sub(pos(v[(i + 2) % 4]), o), sub(pos(v[(i + 3) % 4]), o));
     const Real R = p.radius[v[i]];
     solid += om * R * R * R / 3;  // sphere sector inside the tetrahedron (METHODS §5.2)
+    const Index f = net.pore_face[4 * static_cast<std::size_t>(k) + i];
+    const Real* n = &net.face_normal[3 * static_cast<std::size_t>(f)];
+    const V3 d = sub(o, pos(net.facet_corners(f)[0]));  // towards the corner opposite the facet
+    if (n[0] * d.x + n[1] * d.y + n[2] * d.z > 0) in |= static_cast<std::uint8_t>(1u << i);
   }
   net.pore_cell[k] = vol;
-  net.pore_void[k] = std::max(vol - solid, net.params.min_void_fraction * vol);
+  net.pore_void[k] = std::max(std::max(vol - solid, net.params.min_void_fraction * vol), net.void_floor);
   net.pore_cx[k] = 0.25 * (p.x[v[0]] + p.x[v[1]] + p.x[v[2]] + p.x[v[3]]);
   net.pore_cy[k] = 0.25 * (p.y[v[0]] + p.y[v[1]] + p.y[v[2]] + p.y[v[3]]);
   net.pore_cz[k] = 0.25 * (p.z[v[0]] + p.z[v[1]] + p.z[v[2]] + p.z[v[3]]);
+  net.pore_face_in[k] = in;
 }
 
-// Throat c (facet corners ch_part[3c..3c+2]): length, hydraulic aperture and unclamped conductance.
-void throat_geometry_3d(Network2D& net, const Particles3D& p, Index c, Real pfv_factor) {
-  auto pos = [&](Index i) { return V3{p.x[i], p.y[i], p.z[i]}; };
+// Throat c (after facet_geometry_3d and the pores' centroids): length and unclamped conductance
+// g mu = pfv_factor A_f R_h^2 / (2 L) (Chareyre et al. 2012).
+void throat_conductance_3d(Network2D& net, const Particles3D& p, Index c) {
   const Index* v = &net.ch_part[3 * static_cast<std::size_t>(c)];
   const Index pa = net.ch_pore[2 * c], pb = net.ch_pore[2 * c + 1];
-  const V3 A = pos(v[0]), B = pos(v[1]), C = pos(v[2]);
-  const Real area = 0.5 * norm(cross(sub(B, A), sub(C, A)));
-  Real solid = 0, perim = 0;
-  for (int j = 0; j < 3; ++j) {
-    const V3 o = pos(v[j]);
-    const Real th = angle(sub(pos(v[(j + 1) % 3]), o), sub(pos(v[(j + 2) % 3]), o));
-    const Real R = p.radius[v[j]];
-    solid += 0.5 * th * R * R;
-    perim += th * R;
-  }
-  const Real af = std::max(area - solid, net.params.min_void_fraction * area);
-  const Real rh = af / perim;
   const V3 d{net.pore_cx[pb] - net.pore_cx[pa], net.pore_cy[pb] - net.pore_cy[pa], net.pore_cz[pb] - net.pore_cz[pa]};
   // Adjacent slivers have almost coincident centroids: L at least a tenth of the mean radius.
   const Real L = std::max(norm(d), 0.1 * (p.radius[v[0]] + p.radius[v[1]] + p.radius[v[2]]) / 3);
   net.ch_length[c] = L;
-  net.ch_aperture[c] = 2 * rh;
-  net.ch_cond[c] = pfv_factor * af * rh * rh / (2 * L);  // Chareyre et al. 2012
+  net.ch_cond[c] = std::min(net.ch_cond[c] / (2 * L), net.ch_cond_cap);
+}
+
+// The three passes of a geometry update, each parallel over its items.
+void update_geometry_3d(Network2D& net, const Particles3D& p) {
+#pragma omp parallel for schedule(static) if (net.n_facets() > kParallelMin)
+  for (Index f = 0; f < net.n_facets(); ++f) facet_geometry_3d(net, p, f, net.pfv_factor);
+#pragma omp parallel for schedule(static) if (net.n_pores() > kParallelMin)
+  for (Index k = 0; k < net.n_pores(); ++k) pore_geometry_3d(net, p, k);
+#pragma omp parallel for schedule(static) if (net.n_channels() > kParallelMin)
+  for (Index c = 0; c < net.n_channels(); ++c) throat_conductance_3d(net, p, c);
 }
 
 // Clamp local conductances relative to the median (YADE clamps to maxKdivKmean x the mean,
@@ -141,27 +176,14 @@ Network2D build_network_3d(const Particles3D& p, const NetworkParams& params, Re
   std::sort(cells.begin(), cells.end(), [](const Cell& a, const Cell& b) { return a.key < b.key; });
   const Index np = static_cast<Index>(cells.size());
   net.pore_v.resize(4 * static_cast<std::size_t>(np));
-  net.pore_area.assign(np, 0);
-  net.pore_cell.resize(np);
-  net.pore_void.resize(np);
-  net.pore_cx.resize(np);
-  net.pore_cy.resize(np);
-  net.pore_cz.resize(np);
-  net.pore_hull.assign(np, 0);
-  for (Index k = 0; k < np; ++k) {
+  for (Index k = 0; k < np; ++k)
     for (int i = 0; i < 4; ++i) net.pore_v[4 * k + i] = cells[k].v[i];
-    pore_geometry_3d(net, p, k);
-  }
-  Real mean_cell = 0;
-  for (Index k = 0; k < np; ++k) mean_cell += net.pore_cell[k];
-  mean_cell /= static_cast<Real>(np);
-  net.void_floor = params.min_void_relative * mean_cell;
-  min_void_floor(net);
   // Facets: sorted gid triple -> pores; shared = throat, single = hull.
   struct Facet {
     std::array<std::int64_t, 3> key;
     std::array<Index, 3> v;
     Index pore;
+    int face;  // the pore's corner opposite the facet
   };
   std::vector<Facet> facets;
   facets.reserve(4 * static_cast<std::size_t>(np));
@@ -172,31 +194,72 @@ Network2D build_network_3d(const Particles3D& p, const NetworkParams& params, Re
       std::sort(f.v.begin(), f.v.end(), [&](Index a, Index b) { return gid(a) < gid(b); });
       for (int j = 0; j < 3; ++j) f.key[j] = gid(f.v[j]);
       f.pore = k;
+      f.face = i;
       facets.push_back(f);
     }
   std::sort(facets.begin(), facets.end(),
             [](const Facet& a, const Facet& b) { return std::tie(a.key, a.pore) < std::tie(b.key, b.pore); });
+  net.pore_hull.assign(np, 0);
+  net.pore_face.assign(4 * static_cast<std::size_t>(np), -1);
+  std::vector<std::size_t> hull_facets;
   for (std::size_t e = 0; e < facets.size();) {
     if (e + 1 < facets.size() && facets[e + 1].key == facets[e].key) {
-      const Index pa = facets[e].pore, pb = facets[e + 1].pore;
-      net.ch_pore.push_back(pa);
-      net.ch_pore.push_back(pb);
+      const Index c = static_cast<Index>(net.ch_pore.size() / 2);
+      net.ch_pore.push_back(facets[e].pore);
+      net.ch_pore.push_back(facets[e + 1].pore);
       for (int j = 0; j < 3; ++j) net.ch_part.push_back(facets[e].v[j]);
       net.ch_kind.push_back(ChannelKind::T2T);
       net.ch_pair.push_back(-1);
-      net.ch_length.push_back(0);
-      net.ch_aperture.push_back(0);
-      net.ch_cond.push_back(0);
-      throat_geometry_3d(net, p, net.n_channels() - 1, pfv_factor);
+      net.pore_face[4 * static_cast<std::size_t>(facets[e].pore) + facets[e].face] = c;
+      net.pore_face[4 * static_cast<std::size_t>(facets[e + 1].pore) + facets[e + 1].face] = c;
       e += 2;
     } else {
       net.pore_hull[facets[e].pore] = 1;
+      hull_facets.push_back(e);
       e += 1;
     }
   }
-  const Index nc = net.n_channels();
+  const Index nc = static_cast<Index>(net.ch_pore.size() / 2);
+  for (std::size_t h = 0; h < hull_facets.size(); ++h) {
+    const Facet& f = facets[hull_facets[h]];
+    for (int j = 0; j < 3; ++j) net.hull_part.push_back(f.v[j]);
+    net.hull_pore.push_back(f.pore);
+    net.pore_face[4 * static_cast<std::size_t>(f.pore) + f.face] = nc + static_cast<Index>(h);
+  }
+  net.pore_face_slot.assign(np, 0);
+  for (Index k = 0; k < np; ++k)
+    for (int i = 0; i < 4; ++i) {
+      const Index f = net.pore_face[4 * static_cast<std::size_t>(k) + i];
+      const Index* fv = f < nc ? &net.ch_part[3 * static_cast<std::size_t>(f)] : &net.hull_part[3 * static_cast<std::size_t>(f - nc)];
+      for (int c = 0; c < 4; ++c) {
+        if (c == i) continue;
+        const Index j = net.pore_v[4 * static_cast<std::size_t>(k) + c];
+        const std::uint32_t slot = fv[0] == j ? 0u : fv[1] == j ? 1u : 2u;
+        net.pore_face_slot[k] |= slot << (2 * (4 * i + c));
+      }
+    }
+  // Geometry: pores, throats, facet angles and normals (as each update), then the floors.
+  net.pore_area.assign(np, 0);
+  net.pore_cell.resize(np);
+  net.pore_void.resize(np);
+  net.pore_cx.resize(np);
+  net.pore_cy.resize(np);
+  net.pore_cz.resize(np);
+  net.pore_face_in.assign(np, 0);
+  net.ch_length.assign(nc, 0);
+  net.ch_aperture.assign(nc, 0);
+  net.ch_cond.assign(nc, 0);
+  net.face_angle.assign(3 * static_cast<std::size_t>(net.n_facets()), 0);
+  net.face_normal.assign(3 * static_cast<std::size_t>(net.n_facets()), 0);
   net.pfv_factor = pfv_factor;
+  net.void_floor = 0;
   net.ch_cond_cap = std::numeric_limits<Real>::infinity();
+  update_geometry_3d(net, p);
+  Real mean_cell = 0;
+  for (Index k = 0; k < np; ++k) mean_cell += net.pore_cell[k];
+  mean_cell /= static_cast<Real>(np);
+  net.void_floor = params.min_void_relative * mean_cell;
+  min_void_floor(net);
   if (nc > 0) {
     std::vector<Real> sorted(net.ch_cond);
     std::nth_element(sorted.begin(), sorted.begin() + nc / 2, sorted.end());
@@ -236,16 +299,7 @@ void update_network_3d(Network2D& net, const Particles3D& p) {
   if (net.dim != 3) throw InputError("porenet: update_network_3d needs a network from build_network_3d");
   if (p.x.size() != static_cast<std::size_t>(net.n_particles))
     throw InputError(fmt::format("porenet: {} particles for a network built on {}", p.x.size(), net.n_particles));
-#pragma omp parallel for schedule(static) if (net.n_pores() > kParallelMin)
-  for (Index k = 0; k < net.n_pores(); ++k) {
-    pore_geometry_3d(net, p, k);
-    net.pore_void[k] = std::max(net.pore_void[k], net.void_floor);
-  }
-#pragma omp parallel for schedule(static) if (net.n_channels() > kParallelMin)
-  for (Index c = 0; c < net.n_channels(); ++c) {
-    throat_geometry_3d(net, p, c, net.pfv_factor);
-    net.ch_cond[c] = std::min(net.ch_cond[c], net.ch_cond_cap);
-  }
+  update_geometry_3d(net, p);
 }
 
 }  // namespace ff::porenet

@@ -6,9 +6,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "geometry/packing.hpp"
 #include "porenet/flow.hpp"
+#include "porenet/forces.hpp"
 
 using namespace ff;
 using namespace ff::porenet;
@@ -86,4 +88,65 @@ TEST(PorenetNetwork3D, FourTouchingSpheresAndBoxFlow) {
   EXPECT_LT(*hi / *lo, 3.0);
   EXPECT_GT(*lo, 0.1);
   EXPECT_LT(*hi, 10.0);
+}
+
+// The patch force per unit pressure (forces.cpp) reads the facets' angles and normals that the last
+// geometry update stored, one per facet corner. Check it against the direct integral, computed here
+// from the positions for each pore corner and face (-int_patch n dA = sum_f n_f theta_f R^2 / 2, n_f
+// the face's outward normal, theta_f the face's angle at the sphere), after every sphere of a packing
+// has moved by up to 5 % of the smallest radius (update_network_3d, topology kept). Tolerance 1e-12
+// of theta R^2 (round-off of the two orders of evaluation).
+TEST(PorenetNetwork3D, PatchForcesFollowTheUpdatedGeometry) {
+  PackingSpec spec;
+  spec.dim = 3;
+  spec.container = PackingSpec::Container::Box;
+  spec.box_lo = {0, 0, 0};
+  spec.box_hi = {5e-3, 5e-3, 5e-3};
+  spec.radius_min = 0.4e-3;
+  spec.radius_max = 0.6e-3;
+  spec.porosity = 0.42;
+  spec.seed = 3;
+  const Packing pk = dense_random_packing(spec);
+  std::vector<Real> x, y, z;
+  for (const Vec3& c : pk.position) {
+    x.push_back(c.x());
+    y.push_back(c.y());
+    z.push_back(c.z());
+  }
+  Network2D net = build_network_3d({x, y, z, pk.radius, {}});
+  ASSERT_GT(net.n_pores(), 500);
+  for (std::size_t j = 0; j < x.size(); ++j) {  // a deterministic jitter
+    x[j] += 2e-5 * std::sin(1.3 * static_cast<Real>(j));
+    y[j] += 2e-5 * std::cos(0.7 * static_cast<Real>(j));
+    z[j] += 2e-5 * std::sin(2.1 * static_cast<Real>(j) + 0.4);
+  }
+  const Particles3D p{x, y, z, pk.radius, {}};
+  update_network_3d(net, p);
+  Real worst = 0;
+  long checked = 0;
+  for (Index j = 0; j < net.n_particles; ++j)
+    for (Index e = net.pp_start[j]; e < net.pp_start[j + 1]; ++e) {
+      const Index k = net.pp_pore[e];
+      const int c = net.pp_corner[e];
+      const Vec3 o(x[j], y[j], z[j]);
+      Vec3 expect = Vec3::Zero();
+      for (int f = 0; f < 3; ++f) {  // the faces through j: (j, a, b), the fourth corner d
+        auto corner = [&](int q) {
+          const Index w = net.pore_v[4 * k + (c + 1 + q) % 4];
+          return Vec3(x[w], y[w], z[w]);
+        };
+        const Vec3 a = corner(f) - o, b = corner((f + 1) % 3) - o, d = corner((f + 2) % 3) - o;
+        Vec3 n = a.cross(b).normalized();
+        if (n.dot(d) > 0) n = -n;
+        const Real th = std::atan2(a.cross(b).norm(), a.dot(b));
+        expect += 0.5 * th * pk.radius[j] * pk.radius[j] * n;
+      }
+      Real got[3];
+      unit_patch_force_3d(net, p, j, e, got);
+      const Real scale = pk.radius[j] * pk.radius[j];
+      worst = std::max(worst, (Vec3(got[0], got[1], got[2]) - expect).norm() / scale);
+      ++checked;
+    }
+  std::printf("%ld pore corners: largest |a - a_direct| / R^2 = %.2e\n", checked, worst);
+  EXPECT_LT(worst, 1e-12);
 }
