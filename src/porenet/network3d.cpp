@@ -12,6 +12,7 @@
 #include <limits>
 
 #include "core/error.hpp"
+#include "porenet/atan2_batch.hpp"
 #include "porenet/reduce.hpp"
 #include "porenet/network.hpp"
 
@@ -33,74 +34,92 @@ Real dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 V3 cross(V3 a, V3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
 Real norm(V3 a) { return std::sqrt(dot(a, a)); }
 
-// Solid angle of the tetrahedron at the origin spanned by u, v, w (Van Oosterom & Strackee 1983,
-// IEEE Trans. Biomed. Eng. 30:125).
-Real solid_angle(V3 u, V3 v, V3 w) {
-  const Real lu = norm(u), lv = norm(v), lw = norm(w);
-  const Real num = std::abs(dot(u, cross(v, w)));
-  const Real den = lu * lv * lw + dot(u, v) * lw + dot(u, w) * lv + dot(v, w) * lu;
-  return 2 * std::atan2(num, den);
+// The geometry runs over blocks of facets or pores: a first loop gathers the atan2 arguments of the
+// block, atan2_nonneg evaluates them in one vectorised call, a second loop uses the angles.
+constexpr Index kGeometryBlock = 128;
+
+// Facets [f0, f1): each one's angle at its corners, its unit normal and, for a throat, the fluid area
+// and hydraulic radius (ch_aperture = 2 R_h; ch_cond = pfv_factor A_f R_h^2 until
+// throat_conductance_3d divides by 2 L). The pressure forces read the angles and normals (forces.cpp),
+// so each is computed once a step.
+void facet_geometry_3d(Network2D& net, const Particles3D& p, Index f0, Index f1) {
+  auto pos = [&](Index i) { return V3{p.x[i], p.y[i], p.z[i]}; };
+  Real ys[3 * kGeometryBlock] = {}, xs[3 * kGeometryBlock] = {}, area[kGeometryBlock];
+  for (Index f = f0; f < f1; ++f) {
+    const Index* v = net.facet_corners(f);
+    const V3 A = pos(v[0]), B = pos(v[1]), C = pos(v[2]);
+    const V3 N = cross(sub(B, A), sub(C, A));
+    const Real len = norm(N);
+    area[f - f0] = 0.5 * len;
+    const Real inv = len > 0 ? 1 / len : 0;
+    Real* n = &net.face_normal[3 * static_cast<std::size_t>(f)];
+    n[0] = N.x * inv;
+    n[1] = N.y * inv;
+    n[2] = N.z * inv;
+    for (int j = 0; j < 3; ++j) {  // the angle at corner j: atan2(|u x w|, u . w)
+      const V3 o = pos(v[j]);
+      const V3 u = sub(pos(v[(j + 1) % 3]), o), w = sub(pos(v[(j + 2) % 3]), o);
+      ys[3 * (f - f0) + j] = norm(cross(u, w));
+      xs[3 * (f - f0) + j] = dot(u, w);
+    }
+  }
+  Real* th = &net.face_angle[3 * static_cast<std::size_t>(f0)];
+  atan2_nonneg(ys, xs, th, static_cast<int>(3 * (f1 - f0)));
+  for (Index f = f0; f < std::min(f1, net.n_channels()); ++f) {
+    const Index* v = net.facet_corners(f);
+    Real solid = 0, perim = 0;
+    for (int j = 0; j < 3; ++j) {
+      const Real R = p.radius[v[j]];
+      solid += 0.5 * th[3 * (f - f0) + j] * R * R;
+      perim += th[3 * (f - f0) + j] * R;
+    }
+    const Real af = std::max(area[f - f0] - solid, net.params.min_void_fraction * area[f - f0]);
+    const Real rh = af / perim;
+    net.ch_aperture[f] = 2 * rh;
+    net.ch_cond[f] = net.pfv_factor * af * rh * rh;
+  }
 }
 
-Real angle(V3 u, V3 v) { return std::atan2(norm(cross(u, v)), dot(u, v)); }
-
-// Facet f: its angle at each corner, its unit normal and, for a throat, the fluid area and hydraulic
-// radius (ch_aperture = 2 R_h; ch_cond = pfv_factor A_f R_h^2 until throat_conductance_3d divides by
-// 2 L). The pressure forces read the angles and normals (forces.cpp), so each is computed once a step.
-void facet_geometry_3d(Network2D& net, const Particles3D& p, Index f, Real pfv_factor) {
+// Pores [k0, k1): volume, void (METHODS §5.2; the floors), centroid, and which of the pore's facets'
+// normals point into it (after facet_geometry_3d). The solid angle at corner i is Omega_i =
+// 2 atan2(|u . (v x w)|, |u||v||w| + (u.v)|w| + (u.w)|v| + (v.w)|u|) with u, v, w the edges from it
+// (Van Oosterom & Strackee 1983, IEEE Trans. Biomed. Eng. 30:125).
+void pore_geometry_3d(Network2D& net, const Particles3D& p, Index k0, Index k1) {
   auto pos = [&](Index i) { return V3{p.x[i], p.y[i], p.z[i]}; };
-  const Index* v = net.facet_corners(f);
-  const V3 A = pos(v[0]), B = pos(v[1]), C = pos(v[2]);
-  const V3 N = cross(sub(B, A), sub(C, A));
-  const Real len = norm(N);
-  const Real area = 0.5 * len;
-  const Real inv = len > 0 ? 1 / len : 0;
-  Real* n = &net.face_normal[3 * static_cast<std::size_t>(f)];
-  n[0] = N.x * inv;
-  n[1] = N.y * inv;
-  n[2] = N.z * inv;
-  Real solid = 0, perim = 0;
-  for (int j = 0; j < 3; ++j) {
-    const V3 o = pos(v[j]);
-    const Real th = angle(sub(pos(v[(j + 1) % 3]), o), sub(pos(v[(j + 2) % 3]), o));
-    net.face_angle[3 * static_cast<std::size_t>(f) + j] = th;
-    const Real R = p.radius[v[j]];
-    solid += 0.5 * th * R * R;
-    perim += th * R;
+  Real ys[4 * kGeometryBlock] = {}, xs[4 * kGeometryBlock] = {}, half[4 * kGeometryBlock], vol[kGeometryBlock];
+  for (Index k = k0; k < k1; ++k) {
+    const Index* v = &net.pore_v[4 * static_cast<std::size_t>(k)];
+    std::uint8_t in = 0;
+    for (int i = 0; i < 4; ++i) {
+      const V3 o = pos(v[i]);
+      const V3 u = sub(pos(v[(i + 1) % 4]), o), w = sub(pos(v[(i + 2) % 4]), o), s = sub(pos(v[(i + 3) % 4]), o);
+      const Real lu = norm(u), lw = norm(w), ls = norm(s);
+      ys[4 * (k - k0) + i] = std::abs(dot(u, cross(w, s)));
+      xs[4 * (k - k0) + i] = lu * lw * ls + dot(u, w) * ls + dot(u, s) * lw + dot(w, s) * lu;
+      const Index f = net.pore_face[4 * static_cast<std::size_t>(k) + i];
+      const Real* n = &net.face_normal[3 * static_cast<std::size_t>(f)];
+      const V3 d = sub(o, pos(net.facet_corners(f)[0]));  // towards the corner opposite the facet
+      if (n[0] * d.x + n[1] * d.y + n[2] * d.z > 0) in |= static_cast<std::uint8_t>(1u << i);
+    }
+    const V3 a = pos(v[0]);
+    vol[k - k0] = std::abs(dot(sub(pos(v[1]), a), cross(sub(pos(v[2]), a), sub(pos(v[3]), a)))) / 6;
+    net.pore_cx[k] = 0.25 * (p.x[v[0]] + p.x[v[1]] + p.x[v[2]] + p.x[v[3]]);
+    net.pore_cy[k] = 0.25 * (p.y[v[0]] + p.y[v[1]] + p.y[v[2]] + p.y[v[3]]);
+    net.pore_cz[k] = 0.25 * (p.z[v[0]] + p.z[v[1]] + p.z[v[2]] + p.z[v[3]]);
+    net.pore_face_in[k] = in;
   }
-  if (f >= net.n_channels()) return;
-  const Real af = std::max(area - solid, net.params.min_void_fraction * area);
-  const Real rh = af / perim;
-  net.ch_aperture[f] = 2 * rh;
-  net.ch_cond[f] = pfv_factor * af * rh * rh;
-}
-
-// Volume, void (METHODS §5.2), centroid of pore k from its corners, and which of its facets' normals
-// point into it (after facet_geometry_3d).
-void pore_geometry_3d(Network2D& net, const Particles3D& p, Index k) {
-  auto pos = [&](Index i) { return V3{p.x[i], p.y[i], p.z[i]}; };
-  const Index* v = &net.pore_v[4 * static_cast<std::size_t>(k)];
-  const V3 a = pos(v[0]);
-  const V3 u = sub(pos(v[1]), a), w = sub(pos(v[2]), a), s = sub(pos(v[3]), a);
-  const Real vol = std::abs(dot(u, cross(w, s))) / 6;
-  Real solid = 0;
-  std::uint8_t in = 0;
-  for (int i = 0; i < 4; ++i) {
-    const V3 o = pos(v[i]);
-    const Real om = solid_angle(sub(pos(v[(i + 1) % 4]), o), sub(pos(v[(i + 2) % 4]), o), sub(pos(v[(i + 3) % 4]), o));
-    const Real R = p.radius[v[i]];
-    solid += om * R * R * R / 3;  // sphere sector inside the tetrahedron (METHODS §5.2)
-    const Index f = net.pore_face[4 * static_cast<std::size_t>(k) + i];
-    const Real* n = &net.face_normal[3 * static_cast<std::size_t>(f)];
-    const V3 d = sub(o, pos(net.facet_corners(f)[0]));  // towards the corner opposite the facet
-    if (n[0] * d.x + n[1] * d.y + n[2] * d.z > 0) in |= static_cast<std::uint8_t>(1u << i);
+  atan2_nonneg(ys, xs, half, static_cast<int>(4 * (k1 - k0)));
+  for (Index k = k0; k < k1; ++k) {
+    const Index* v = &net.pore_v[4 * static_cast<std::size_t>(k)];
+    Real solid = 0;
+    for (int i = 0; i < 4; ++i) {
+      const Real R = p.radius[v[i]];
+      solid += 2 * half[4 * (k - k0) + i] * R * R * R / 3;  // sphere sector inside the tetrahedron
+    }
+    const Real V = vol[k - k0];
+    net.pore_cell[k] = V;
+    net.pore_void[k] = std::max(std::max(V - solid, net.params.min_void_fraction * V), net.void_floor);
   }
-  net.pore_cell[k] = vol;
-  net.pore_void[k] = std::max(std::max(vol - solid, net.params.min_void_fraction * vol), net.void_floor);
-  net.pore_cx[k] = 0.25 * (p.x[v[0]] + p.x[v[1]] + p.x[v[2]] + p.x[v[3]]);
-  net.pore_cy[k] = 0.25 * (p.y[v[0]] + p.y[v[1]] + p.y[v[2]] + p.y[v[3]]);
-  net.pore_cz[k] = 0.25 * (p.z[v[0]] + p.z[v[1]] + p.z[v[2]] + p.z[v[3]]);
-  net.pore_face_in[k] = in;
 }
 
 // Throat c (after facet_geometry_3d and the pores' centroids): length and unclamped conductance
@@ -117,10 +136,13 @@ void throat_conductance_3d(Network2D& net, const Particles3D& p, Index c) {
 
 // The three passes of a geometry update, each parallel over its items.
 void update_geometry_3d(Network2D& net, const Particles3D& p) {
-#pragma omp parallel for schedule(static) if (net.n_facets() > kParallelMin)
-  for (Index f = 0; f < net.n_facets(); ++f) facet_geometry_3d(net, p, f, net.pfv_factor);
-#pragma omp parallel for schedule(static) if (net.n_pores() > kParallelMin)
-  for (Index k = 0; k < net.n_pores(); ++k) pore_geometry_3d(net, p, k);
+  const Index nf = net.n_facets(), np = net.n_pores();
+#pragma omp parallel for schedule(static) if (nf > kParallelMin)
+  for (Index b = 0; b < (nf + kGeometryBlock - 1) / kGeometryBlock; ++b)
+    facet_geometry_3d(net, p, b * kGeometryBlock, std::min(nf, (b + 1) * kGeometryBlock));
+#pragma omp parallel for schedule(static) if (np > kParallelMin)
+  for (Index b = 0; b < (np + kGeometryBlock - 1) / kGeometryBlock; ++b)
+    pore_geometry_3d(net, p, b * kGeometryBlock, std::min(np, (b + 1) * kGeometryBlock));
 #pragma omp parallel for schedule(static) if (net.n_channels() > kParallelMin)
   for (Index c = 0; c < net.n_channels(); ++c) throat_conductance_3d(net, p, c);
 }
