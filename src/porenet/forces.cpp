@@ -103,37 +103,21 @@ void add_pressure_forces_void_gradient(const Network2D& net, const Particles2D& 
 
 namespace ff::porenet {
 
-// Sphere j at a corner of tetrahedron k: the pressure on the spherical patch inside the tetrahedron.
-// The patch and the three plane sectors of the tetrahedron's faces through j (angle theta at j,
-// area theta R^2 / 2) close a cone, so int_patch n dA = -sum_f n_f theta_f R^2 / 2 (n_f the face's
-// outward normal) and the force -p int_patch n dA = p sum_f n_f theta_f R^2 / 2. A face between two
-// pores gets opposite normals from them: an interior sphere at uniform pressure feels no net force.
+// Sphere j at a corner of tetrahedron k: the pressure on the spherical patch inside the tetrahedron,
+// p times the patch force per unit pressure that the last geometry update stored (network3d.cpp,
+// pore_geometry_3d: the cone's faces, n_f theta_f R^2 / 2 each). A face between two pores gets
+// opposite normals from them: an interior sphere at uniform pressure feels no net force.
 namespace {
-// The facets' angles and unit normals come from the network's last geometry update (one atan2 per
-// facet corner a step instead of one per pore corner and face: 3 x fewer, the throat's conductance
-// uses the same angles). Inlined into add_pressure_forces_3d's loop.
-inline void patch_force(const Network2D& net, const Particles3D& p, Index j, Index e, Real out[3]) {
-  out[0] = out[1] = out[2] = 0;
-  const Real R = p.radius[j];
-  const Index k = net.pp_pore[e];
-  const int c = net.pp_corner[e];
-  const std::size_t k4 = 4 * static_cast<std::size_t>(k);
-  const unsigned in = net.pore_face_in[k];
-  const std::uint32_t slots = net.pore_face_slot[k];
-  for (int i = 0; i < 4; ++i) {  // the faces through j: those opposite the other three corners
-    if (i == c) continue;
-    const auto f = static_cast<std::size_t>(net.pore_face[k4 + i]);
-    const unsigned slot = (slots >> (2 * (4 * i + c))) & 3u;
-    const Real th = net.face_angle[3 * f + slot];
-    const Real w = (((in >> i) & 1u) ? -0.5 : 0.5) * th * R * R;  // along the outward normal
-    const Real* n = &net.face_normal[3 * f];
-    for (int q = 0; q < 3; ++q) out[q] += w * n[q];
-  }
+inline void patch_force(const Network2D& net, Index e, Real out[3]) {
+  const Real* a = &net.pore_patch[12 * static_cast<std::size_t>(net.pp_pore[e]) + 3 * net.pp_corner[e]];
+  out[0] = a[0];
+  out[1] = a[1];
+  out[2] = a[2];
 }
 }  // namespace
 
 void unit_patch_force_3d(const Network2D& net, const Particles3D& p, Index j, Index e, Real out[3]) {
-  patch_force(net, p, j, e, out);
+  patch_force(net, e, out);
 }
 
 void add_pressure_forces_3d(const Network2D& net, const Particles3D& p, std::span<const Real> P, std::span<Real> fx,
@@ -149,7 +133,7 @@ void add_pressure_forces_3d(const Network2D& net, const Particles3D& p, std::spa
     Real s[3] = {0, 0, 0};
     for (Index e = net.pp_start[j]; e < net.pp_start[j + 1]; ++e) {
       Real a[3];
-      patch_force(net, p, j, e, a);
+      patch_force(net, e, a);
       const Real Pk = P[net.pp_pore[e]];
       for (int q = 0; q < 3; ++q) s[q] += Pk * a[q];
     }

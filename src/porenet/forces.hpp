@@ -47,8 +47,8 @@ void add_shear_forces(const Network2D& net, const Particles2D& particles, std::s
                       std::span<Real> fx, std::span<Real> fy);
 
 // 3D (PFV-style integration over the sphere surface; forces.cpp): pressure on the spherical patches of
-// each sphere inside its tetrahedra, added to fx, fy, fz [N]. Both read the facets' angles and normals
-// of the network's last geometry (build_network_3d or update_network_3d at these positions).
+// each sphere inside its tetrahedra, added to fx, fy, fz [N]. Both read the patch forces per unit
+// pressure of the network's last geometry (build_network_3d or update_network_3d at these positions).
 void add_pressure_forces_3d(const Network2D& net, const Particles3D& particles, std::span<const Real> pore_pressure,
                             std::span<Real> fx, std::span<Real> fy, std::span<Real> fz);
 // The force on sphere j per unit pressure in the tetrahedron of its pore-corner entry e (net.pp_pore[e])

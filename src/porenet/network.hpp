@@ -111,16 +111,9 @@ struct Network2D {
   Index n_pairs = 0;          // size of the PairList the network was built with
   Index unmatched_pairs = 0;  // pairs of the list that are not Delaunay edges (no channel)
 
-  // 3D facets: the throats first (facet c = channel c, corners ch_part[3c..3c+2]), then the hull
-  // facets (facet n_channels() + h: corners hull_part[3h..3h+2], one pore hull_pore[h]).
-  std::vector<Index> hull_part, hull_pore;
-  std::vector<Index> pore_face;             // facet opposite corner i of pore k: pore_face[4k+i]
-  std::vector<std::uint32_t> pore_face_slot;  // bits 2(4i+c): where corner c of pore k sits in that facet
-  // Per step (update_network_3d): each facet's angle at its corners [rad] (3 per facet) and unit
-  // normal of (c1 - c0) x (c2 - c0) (3 per facet; 0 for a degenerate facet); bit i of
-  // pore_face_in[k]: the normal of the facet opposite corner i points into pore k.
-  std::vector<Real> face_angle, face_normal;
-  std::vector<std::uint8_t> pore_face_in;
+  // 3D, per step (update_network_3d): the patch force per unit pressure [m^2] of the sphere at corner c
+  // of pore k, -int_patch n dA (forces.cpp), at pore_patch[12k + 3c .. 12k + 3c + 2].
+  std::vector<Real> pore_patch;
 
   Index hidden_particles = 0;  // 3D regular triangulation: spheres with an empty power cell (no pore)
   // Floor of every pore's void [m^3] (min_void_relative x the mean cell; 2D: of the last update; a pore
@@ -131,11 +124,6 @@ struct Network2D {
 
   Index n_pores() const { return static_cast<Index>(pore_area.size()); }
   Index n_channels() const { return static_cast<Index>(ch_length.size()); }
-  Index n_facets() const { return n_channels() + static_cast<Index>(hull_pore.size()); }  // 3D
-  const Index* facet_corners(Index f) const {  // 3D
-    return f < n_channels() ? &ch_part[3 * static_cast<std::size_t>(f)]
-                            : &hull_part[3 * static_cast<std::size_t>(f - n_channels())];
-  }
 };
 
 // Triangulates and builds pores, channels and apertures. Throws InputError for mismatched

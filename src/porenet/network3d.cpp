@@ -34,87 +34,81 @@ Real dot(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 V3 cross(V3 a, V3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
 Real norm(V3 a) { return std::sqrt(dot(a, a)); }
 
-// The geometry runs over blocks of facets or pores: a first loop gathers the atan2 arguments of the
+// The geometry runs over blocks of pores or throats: a first loop gathers the atan2 arguments of the
 // block, atan2_nonneg evaluates them in one vectorised call, a second loop uses the angles.
-constexpr Index kGeometryBlock = 128;
+constexpr Index kGeometryBlock = 64;
 
-// Facets [f0, f1): each one's angle at its corners, its unit normal and, for a throat, the fluid area
-// and hydraulic radius (ch_aperture = 2 R_h; ch_cond = pfv_factor A_f R_h^2 until
-// throat_conductance_3d divides by 2 L). The pressure forces read the angles and normals (forces.cpp),
-// so each is computed once a step.
-void facet_geometry_3d(Network2D& net, const Particles3D& p, Index f0, Index f1) {
-  auto pos = [&](Index i) { return V3{p.x[i], p.y[i], p.z[i]}; };
-  Real ys[3 * kGeometryBlock] = {}, xs[3 * kGeometryBlock] = {}, area[kGeometryBlock];
-  for (Index f = f0; f < f1; ++f) {
-    const Index* v = net.facet_corners(f);
-    const V3 A = pos(v[0]), B = pos(v[1]), C = pos(v[2]);
-    const V3 N = cross(sub(B, A), sub(C, A));
-    const Real len = norm(N);
-    area[f - f0] = 0.5 * len;
-    const Real inv = len > 0 ? 1 / len : 0;
-    Real* n = &net.face_normal[3 * static_cast<std::size_t>(f)];
-    n[0] = N.x * inv;
-    n[1] = N.y * inv;
-    n[2] = N.z * inv;
-    for (int j = 0; j < 3; ++j) {  // the angle at corner j: atan2(|u x w|, u . w)
-      const V3 o = pos(v[j]);
-      const V3 u = sub(pos(v[(j + 1) % 3]), o), w = sub(pos(v[(j + 2) % 3]), o);
-      ys[3 * (f - f0) + j] = norm(cross(u, w));
-      xs[3 * (f - f0) + j] = dot(u, w);
-    }
-  }
-  Real* th = &net.face_angle[3 * static_cast<std::size_t>(f0)];
-  atan2_nonneg(ys, xs, th, static_cast<int>(3 * (f1 - f0)));
-  for (Index f = f0; f < std::min(f1, net.n_channels()); ++f) {
-    const Index* v = net.facet_corners(f);
-    Real solid = 0, perim = 0;
-    for (int j = 0; j < 3; ++j) {
-      const Real R = p.radius[v[j]];
-      solid += 0.5 * th[3 * (f - f0) + j] * R * R;
-      perim += th[3 * (f - f0) + j] * R;
-    }
-    const Real af = std::max(area[f - f0] - solid, net.params.min_void_fraction * area[f - f0]);
-    const Real rh = af / perim;
-    net.ch_aperture[f] = 2 * rh;
-    net.ch_cond[f] = net.pfv_factor * af * rh * rh;
-  }
-}
-
-// Pores [k0, k1): volume, void (METHODS §5.2; the floors), centroid, and which of the pore's facets'
-// normals point into it (after facet_geometry_3d). The solid angle at corner i is Omega_i =
-// 2 atan2(|u . (v x w)|, |u||v||w| + (u.v)|w| + (u.w)|v| + (v.w)|u|) with u, v, w the edges from it
-// (Van Oosterom & Strackee 1983, IEEE Trans. Biomed. Eng. 30:125).
+// Pores [k0, k1): volume, void (METHODS §5.2; the floors), centroid, and each corner sphere's patch
+// force per unit pressure (pore_patch; forces.cpp). Sphere j at corner c: the patch inside the
+// tetrahedron and the three plane sectors of the faces through j (angle theta at j, area theta R^2/2)
+// close a cone, so -int_patch n dA = sum_f n_f theta_f R^2 / 2, n_f the face's outward unit normal.
+// The solid angle at corner i is Omega_i = 2 atan2(|u . (v x w)|, |u||v||w| + (u.v)|w| + (u.w)|v| +
+// (v.w)|u|) with u, v, w the edges from it (Van Oosterom & Strackee 1983, IEEE Trans. Biomed. Eng.
+// 30:125).
 void pore_geometry_3d(Network2D& net, const Particles3D& p, Index k0, Index k1) {
-  auto pos = [&](Index i) { return V3{p.x[i], p.y[i], p.z[i]}; };
-  Real ys[4 * kGeometryBlock] = {}, xs[4 * kGeometryBlock] = {}, half[4 * kGeometryBlock], vol[kGeometryBlock];
+  constexpr int kArgs = 16;  // per pore: 4 solid angles, then 3 angles at the corners of each face
+  Real ys[kArgs * kGeometryBlock] = {}, xs[kArgs * kGeometryBlock] = {}, th[kArgs * kGeometryBlock];
+  Real normal[12 * kGeometryBlock], vol[kGeometryBlock];
   for (Index k = k0; k < k1; ++k) {
     const Index* v = &net.pore_v[4 * static_cast<std::size_t>(k)];
-    std::uint8_t in = 0;
+    V3 c[4];
+    for (int i = 0; i < 4; ++i) c[i] = V3{p.x[v[i]], p.y[v[i]], p.z[v[i]]};
+    Real* y = &ys[kArgs * (k - k0)];
+    Real* x = &xs[kArgs * (k - k0)];
+    Real len[4][4];  // edge lengths
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) len[i][j] = len[j][i] = norm(sub(c[j], c[i]));
+    Real twice_area[4];  // of face i; |e1 x e2| at each of its corners
     for (int i = 0; i < 4; ++i) {
-      const V3 o = pos(v[i]);
-      const V3 u = sub(pos(v[(i + 1) % 4]), o), w = sub(pos(v[(i + 2) % 4]), o), s = sub(pos(v[(i + 3) % 4]), o);
-      const Real lu = norm(u), lw = norm(w), ls = norm(s);
-      ys[4 * (k - k0) + i] = std::abs(dot(u, cross(w, s)));
-      xs[4 * (k - k0) + i] = lu * lw * ls + dot(u, w) * ls + dot(u, s) * lw + dot(w, s) * lu;
-      const Index f = net.pore_face[4 * static_cast<std::size_t>(k) + i];
-      const Real* n = &net.face_normal[3 * static_cast<std::size_t>(f)];
-      const V3 d = sub(o, pos(net.facet_corners(f)[0]));  // towards the corner opposite the facet
-      if (n[0] * d.x + n[1] * d.y + n[2] * d.z > 0) in |= static_cast<std::uint8_t>(1u << i);
+      // Face i (opposite corner i): corners c[i+1], c[i+2], c[i+3]; its outward normal points away from c[i].
+      const V3 a = c[(i + 1) % 4];
+      const V3 N = cross(sub(c[(i + 2) % 4], a), sub(c[(i + 3) % 4], a));
+      twice_area[i] = norm(N);
+      const Real sgn = dot(N, sub(c[i], a)) > 0 ? -1.0 : 1.0;
+      const Real inv = twice_area[i] > 0 ? sgn / twice_area[i] : 0;
+      normal[12 * (k - k0) + 3 * i] = N.x * inv;
+      normal[12 * (k - k0) + 3 * i + 1] = N.y * inv;
+      normal[12 * (k - k0) + 3 * i + 2] = N.z * inv;
     }
-    const V3 a = pos(v[0]);
-    vol[k - k0] = std::abs(dot(sub(pos(v[1]), a), cross(sub(pos(v[2]), a), sub(pos(v[3]), a)))) / 6;
+    const Real six_vol = std::abs(dot(sub(c[1], c[0]), cross(sub(c[2], c[0]), sub(c[3], c[0]))));
+    vol[k - k0] = six_vol / 6;
+    for (int i = 0; i < 4; ++i) {
+      const int o1 = (i + 1) % 4, o2 = (i + 2) % 4, o3 = (i + 3) % 4;
+      const V3 u = sub(c[o1], c[i]), w = sub(c[o2], c[i]), s = sub(c[o3], c[i]);
+      const Real lu = len[i][o1], lw = len[i][o2], ls = len[i][o3];
+      const Real uw = dot(u, w), us = dot(u, s), ws = dot(w, s);
+      y[i] = six_vol;
+      x[i] = lu * lw * ls + uw * ls + us * lw + ws * lu;
+      // The angle at corner i in each face through it (face f holds i as its corner (i - f + 3) % 4).
+      y[4 + 3 * o1 + (i - o1 + 3) % 4] = twice_area[o1];  // face without o1: edges w, s
+      x[4 + 3 * o1 + (i - o1 + 3) % 4] = ws;
+      y[4 + 3 * o2 + (i - o2 + 3) % 4] = twice_area[o2];  // edges u, s
+      x[4 + 3 * o2 + (i - o2 + 3) % 4] = us;
+      y[4 + 3 * o3 + (i - o3 + 3) % 4] = twice_area[o3];  // edges u, w
+      x[4 + 3 * o3 + (i - o3 + 3) % 4] = uw;
+    }
     net.pore_cx[k] = 0.25 * (p.x[v[0]] + p.x[v[1]] + p.x[v[2]] + p.x[v[3]]);
     net.pore_cy[k] = 0.25 * (p.y[v[0]] + p.y[v[1]] + p.y[v[2]] + p.y[v[3]]);
     net.pore_cz[k] = 0.25 * (p.z[v[0]] + p.z[v[1]] + p.z[v[2]] + p.z[v[3]]);
-    net.pore_face_in[k] = in;
   }
-  atan2_nonneg(ys, xs, half, static_cast<int>(4 * (k1 - k0)));
+  atan2_nonneg(ys, xs, th, static_cast<int>(kArgs * (k1 - k0)));
   for (Index k = k0; k < k1; ++k) {
     const Index* v = &net.pore_v[4 * static_cast<std::size_t>(k)];
+    const Real* t = &th[kArgs * (k - k0)];
+    const Real* n = &normal[12 * (k - k0)];
+    Real* patch = &net.pore_patch[12 * static_cast<std::size_t>(k)];
     Real solid = 0;
     for (int i = 0; i < 4; ++i) {
       const Real R = p.radius[v[i]];
-      solid += 2 * half[4 * (k - k0) + i] * R * R * R / 3;  // sphere sector inside the tetrahedron
+      solid += 2 * t[i] * R * R * R / 3;  // sphere sector inside the tetrahedron
+      Real a[3] = {0, 0, 0};
+      for (int face = 0; face < 4; ++face) {  // the faces through corner i
+        if (face == i) continue;
+        const int m = (i - face + 3) % 4;  // corner i is corner m of face `face`
+        const Real w = 0.5 * t[4 + 3 * face + m] * R * R;
+        for (int q = 0; q < 3; ++q) a[q] += w * n[3 * face + q];
+      }
+      for (int q = 0; q < 3; ++q) patch[3 * i + q] = a[q];
     }
     const Real V = vol[k - k0];
     net.pore_cell[k] = V;
@@ -122,29 +116,54 @@ void pore_geometry_3d(Network2D& net, const Particles3D& p, Index k0, Index k1) 
   }
 }
 
-// Throat c (after facet_geometry_3d and the pores' centroids): length and unclamped conductance
-// g mu = pfv_factor A_f R_h^2 / (2 L) (Chareyre et al. 2012).
-void throat_conductance_3d(Network2D& net, const Particles3D& p, Index c) {
-  const Index* v = &net.ch_part[3 * static_cast<std::size_t>(c)];
-  const Index pa = net.ch_pore[2 * c], pb = net.ch_pore[2 * c + 1];
-  const V3 d{net.pore_cx[pb] - net.pore_cx[pa], net.pore_cy[pb] - net.pore_cy[pa], net.pore_cz[pb] - net.pore_cz[pa]};
-  // Adjacent slivers have almost coincident centroids: L at least a tenth of the mean radius.
-  const Real L = std::max(norm(d), 0.1 * (p.radius[v[0]] + p.radius[v[1]] + p.radius[v[2]]) / 3);
-  net.ch_length[c] = L;
-  net.ch_cond[c] = std::min(net.ch_cond[c] / (2 * L), net.ch_cond_cap);
+// Throats [c0, c1) (after the pores' centroids): fluid area A_f = A - sum_k theta_k R_k^2 / 2,
+// hydraulic radius R_h = A_f / sum_k theta_k R_k (ch_aperture = 2 R_h), length L (centroid distance)
+// and conductance g mu = pfv_factor A_f R_h^2 / (2 L) (Chareyre et al. 2012), clamped.
+void throat_geometry_3d(Network2D& net, const Particles3D& p, Index c0, Index c1) {
+  auto pos = [&](Index i) { return V3{p.x[i], p.y[i], p.z[i]}; };
+  Real ys[3 * kGeometryBlock] = {}, xs[3 * kGeometryBlock] = {}, th[3 * kGeometryBlock], area[kGeometryBlock];
+  for (Index c = c0; c < c1; ++c) {
+    const Index* v = &net.ch_part[3 * static_cast<std::size_t>(c)];
+    const V3 A = pos(v[0]), B = pos(v[1]), C = pos(v[2]);
+    const Real twice_area = norm(cross(sub(B, A), sub(C, A)));  // |u x w| at every corner
+    area[c - c0] = 0.5 * twice_area;
+    for (int j = 0; j < 3; ++j) {  // the angle at corner j: atan2(|u x w|, u . w)
+      const V3 o = pos(v[j]);
+      ys[3 * (c - c0) + j] = twice_area;
+      xs[3 * (c - c0) + j] = dot(sub(pos(v[(j + 1) % 3]), o), sub(pos(v[(j + 2) % 3]), o));
+    }
+  }
+  atan2_nonneg(ys, xs, th, static_cast<int>(3 * (c1 - c0)));
+  for (Index c = c0; c < c1; ++c) {
+    const Index* v = &net.ch_part[3 * static_cast<std::size_t>(c)];
+    Real solid = 0, perim = 0;
+    for (int j = 0; j < 3; ++j) {
+      const Real R = p.radius[v[j]];
+      solid += 0.5 * th[3 * (c - c0) + j] * R * R;
+      perim += th[3 * (c - c0) + j] * R;
+    }
+    const Real af = std::max(area[c - c0] - solid, net.params.min_void_fraction * area[c - c0]);
+    const Real rh = af / perim;
+    const Index pa = net.ch_pore[2 * c], pb = net.ch_pore[2 * c + 1];
+    const V3 d{net.pore_cx[pb] - net.pore_cx[pa], net.pore_cy[pb] - net.pore_cy[pa], net.pore_cz[pb] - net.pore_cz[pa]};
+    // Adjacent slivers have almost coincident centroids: L at least a tenth of the mean radius.
+    const Real L = std::max(norm(d), 0.1 * (p.radius[v[0]] + p.radius[v[1]] + p.radius[v[2]]) / 3);
+    net.ch_length[c] = L;
+    net.ch_aperture[c] = 2 * rh;
+    net.ch_cond[c] = std::min(net.pfv_factor * af * rh * rh / (2 * L), net.ch_cond_cap);
+  }
 }
 
-// The three passes of a geometry update, each parallel over its items.
+// A geometry update: the pores, then the throats (they need the pores' centroids), each parallel over
+// blocks.
 void update_geometry_3d(Network2D& net, const Particles3D& p) {
-  const Index nf = net.n_facets(), np = net.n_pores();
-#pragma omp parallel for schedule(static) if (nf > kParallelMin)
-  for (Index b = 0; b < (nf + kGeometryBlock - 1) / kGeometryBlock; ++b)
-    facet_geometry_3d(net, p, b * kGeometryBlock, std::min(nf, (b + 1) * kGeometryBlock));
+  const Index np = net.n_pores(), nc = net.n_channels();
 #pragma omp parallel for schedule(static) if (np > kParallelMin)
   for (Index b = 0; b < (np + kGeometryBlock - 1) / kGeometryBlock; ++b)
     pore_geometry_3d(net, p, b * kGeometryBlock, std::min(np, (b + 1) * kGeometryBlock));
-#pragma omp parallel for schedule(static) if (net.n_channels() > kParallelMin)
-  for (Index c = 0; c < net.n_channels(); ++c) throat_conductance_3d(net, p, c);
+#pragma omp parallel for schedule(static) if (nc > kParallelMin)
+  for (Index b = 0; b < (nc + kGeometryBlock - 1) / kGeometryBlock; ++b)
+    throat_geometry_3d(net, p, b * kGeometryBlock, std::min(nc, (b + 1) * kGeometryBlock));
 }
 
 // Clamp local conductances relative to the median (YADE clamps to maxKdivKmean x the mean,
@@ -205,7 +224,6 @@ Network2D build_network_3d(const Particles3D& p, const NetworkParams& params, Re
     std::array<std::int64_t, 3> key;
     std::array<Index, 3> v;
     Index pore;
-    int face;  // the pore's corner opposite the facet
   };
   std::vector<Facet> facets;
   facets.reserve(4 * static_cast<std::size_t>(np));
@@ -216,50 +234,25 @@ Network2D build_network_3d(const Particles3D& p, const NetworkParams& params, Re
       std::sort(f.v.begin(), f.v.end(), [&](Index a, Index b) { return gid(a) < gid(b); });
       for (int j = 0; j < 3; ++j) f.key[j] = gid(f.v[j]);
       f.pore = k;
-      f.face = i;
       facets.push_back(f);
     }
   std::sort(facets.begin(), facets.end(),
             [](const Facet& a, const Facet& b) { return std::tie(a.key, a.pore) < std::tie(b.key, b.pore); });
   net.pore_hull.assign(np, 0);
-  net.pore_face.assign(4 * static_cast<std::size_t>(np), -1);
-  std::vector<std::size_t> hull_facets;
   for (std::size_t e = 0; e < facets.size();) {
     if (e + 1 < facets.size() && facets[e + 1].key == facets[e].key) {
-      const Index c = static_cast<Index>(net.ch_pore.size() / 2);
       net.ch_pore.push_back(facets[e].pore);
       net.ch_pore.push_back(facets[e + 1].pore);
       for (int j = 0; j < 3; ++j) net.ch_part.push_back(facets[e].v[j]);
       net.ch_kind.push_back(ChannelKind::T2T);
       net.ch_pair.push_back(-1);
-      net.pore_face[4 * static_cast<std::size_t>(facets[e].pore) + facets[e].face] = c;
-      net.pore_face[4 * static_cast<std::size_t>(facets[e + 1].pore) + facets[e + 1].face] = c;
       e += 2;
     } else {
       net.pore_hull[facets[e].pore] = 1;
-      hull_facets.push_back(e);
       e += 1;
     }
   }
   const Index nc = static_cast<Index>(net.ch_pore.size() / 2);
-  for (std::size_t h = 0; h < hull_facets.size(); ++h) {
-    const Facet& f = facets[hull_facets[h]];
-    for (int j = 0; j < 3; ++j) net.hull_part.push_back(f.v[j]);
-    net.hull_pore.push_back(f.pore);
-    net.pore_face[4 * static_cast<std::size_t>(f.pore) + f.face] = nc + static_cast<Index>(h);
-  }
-  net.pore_face_slot.assign(np, 0);
-  for (Index k = 0; k < np; ++k)
-    for (int i = 0; i < 4; ++i) {
-      const Index f = net.pore_face[4 * static_cast<std::size_t>(k) + i];
-      const Index* fv = f < nc ? &net.ch_part[3 * static_cast<std::size_t>(f)] : &net.hull_part[3 * static_cast<std::size_t>(f - nc)];
-      for (int c = 0; c < 4; ++c) {
-        if (c == i) continue;
-        const Index j = net.pore_v[4 * static_cast<std::size_t>(k) + c];
-        const std::uint32_t slot = fv[0] == j ? 0u : fv[1] == j ? 1u : 2u;
-        net.pore_face_slot[k] |= slot << (2 * (4 * i + c));
-      }
-    }
   // Geometry: pores, throats, facet angles and normals (as each update), then the floors.
   net.pore_area.assign(np, 0);
   net.pore_cell.resize(np);
@@ -267,12 +260,10 @@ Network2D build_network_3d(const Particles3D& p, const NetworkParams& params, Re
   net.pore_cx.resize(np);
   net.pore_cy.resize(np);
   net.pore_cz.resize(np);
-  net.pore_face_in.assign(np, 0);
+  net.pore_patch.assign(12 * static_cast<std::size_t>(np), 0);
   net.ch_length.assign(nc, 0);
   net.ch_aperture.assign(nc, 0);
   net.ch_cond.assign(nc, 0);
-  net.face_angle.assign(3 * static_cast<std::size_t>(net.n_facets()), 0);
-  net.face_normal.assign(3 * static_cast<std::size_t>(net.n_facets()), 0);
   net.pfv_factor = pfv_factor;
   net.void_floor = 0;
   net.ch_cond_cap = std::numeric_limits<Real>::infinity();
