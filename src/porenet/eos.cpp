@@ -136,6 +136,27 @@ Real Eos::density(Real p, bool liquid) const {
   return 0;
 }
 
+Real Eos::density_near(Real p, bool liquid, Real guess) const {
+  if (kind != EosKind::PengRobinson || !(p > 0) || !(guess > 0) || !std::isfinite(guess)) return density(p, liquid);
+  // Newton on p(V) = p in the molar volume V (uncorrected, B10): on the liquid branch p(V) falls and is
+  // convex, on the gas branch it falls; a step that leaves (b, spinodal) or a rising p(V) means the
+  // guess was on another branch.
+  Real V = molar_mass / guess - s;
+  const Real vmax = liquid && v_spinodal > 0 ? v_spinodal : std::numeric_limits<Real>::infinity();
+  for (int it = 0; it < 8; ++it) {
+    if (!(V > b && V < vmax)) break;
+    const Real d = pr_dpdV(*this, V);
+    if (!(d < 0)) break;
+    const Real dV = (pr_p(*this, V) - p) / d;
+    V -= dV;
+    if (std::abs(dV) <= 1e-14 * V) {
+      if (!(V > b && V < vmax) || !(pr_dpdV(*this, V) < 0)) break;
+      return molar_mass / (V + s);  // B17: V_corr = V + s
+    }
+  }
+  return density(p, liquid);
+}
+
 Real Eos::bulk_modulus(Real rho) const {
   switch (kind) {
     case EosKind::PengRobinson: return -(molar_mass / rho) * pr_dpdV(*this, molar_mass / rho - s);

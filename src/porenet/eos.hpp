@@ -44,6 +44,11 @@ struct Eos {
   // Density at pressure p. PR: liquid root (smallest Z) if liquid, else the largest (vapour or
   // supercritical) root. Throws NumericalError if p <= 0 for a gas law.
   Real density(Real p, bool liquid) const;
+  // The same root found by Newton's method from a nearby density `guess` on the same branch (a pore's
+  // last density: a few iterations instead of the cubic's trigonometric roots); falls back to
+  // density() when the iteration leaves the branch or does not settle. Agrees with density() to
+  // round-off; the result depends on the guess only in the last bits.
+  Real density_near(Real p, bool liquid, Real guess) const;
   // Isothermal bulk modulus rho dp/drho [Pa].
   Real bulk_modulus(Real rho) const;
   // Largest admissible density (PR: V -> b), +inf for the other laws.

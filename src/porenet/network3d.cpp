@@ -46,8 +46,10 @@ constexpr Index kGeometryBlock = 64;
 // (v.w)|u|) with u, v, w the edges from it (Van Oosterom & Strackee 1983, IEEE Trans. Biomed. Eng.
 // 30:125).
 void pore_geometry_3d(Network2D& net, const Particles3D& p, Index k0, Index k1) {
-  constexpr int kArgs = 16;  // per pore: 4 solid angles, then 3 angles at the corners of each face
-  Real ys[kArgs * kGeometryBlock] = {}, xs[kArgs * kGeometryBlock] = {}, th[kArgs * kGeometryBlock];
+  // Per pore: 4 solid angles, then the angles at the first two corners of each face (the third is pi
+  // minus them).
+  constexpr int kArgs = 12;
+  Real ys[kArgs * kGeometryBlock], xs[kArgs * kGeometryBlock], th[kArgs * kGeometryBlock];
   Real normal[12 * kGeometryBlock], vol[kGeometryBlock];
   for (Index k = k0; k < k1; ++k) {
     const Index* v = &net.pore_v[4 * static_cast<std::size_t>(k)];
@@ -79,19 +81,21 @@ void pore_geometry_3d(Network2D& net, const Particles3D& p, Index k0, Index k1) 
       const Real uw = dot(u, w), us = dot(u, s), ws = dot(w, s);
       y[i] = six_vol;
       x[i] = lu * lw * ls + uw * ls + us * lw + ws * lu;
-      // The angle at corner i in each face through it (face f holds i as its corner (i - f + 3) % 4).
-      y[4 + 3 * o1 + (i - o1 + 3) % 4] = twice_area[o1];  // face without o1: edges w, s
-      x[4 + 3 * o1 + (i - o1 + 3) % 4] = ws;
-      y[4 + 3 * o2 + (i - o2 + 3) % 4] = twice_area[o2];  // edges u, s
-      x[4 + 3 * o2 + (i - o2 + 3) % 4] = us;
-      y[4 + 3 * o3 + (i - o3 + 3) % 4] = twice_area[o3];  // edges u, w
-      x[4 + 3 * o3 + (i - o3 + 3) % 4] = uw;
+      // The angle at corner i in each face through it (face f holds i as its corner (i - f + 3) % 4;
+      // corners 0 and 1 only).
+      const int m1 = (i - o1 + 3) % 4, m2 = (i - o2 + 3) % 4, m3 = (i - o3 + 3) % 4;
+      if (m1 < 2) y[4 + 2 * o1 + m1] = twice_area[o1], x[4 + 2 * o1 + m1] = ws;  // face without o1: edges w, s
+      if (m2 < 2) y[4 + 2 * o2 + m2] = twice_area[o2], x[4 + 2 * o2 + m2] = us;  // edges u, s
+      if (m3 < 2) y[4 + 2 * o3 + m3] = twice_area[o3], x[4 + 2 * o3 + m3] = uw;  // edges u, w
     }
     net.pore_cx[k] = 0.25 * (p.x[v[0]] + p.x[v[1]] + p.x[v[2]] + p.x[v[3]]);
     net.pore_cy[k] = 0.25 * (p.y[v[0]] + p.y[v[1]] + p.y[v[2]] + p.y[v[3]]);
     net.pore_cz[k] = 0.25 * (p.z[v[0]] + p.z[v[1]] + p.z[v[2]] + p.z[v[3]]);
   }
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // the loop above fills every argument
   atan2_nonneg(ys, xs, th, static_cast<int>(kArgs * (k1 - k0)));
+#pragma GCC diagnostic pop
   for (Index k = k0; k < k1; ++k) {
     const Index* v = &net.pore_v[4 * static_cast<std::size_t>(k)];
     const Real* t = &th[kArgs * (k - k0)];
@@ -105,7 +109,8 @@ void pore_geometry_3d(Network2D& net, const Particles3D& p, Index k0, Index k1) 
       for (int face = 0; face < 4; ++face) {  // the faces through corner i
         if (face == i) continue;
         const int m = (i - face + 3) % 4;  // corner i is corner m of face `face`
-        const Real w = 0.5 * t[4 + 3 * face + m] * R * R;
+        const Real theta = m < 2 ? t[4 + 2 * face + m] : kPi - t[4 + 2 * face] - t[4 + 2 * face + 1];
+        const Real w = 0.5 * theta * R * R;
         for (int q = 0; q < 3; ++q) a[q] += w * n[3 * face + q];
       }
       for (int q = 0; q < 3; ++q) patch[3 * i + q] = a[q];
@@ -121,26 +126,30 @@ void pore_geometry_3d(Network2D& net, const Particles3D& p, Index k0, Index k1) 
 // and conductance g mu = pfv_factor A_f R_h^2 / (2 L) (Chareyre et al. 2012), clamped.
 void throat_geometry_3d(Network2D& net, const Particles3D& p, Index c0, Index c1) {
   auto pos = [&](Index i) { return V3{p.x[i], p.y[i], p.z[i]}; };
-  Real ys[3 * kGeometryBlock] = {}, xs[3 * kGeometryBlock] = {}, th[3 * kGeometryBlock], area[kGeometryBlock];
+  Real ys[2 * kGeometryBlock], xs[2 * kGeometryBlock], th[2 * kGeometryBlock], area[kGeometryBlock];
   for (Index c = c0; c < c1; ++c) {
     const Index* v = &net.ch_part[3 * static_cast<std::size_t>(c)];
     const V3 A = pos(v[0]), B = pos(v[1]), C = pos(v[2]);
     const Real twice_area = norm(cross(sub(B, A), sub(C, A)));  // |u x w| at every corner
     area[c - c0] = 0.5 * twice_area;
-    for (int j = 0; j < 3; ++j) {  // the angle at corner j: atan2(|u x w|, u . w)
+    for (int j = 0; j < 2; ++j) {  // the angle at corner j: atan2(|u x w|, u . w); at corner 2 pi minus both
       const V3 o = pos(v[j]);
-      ys[3 * (c - c0) + j] = twice_area;
-      xs[3 * (c - c0) + j] = dot(sub(pos(v[(j + 1) % 3]), o), sub(pos(v[(j + 2) % 3]), o));
+      ys[2 * (c - c0) + j] = twice_area;
+      xs[2 * (c - c0) + j] = dot(sub(pos(v[(j + 1) % 3]), o), sub(pos(v[(j + 2) % 3]), o));
     }
   }
-  atan2_nonneg(ys, xs, th, static_cast<int>(3 * (c1 - c0)));
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // the loop above fills every argument
+  atan2_nonneg(ys, xs, th, static_cast<int>(2 * (c1 - c0)));
+#pragma GCC diagnostic pop
   for (Index c = c0; c < c1; ++c) {
     const Index* v = &net.ch_part[3 * static_cast<std::size_t>(c)];
+    const Real angle[3] = {th[2 * (c - c0)], th[2 * (c - c0) + 1], kPi - th[2 * (c - c0)] - th[2 * (c - c0) + 1]};
     Real solid = 0, perim = 0;
     for (int j = 0; j < 3; ++j) {
       const Real R = p.radius[v[j]];
-      solid += 0.5 * th[3 * (c - c0) + j] * R * R;
-      perim += th[3 * (c - c0) + j] * R;
+      solid += 0.5 * angle[j] * R * R;
+      perim += angle[j] * R;
     }
     const Real af = std::max(area[c - c0] - solid, net.params.min_void_fraction * area[c - c0]);
     const Real rh = af / perim;

@@ -280,8 +280,10 @@ void TwoPhaseFlow::update_pore_states(Real dt, const char* scheme) {
     const Real a = solve_shared_pressure(std::max(mq_[i], 0.0), std::max(mp_[i], 0.0), V, alpha_[i], p);
     alpha_[i] = a;
     p_[i] = p;
-    rq_[i] = a > 0 ? mq_[i] / (a * V) : prm_.liquid.density(p > 0 ? p : 1.0, true);  // B20
-    rp_[i] = a < 1 ? mp_[i] / ((1 - a) * V) : prm_.gas.density(p > 0 ? p : 1.0, false);
+    // B20; an absent phase keeps the density of the pore's pressure (the implicit step's weights),
+    // found from its last one.
+    rq_[i] = a > 0 ? mq_[i] / (a * V) : prm_.liquid.density_near(p > 0 ? p : 1.0, true, rq_[i]);
+    rp_[i] = a < 1 ? mp_[i] / ((1 - a) * V) : prm_.gas.density_near(p > 0 ? p : 1.0, false, rp_[i]);
   }
   if (bad >= 0)
     throw NumericalError(fmt::format("porenet: pore {} phase masses ({}, {}) kg after an {} step of {} s; reduce dt "
