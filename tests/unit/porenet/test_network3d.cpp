@@ -18,6 +18,33 @@
 using namespace ff;
 using namespace ff::porenet;
 
+namespace {
+// A dense random packing of spheres (radii 0.4-0.6 mm) in the box [0, hi], as coordinate arrays.
+struct Spheres {
+  std::vector<Real> x, y, z, r;
+};
+Spheres box_spheres(const Vec3& hi, Real porosity, std::uint64_t seed) {
+  PackingSpec spec;
+  spec.dim = 3;
+  spec.container = PackingSpec::Container::Box;
+  spec.box_lo = {0, 0, 0};
+  spec.box_hi = hi;
+  spec.radius_min = 0.4e-3;
+  spec.radius_max = 0.6e-3;
+  spec.porosity = porosity;
+  spec.seed = seed;
+  const Packing pk = dense_random_packing(spec);
+  Spheres s;
+  for (const Vec3& c : pk.position) {
+    s.x.push_back(c.x());
+    s.y.push_back(c.y());
+    s.z.push_back(c.z());
+  }
+  s.r = pk.radius;
+  return s;
+}
+}  // namespace
+
 TEST(PorenetNetwork3D, FourTouchingSpheresAndBoxFlow) {
   // Regular tetrahedron of edge 2 with unit spheres: void = V_tet - 4 Omega / 3, Omega = 0.5513 sr.
   std::vector<Real> x{0, 2, 1, 1}, y{0, 0, std::sqrt(3.0), 1 / std::sqrt(3.0)}, z{0, 0, 0, 2 * std::sqrt(2.0 / 3)},
@@ -93,37 +120,23 @@ TEST(PorenetNetwork3D, FourTouchingSpheresAndBoxFlow) {
   EXPECT_LT(*hi, 10.0);
 }
 
-// The patch force per unit pressure (forces.cpp) reads the facets' angles and normals that the last
-// geometry update stored, one per facet corner. Check it against the direct integral, computed here
+// The patch force per unit pressure (forces.cpp) reads the vector the last geometry update stored for
+// each pore corner (network3d.cpp). Check it against the direct integral, computed here
 // from the positions for each pore corner and face (-int_patch n dA = sum_f n_f theta_f R^2 / 2, n_f
 // the face's outward normal, theta_f the face's angle at the sphere), after every sphere of a packing
 // has moved by up to 5 % of the smallest radius (update_network_3d, topology kept). Tolerance 1e-12
 // of theta R^2 (round-off of the two orders of evaluation).
 TEST(PorenetNetwork3D, PatchForcesFollowTheUpdatedGeometry) {
-  PackingSpec spec;
-  spec.dim = 3;
-  spec.container = PackingSpec::Container::Box;
-  spec.box_lo = {0, 0, 0};
-  spec.box_hi = {5e-3, 5e-3, 5e-3};
-  spec.radius_min = 0.4e-3;
-  spec.radius_max = 0.6e-3;
-  spec.porosity = 0.42;
-  spec.seed = 3;
-  const Packing pk = dense_random_packing(spec);
-  std::vector<Real> x, y, z;
-  for (const Vec3& c : pk.position) {
-    x.push_back(c.x());
-    y.push_back(c.y());
-    z.push_back(c.z());
-  }
-  Network2D net = build_network_3d({x, y, z, pk.radius, {}});
+  Spheres pk = box_spheres({5e-3, 5e-3, 5e-3}, 0.42, 3);
+  auto &x = pk.x, &y = pk.y, &z = pk.z;
+  Network2D net = build_network_3d({x, y, z, pk.r, {}});
   ASSERT_GT(net.n_pores(), 500);
   for (std::size_t j = 0; j < x.size(); ++j) {  // a deterministic jitter
     x[j] += 2e-5 * std::sin(1.3 * static_cast<Real>(j));
     y[j] += 2e-5 * std::cos(0.7 * static_cast<Real>(j));
     z[j] += 2e-5 * std::sin(2.1 * static_cast<Real>(j) + 0.4);
   }
-  const Particles3D p{x, y, z, pk.radius, {}};
+  const Particles3D p{x, y, z, pk.r, {}};
   update_network_3d(net, p);
   Real worst = 0;
   long checked = 0;
@@ -142,11 +155,11 @@ TEST(PorenetNetwork3D, PatchForcesFollowTheUpdatedGeometry) {
         Vec3 n = a.cross(b).normalized();
         if (n.dot(d) > 0) n = -n;
         const Real th = std::atan2(a.cross(b).norm(), a.dot(b));
-        expect += 0.5 * th * pk.radius[j] * pk.radius[j] * n;
+        expect += 0.5 * th * pk.r[j] * pk.r[j] * n;
       }
       Real got[3];
       unit_patch_force_3d(net, p, j, e, got);
-      const Real scale = pk.radius[j] * pk.radius[j];
+      const Real scale = pk.r[j] * pk.r[j];
       worst = std::max(worst, (Vec3(got[0], got[1], got[2]) - expect).norm() / scale);
       ++checked;
     }
@@ -190,32 +203,19 @@ TEST(PorenetNetwork3D, VectorisedAtan2MatchesLibmAndDoesNotDependOnTheBatch) {
 // The geometry update runs over blocks of pores and throats in parallel (above kParallelMin): 1 and 2
 // threads give the same bits (voids, patch vectors, conductances) on a network large enough to split.
 TEST(PorenetNetwork3D, GeometryUpdateIsTheSameOnOneAndTwoThreads) {
-  PackingSpec spec;
-  spec.dim = 3;
-  spec.container = PackingSpec::Container::Box;
-  spec.box_lo = {0, 0, 0};
-  spec.box_hi = {10e-3, 10e-3, 8e-3};
-  spec.radius_min = 0.4e-3;
-  spec.radius_max = 0.6e-3;
-  spec.porosity = 0.42;
-  spec.seed = 4;
-  const Packing pk = dense_random_packing(spec);
-  std::vector<Real> x, y, z;
-  for (const Vec3& c : pk.position) {
-    x.push_back(c.x() + 1e-5 * std::sin(3.1 * c.y() / 1e-3));
-    y.push_back(c.y());
-    z.push_back(c.z());
-  }
-  Network2D one = build_network_3d({x, y, z, pk.radius, {}});
+  Spheres pk = box_spheres({10e-3, 10e-3, 8e-3}, 0.42, 4);
+  auto &x = pk.x, &y = pk.y, &z = pk.z;
+  for (std::size_t j = 0; j < x.size(); ++j) x[j] += 1e-5 * std::sin(3.1 * y[j] / 1e-3);
+  Network2D one = build_network_3d({x, y, z, pk.r, {}});
   ASSERT_GT(one.n_pores(), kParallelMin);  // both loops split (throats ~2x the pores)
   Network2D two = one;
   for (auto& v : x) v += 3e-6;  // a move that changes every pore's shape a little
   for (std::size_t j = 0; j < y.size(); ++j) y[j] += 2e-6 * std::cos(static_cast<Real>(j));
   const int before = omp_get_max_threads();
   omp_set_num_threads(1);
-  update_network_3d(one, {x, y, z, pk.radius, {}});
+  update_network_3d(one, {x, y, z, pk.r, {}});
   omp_set_num_threads(2);
-  update_network_3d(two, {x, y, z, pk.radius, {}});
+  update_network_3d(two, {x, y, z, pk.r, {}});
   omp_set_num_threads(before);
   EXPECT_EQ(one.pore_void, two.pore_void);
   EXPECT_EQ(one.pore_patch, two.pore_patch);
