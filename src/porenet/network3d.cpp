@@ -83,10 +83,15 @@ void pore_geometry_3d(Network2D& net, const Particles3D& p, Index k0, Index k1) 
       x[i] = lu * lw * ls + uw * ls + us * lw + ws * lu;
       // The angle at corner i in each face through it (face f holds i as its corner (i - f + 3) % 4;
       // corners 0 and 1 only).
-      const int m1 = (i - o1 + 3) % 4, m2 = (i - o2 + 3) % 4, m3 = (i - o3 + 3) % 4;
-      if (m1 < 2) y[4 + 2 * o1 + m1] = twice_area[o1], x[4 + 2 * o1 + m1] = ws;  // face without o1: edges w, s
-      if (m2 < 2) y[4 + 2 * o2 + m2] = twice_area[o2], x[4 + 2 * o2 + m2] = us;  // edges u, s
-      if (m3 < 2) y[4 + 2 * o3 + m3] = twice_area[o3], x[4 + 2 * o3 + m3] = uw;  // edges u, w
+      auto face_angle_at_i = [&](int f, Real cosine_term) {  // atan2(|e1 x e2|, e1 . e2)
+        const int m = (i - f + 3) % 4;
+        if (m >= 2) return;
+        y[4 + 2 * f + m] = twice_area[f];
+        x[4 + 2 * f + m] = cosine_term;
+      };
+      face_angle_at_i(o1, ws);  // the face without o1: edges w, s
+      face_angle_at_i(o2, us);  // edges u, s
+      face_angle_at_i(o3, uw);  // edges u, w
     }
     net.pore_cx[k] = 0.25 * (p.x[v[0]] + p.x[v[1]] + p.x[v[2]] + p.x[v[3]]);
     net.pore_cy[k] = 0.25 * (p.y[v[0]] + p.y[v[1]] + p.y[v[2]] + p.y[v[3]]);
