@@ -107,17 +107,11 @@ namespace ff::porenet {
 // p times the patch force per unit pressure that the last geometry update stored (network3d.cpp,
 // pore_geometry_3d: the cone's faces, n_f theta_f R^2 / 2 each). A face between two pores gets
 // opposite normals from them: an interior sphere at uniform pressure feels no net force.
-namespace {
-inline void patch_force(const Network2D& net, Index e, Real out[3]) {
+void unit_patch_force_3d(const Network2D& net, Index e, Real out[3]) {
   const Real* a = &net.pore_patch[12 * static_cast<std::size_t>(net.pp_pore[e]) + 3 * net.pp_corner[e]];
   out[0] = a[0];
   out[1] = a[1];
   out[2] = a[2];
-}
-}  // namespace
-
-void unit_patch_force_3d(const Network2D& net, const Particles3D& p, Index j, Index e, Real out[3]) {
-  patch_force(net, e, out);
 }
 
 void add_pressure_forces_3d(const Network2D& net, const Particles3D& p, std::span<const Real> P, std::span<Real> fx,
@@ -133,7 +127,7 @@ void add_pressure_forces_3d(const Network2D& net, const Particles3D& p, std::spa
     Real s[3] = {0, 0, 0};
     for (Index e = net.pp_start[j]; e < net.pp_start[j + 1]; ++e) {
       Real a[3];
-      patch_force(net, e, a);
+      unit_patch_force_3d(net, e, a);
       const Real Pk = P[net.pp_pore[e]];
       for (int q = 0; q < 3; ++q) s[q] += Pk * a[q];
     }

@@ -51,8 +51,8 @@ void add_shear_forces(const Network2D& net, const Particles2D& particles, std::s
 // pressure of the network's last geometry (build_network_3d or update_network_3d at these positions).
 void add_pressure_forces_3d(const Network2D& net, const Particles3D& particles, std::span<const Real> pore_pressure,
                             std::span<Real> fx, std::span<Real> fy, std::span<Real> fz);
-// The force on sphere j per unit pressure in the tetrahedron of its pore-corner entry e (net.pp_pore[e])
-// [m^2]: sum_f n_f theta_f R^2 / 2 (forces.cpp); add_pressure_forces_3d sums P_k times it.
-void unit_patch_force_3d(const Network2D& net, const Particles3D& particles, Index j, Index e, Real out[3]);
+// The force per unit pressure [m^2] on the sphere of pore-corner entry e (pore net.pp_pore[e]):
+// sum_f n_f theta_f R^2 / 2 (forces.cpp); add_pressure_forces_3d sums P_k times it.
+void unit_patch_force_3d(const Network2D& net, Index e, Real out[3]);
 
 }  // namespace ff::porenet

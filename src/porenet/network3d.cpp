@@ -267,7 +267,8 @@ Network2D build_network_3d(const Particles3D& p, const NetworkParams& params, Re
     }
   }
   const Index nc = static_cast<Index>(net.ch_pore.size() / 2);
-  // Geometry: pores, throats, facet angles and normals (as each update), then the floors.
+  // Geometry as each update does (pores with their patch vectors, then throats), then the void floor
+  // and the conductance cap, both from this first geometry.
   net.pore_area.assign(np, 0);
   net.pore_cell.resize(np);
   net.pore_void.resize(np);

@@ -127,13 +127,12 @@ void DemPorenet3D::compute_fluid_forces(Real p_floor) {
   // p dV/dx_j, the floors as the fluid stiffness's open_floored (the geometric gradient at the relative
   // floor: at a fixed pressure it is the gradient of p V, conservative).
   const auto& net = *net_;
-  const porenet::Particles3D parts = view();
 #pragma omp parallel for schedule(static) if (net.n_particles > porenet::kParallelMin)
   for (Index j = 0; j < net.n_particles; ++j) {
     Vec3 f = Vec3::Zero();
     for (Index e = net.pp_start[j]; e < net.pp_start[j + 1]; ++e) {
       Real a[3];
-      porenet::unit_patch_force_3d(net, parts, j, e, a);
+      porenet::unit_patch_force_3d(net, e, a);
       f += pg_[static_cast<std::size_t>(net.pp_pore[e])] * void_gradient(j, e, Vec3(a[0], a[1], a[2]), false);
     }
     fx_[static_cast<std::size_t>(j)] = f.x();
@@ -329,7 +328,6 @@ Vec3 DemPorenet3D::void_gradient(Index j, Index e, const Vec3& a, bool floored) 
 
 std::vector<Real> DemPorenet3D::fluid_stiffness(bool open_floored) const {
   const auto& net = *net_;
-  const porenet::Particles3D parts = view();
   std::vector<Real> k(static_cast<std::size_t>(net.n_particles), 0.0);
   for (Index j = 0; j < net.n_particles; ++j) {
     Real sum = 0;
@@ -339,7 +337,7 @@ std::vector<Real> DemPorenet3D::fluid_stiffness(bool open_floored) const {
       const Real K = flow_->mixture_bulk_modulus(i);
       if (!(K > 0)) continue;
       Real a[3];
-      porenet::unit_patch_force_3d(net, parts, j, e, a);
+      porenet::unit_patch_force_3d(net, e, a);
       const Vec3 av(a[0], a[1], a[2]);
       const Real g = void_gradient(j, e, av, !open_floored).norm();
       const Real force_per_p = prm_.pressure_force == PressureForce::Surface ? av.norm() : g;

@@ -319,14 +319,6 @@ TEST(CouplingPorenet3D, FluidStiffnessIsTheUndrainedForceChangePerMove) {
     if (net0.pore_hull[i])
       for (int k = 0; k < 4; ++k) hull[static_cast<std::size_t>(net0.pore_v[4 * i + k])] = 1;
   const auto kest = c0.fluid_stiffness(false), kopen = c0.fluid_stiffness(true);
-  std::vector<Real> x, y, z, r;
-  for (const auto& q : s0->sys.particles.pos) {
-    x.push_back(q.x());
-    y.push_back(q.y());
-    z.push_back(q.z());
-  }
-  r.assign(s0->sys.particles.radius.begin(), s0->sys.particles.radius.end());
-  const porenet::Particles3D parts{x, y, z, r, {}};
   int tested = 0;
   for (std::size_t j = 0; j < hull.size() && tested < 4; ++j) {
     if (hull[j]) continue;
@@ -335,7 +327,7 @@ TEST(CouplingPorenet3D, FluidStiffnessIsTheUndrainedForceChangePerMove) {
     for (Index e = net0.pp_start[j]; e < net0.pp_start[j + 1]; ++e) {
       const Index i = net0.pp_pore[e];
       Real a[3];
-      porenet::unit_patch_force_3d(net0, parts, static_cast<Index>(j), e, a);
+      porenet::unit_patch_force_3d(net0, e, a);
       const Vec3 av(a[0], a[1], a[2]);
       trace_pred += 5e7 * av.dot(c0.void_gradient(static_cast<Index>(j), e, av, true)) / net0.pore_void[i];
     }

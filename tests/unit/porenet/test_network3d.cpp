@@ -158,7 +158,7 @@ TEST(PorenetNetwork3D, PatchForcesFollowTheUpdatedGeometry) {
         expect += 0.5 * th * pk.r[j] * pk.r[j] * n;
       }
       Real got[3];
-      unit_patch_force_3d(net, p, j, e, got);
+      unit_patch_force_3d(net, e, got);
       const Real scale = pk.r[j] * pk.r[j];
       worst = std::max(worst, (Vec3(got[0], got[1], got[2]) - expect).norm() / scale);
       ++checked;
