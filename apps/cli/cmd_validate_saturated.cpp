@@ -45,6 +45,7 @@ struct Args {
   double bond_gap = 0.5;  // x radius_min: neighbours this close are bonded (0.1: ~1.7 bonds per disc, brittle)
   double safety = 0.3;    // dem.time_step_safety (of the critical step with the pore fluid's stiffness)
   int seed = 7, threads = 1, packings = 3, jobs = 1;
+  std::string placement = "uniform";  // fluid.liquid_placement of the partly saturated runs
   bool quick = false, overwrite = false, resume = false;
 };
 
@@ -84,13 +85,14 @@ platen_friction = 0.1
 max_strain = 0.01
 [fluid]
 drainage = "sides"
+liquid_placement = "{}"
 [output]
 vtk = false
 plots = false
 progress_interval = 0
 )",
                      a.safety, 2600 * 4 * 0.25 * (a.radius_min + a.radius_max) / 3, a.width, a.height, a.radius_min,
-                     a.radius_max, a.bond_gap * a.radius_min, a.seed, a.velocity);
+                     a.radius_max, a.bond_gap * a.radius_min, a.seed, a.velocity, a.placement);
 }
 
 void write_text(const fs::path& f, const std::string& t) {
@@ -494,6 +496,10 @@ const bool registered = ff::cli::register_command({"validate-saturated", [](CLI:
   sub->add_option("--width", a->width, "specimen width [m]")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--height", a->height, "specimen height [m]")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_option("--velocity", a->velocity, "platen velocity, each [m/s]")->check(CLI::PositiveNumber)->capture_default_str();
+  sub->add_option("--liquid-placement", a->placement,
+                  "where a saturation below 1 puts the water (fluid.liquid_placement): uniform or smallest_pores_first")
+      ->check(CLI::IsMember({"uniform", "smallest_pores_first"}))
+      ->capture_default_str();
   sub->add_option("--seed", a->seed, "first packing seed")->capture_default_str();
   sub->add_option("--bond-gap", a->bond_gap, "neighbours closer than this x radius_min are bonded (sample.bond_gap)")
       ->check(CLI::NonNegativeNumber)

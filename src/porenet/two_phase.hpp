@@ -57,6 +57,16 @@ struct StratifiedRates {
 // G = -dp/dx [Pa/m]; layer thicknesses h_q, h_p >= 0 [m]; viscosities [Pa s].
 StratifiedRates stratified_channel_flow(Real G, Real h_q, Real h_p, Real mu_q, Real mu_p);
 
+// Where an initial saturation S below 1 puts the liquid.
+//  Uniform: every pore holds the fraction S.
+//  SmallestPoresFirst: the capillary-equilibrium arrangement of a wetting liquid (Young-Laplace:
+//    the entry pressure of a pore falls with its size, so at rest the liquid fills the smallest
+//    pores and the gas the largest; the quasi-static drainage picture of pore-network models,
+//    Blunt 2017, Multiphase Flow in Permeable Media, ch. 4). Pores are taken by void volume, ascending
+//    (ties by index), filled with liquid until S x the total void is placed; the pore where that
+//    happens keeps the remainder as a fraction, the rest hold gas only.
+enum class LiquidPlacement : std::uint8_t { Uniform = 0, SmallestPoresFirst = 1 };
+
 struct TwoPhaseParams {
   Eos liquid = Eos::water_pr(293.15);
   Eos gas = Eos::air_pr(293.15);
@@ -75,8 +85,10 @@ class TwoPhaseFlow {
  public:
   TwoPhaseFlow(const Network2D& net, const TwoPhaseParams& params);
 
-  // Pressure p and liquid saturation S (0..1) in every pore; masses from the EOS at the current voids.
-  void init(Real p, Real saturation);
+  // Pressure p everywhere and liquid saturation S (0..1) of the whole void, placed as `placement`
+  // says; masses from the EOS at the current voids. Boundary conditions set afterwards override
+  // their pores.
+  void init(Real p, Real saturation, LiquidPlacement placement = LiquidPlacement::Uniform);
   // Sets one pore's state (before stepping), e.g. a non-uniform initial field.
   void set_pore_state(Index pore, Real p, Real saturation);
   // Pressure: value = p [Pa] with liquid fraction alpha_bc; Flux: value = liquid mass inflow [kg/s].

@@ -146,7 +146,7 @@ void DemPorenetCoupling::init(dem::DemSystem& sys, const PorenetCouplingParams& 
   mean_radius_ /= static_cast<Real>(n);
   build_pairs(sys);
   make_network_and_flow(net_, flow_);
-  flow_->init(prm_.initial_pressure, prm_.saturation);
+  flow_->init(prm_.initial_pressure, prm_.saturation, prm_.placement);
   set_boundaries(*flow_, *net_);
   pg_.assign(static_cast<std::size_t>(net_->n_pores()), 0);
   vap_.assign(static_cast<std::size_t>(net_->n_pores()), 0);

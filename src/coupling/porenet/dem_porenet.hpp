@@ -55,6 +55,7 @@ struct PorenetCouplingParams {
   Real initial_pressure = 1e5;  // [Pa]
   Real ambient_pressure = 1e5;  // outside the sample [Pa]; forces use p - ambient
   Real saturation = 1.0;        // initial liquid saturation, 0..1
+  porenet::LiquidPlacement placement = porenet::LiquidPlacement::Uniform;  // where S < 1 puts the liquid
   Real retriangulation_tolerance = 0.25;  // x mean radius (cf. YADE defTolerance)
   Real dt_safety = 0.9;                   // flow sub-step <= safety x stable step
   long max_substeps = 200000;             // a flow step this small is an error, not a slow run

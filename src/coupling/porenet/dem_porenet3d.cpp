@@ -67,7 +67,7 @@ void DemPorenet3D::init(const dem::DemSystem& sys, const Porenet3DParams& params
   mean_radius_ /= static_cast<Real>(n);
   stats_ = {};
   make_network_and_flow(net_, flow_);
-  flow_->init(prm_.initial_pressure, prm_.saturation);
+  flow_->init(prm_.initial_pressure, prm_.saturation, prm_.placement);
   set_boundaries(*flow_, *net_);
 }
 

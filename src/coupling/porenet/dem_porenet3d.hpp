@@ -41,6 +41,7 @@ struct Porenet3DParams {
   Real initial_pressure = 1e5;  // [Pa]
   Real ambient_pressure = 1e5;  // outside the sample [Pa]; forces use p - ambient
   Real saturation = 1.0;        // initial liquid saturation, 0..1
+  porenet::LiquidPlacement placement = porenet::LiquidPlacement::Uniform;  // where S < 1 puts the liquid
   Real retriangulation_tolerance = 0.25;  // x mean radius (cf. YADE defTolerance)
   porenet::RemapConserve remap = porenet::RemapConserve::Mass;  // what a retriangulation carries (remap.hpp)
   bool implicit = true;

@@ -37,6 +37,11 @@ void declare(ParamTable& t) {
   declare_ucs_params(t);
   t.real("fluid.saturation", 1.0, "-", "initial liquid saturation of the pores (0: dry, gas only; 1: liquid only)")
       .range(0, 1);
+  t.string("fluid.liquid_placement", "uniform",
+           "where a saturation below 1 puts the liquid: uniform (every pore holds that fraction) or "
+           "smallest_pores_first (capillary equilibrium of a wetting liquid: the smallest pores full, the largest "
+           "gas only; docs/saturated.md)")
+      .one_of({"uniform", "smallest_pores_first"});
   t.real("fluid.liquid_viscosity", 1e-3, "Pa s", "dynamic viscosity of the liquid (water: 1e-3)").positive();
   t.real("fluid.gas_viscosity", 1.8e-5, "Pa s", "dynamic viscosity of the gas (air: 1.8e-5)").positive();
   t.string("fluid.liquid_eos", "barotropic",
@@ -136,6 +141,11 @@ porenet::TwoPhaseParams fluid_params(const Config& cfg) {
   return f;
 }
 
+porenet::LiquidPlacement liquid_placement(const Config& cfg) {
+  return cfg.string("fluid.liquid_placement") == "smallest_pores_first" ? porenet::LiquidPlacement::SmallestPoresFirst
+                                                                        : porenet::LiquidPlacement::Uniform;
+}
+
 // fluid.pressure_forces; auto: the void gradient in 2D, the surface (patches) in 3D.
 coupling::PressureForce pressure_force(const Config& cfg, bool dim3) {
   const std::string& v = cfg.string("fluid.pressure_forces");
@@ -148,6 +158,7 @@ coupling::PorenetCouplingParams coupling_params(const Config& cfg) {
   p.fluid = fluid_params(cfg);
   p.initial_pressure = p.ambient_pressure = cfg.real("fluid.initial_pressure");
   p.saturation = cfg.real("fluid.saturation");
+  p.placement = liquid_placement(cfg);
   p.drainage = cfg.string("fluid.drainage") == "closed" ? coupling::Drainage::Closed : coupling::Drainage::Sides;
   p.network.b1_h0 = cfg.real("fluid.aperture_h0");
   p.network.b1_h_inf = cfg.real("fluid.aperture_hinf");
@@ -169,6 +180,7 @@ coupling::Porenet3DParams params_3d(const Config& cfg) {
   p.fluid = fluid_params(cfg);
   p.initial_pressure = p.ambient_pressure = cfg.real("fluid.initial_pressure");
   p.saturation = cfg.real("fluid.saturation");
+  p.placement = liquid_placement(cfg);
   p.network.min_void_relative = cfg.real("fluid.min_void_relative");
   p.pfv_factor = cfg.real("fluid.pfv_factor");
   p.fluid.cg_tolerance = cfg.real("fluid.cg_tolerance");
@@ -414,6 +426,7 @@ class SaturatedUcsRun final : public UcsRun {
     f["dimension"] = fluid_.dim3() ? 3 : 2;
     f["max_pore_pressure_Pa"] = ex_.max_pore_pressure;
     f["saturation_initial"] = cfg.real("fluid.saturation");
+    f["liquid_placement"] = cfg.string("fluid.liquid_placement");
     f["saturation_final"] = fluid_.flow().saturation();
     f["retriangulations"] = fluid_.retriangulations();
     f["dem_dt_s"] = sys.settings.dt;
