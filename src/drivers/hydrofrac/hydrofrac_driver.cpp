@@ -31,11 +31,11 @@
 #include "drivers/dem_results.hpp"
 #include "drivers/hydrofrac/borehole.hpp"
 #include "drivers/hydrofrac/dfn.hpp"
+#include "drivers/hydrofrac/hydrofrac_params.hpp"
 #include "drivers/hydrofrac/kirsch.hpp"
 #include "drivers/hydrofrac/sleeve_load.hpp"
 #include "drivers/hydrofrac/lbm_load.hpp"
 #include "drivers/hydrofrac/network_load.hpp"
-#include "drivers/flow/flow_runner.hpp"
 #include "io/pvd.hpp"
 #include "coupling/fluid_spec.hpp"
 #include "drivers/run_control.hpp"
@@ -53,239 +53,9 @@ namespace {
 
 using hydrofrac::BoreholeGeometry;
 using hydrofrac::CircleStress;
-
-void declare(ParamTable& t) {
-  dem::declare_dem_params(t);
-  dem::declare_sample_params(t);
-  hydrofrac::declare_dfn_params(t);
-  t.real("borehole.radius", 3e-3, "m", "borehole radius: particles whose centres lie closer to the block's centre axis are removed")
-      .positive();
-  t.real("borehole.perforation_length", 0, "m", "length of each perforation slot beyond the wall (0: none)").non_negative();
-  t.real("borehole.perforation_width", 0, "m", "width of the perforation slots (0: 2 sample.radius_max)").non_negative();
-  t.real("borehole.perforation_azimuth", 0, "deg", "direction of the perforation from x (the sigma_H direction)");
-  t.integer("borehole.perforation_sides", 2, "-", "1: one slot; 2: two opposite slots").range(1, 2);
-  t.real("insitu.sigma_H", 5e6, "Pa", "maximum horizontal stress, applied along x by servo walls (compression > 0)").positive();
-  t.real("insitu.sigma_h", 5e6, "Pa", "minimum horizontal stress, along y").positive();
-  t.real("insitu.sigma_v", 5e6, "Pa", "vertical stress along z (3D only)").positive();
-  t.real("insitu.tolerance", 0.02, "-",
-         "equilibrium before injection: every wall stress within this fraction of its target and the unbalanced-force "
-         "ratio below it")
-      .positive();
-  t.integer("insitu.max_steps", 100000, "steps", "cap of the in-situ stage (a warning when equilibrium is not reached)").positive();
-  t.real("insitu.servo_velocity", 0.5, "m/s", "speed cap of the wall servos").positive();
-  t.real("insitu.servo_relaxation", 0.5, "-", "servo relaxation factor alpha (PFC default 0.8)").open_range(0, 1).at_most(1);
-  t.string("injection.fluid", "sleeve",
-           "fluid model: sleeve (pressure on the hole's wall particles, and on connected crack faces with penetration); "
-           "lbm (lattice Boltzmann fluid over the block, keys fluid.*; docs/hydrofrac.md); network (pore-network flow from the "
-           "hole into the rock and its cracks, keys network.*)")
-      .one_of({"sleeve", "lbm", "network"});
-  // The pore network (injection.fluid = "network"; drivers/hydrofrac/network_load.hpp).
-  t.real("network.viscosity", 1e-3, "Pa s", "network: dynamic viscosity of the injected liquid").positive();
-  t.real("network.density", 1000, "kg/m^3", "network: liquid density at network.pore_pressure").positive();
-  t.real("network.pore_pressure", 1e5, "Pa",
-         "network: the rock's initial (absolute) pore pressure, the zero of the reported pressure and of the grain forces")
-      .positive();
-  t.real("network.vapour_pressure", 2.34e3, "Pa", "network: a pore pulled below it cavitates (held there, its liquid mass kept)")
-      .non_negative();
-  t.real("network.aperture_h0", 1e-6, "m", "network, 2D: contact/bond channel aperture at zero normal stress (Eq. B1 h0)").positive();
-  t.real("network.aperture_hinf", 1e-7, "m", "network, 2D: contact/bond channel aperture at infinite normal stress (Eq. B1 h_inf)")
-      .positive();
-  t.real("network.b2_gamma", 0.02, "-",
-         "network, 2D: factor of the geometric pore-to-pore aperture (Eq. B2; 1 = the free gap between the grains: a "
-         "permeable packing; 0.02: a tight rock the fluid penetrates over a few grains during the ramp)")
-      .positive();
-  t.real("network.throat_factor", 1e-7, "-",
-         "network, 3D: factor on the throats' geometric (PFV) conductance: 1 = the packing's own throats, through which "
-         "the whole block fills within a few DEM steps; 1e-7: a tight rock the fluid penetrates over a few grains")
-      .positive();
-  t.real("network.max_conductance_ratio", 100, "-", "network, 3D: throat conductance cap, x the median at a triangulation").positive();
-  t.real("network.retriangulation_tolerance", 0.25, "-",
-         "network: retriangulate when a particle moved this many mean radii since the last triangulation")
-      .positive();
-  t.string("network.remap", "mass",
-           "network: what a retriangulation carries over: mass (each phase's mass; every pore's pressure then shifts by "
-           "the bulk modulus x the relative change of the network's total void) or pressure (each pore's pressure; the "
-           "mass change is reported in summary.json's network.mass_budget_kg.remap_change; docs/saturated.md)")
-      .one_of({"mass", "pressure"});
-  t.string("network.pressure_forces", "surface",
-           "network: the pores' push on the grains: surface (2D: the pressure on each disc's arc in the pore, seed 004 "
-           "B26-B27; 3D: on each sphere's patches) or void_gradient (p dV/dx: conservative; use it with "
-           "network.faces = drained: with closed faces the block breaks at its faces, docs/hydrofrac.md)")
-      .one_of({"surface", "void_gradient"});
-  t.integer("network.flow_every", 0, "steps",
-            "network: DEM steps per implicit flow step (0: from the fluid-grain stiffness, see docs/hydrofrac.md)")
-      .non_negative();
-  t.string("network.faces", "auto",
-           "network: the pores on the block's hull: drained (held at network.pore_pressure, the far field, with every "
-           "pore within one largest radius of the outermost centres), closed "
-           "(undrained) or auto (drained in 3D, closed in 2D). Closed 3D hulls fail: the flat tetrahedra between grains "
-           "pressed on a wall reach 0.1-1 GPa as the grains move and break bonds at the faces (docs/hydrofrac.md)")
-      .one_of({"auto", "drained", "closed"});
-  t.boolean("network.vtk", true, "network: write the pores (vtk/pores_*.vtu: gauge pressure per pore) with the particle snapshots");
-  // The lattice Boltzmann fluid (injection.fluid = "lbm"), SI units (coupling::FluidSpec).
-  t.real("fluid.density", 1000, "kg/m^3", "lbm: fluid density").positive();
-  t.real("fluid.viscosity", 1e-6, "m^2/s", "lbm: kinematic viscosity (set this or fluid.dynamic_viscosity)").positive();
-  t.real("fluid.dynamic_viscosity", 0.0, "Pa s", "lbm: dynamic viscosity; replaces fluid.viscosity when > 0").non_negative();
-  t.real("fluid.bulk_modulus", 0.0, "Pa",
-         "lbm: effective bulk modulus K_eff = rho c_s^2, fixes the LBM step (set exactly one of fluid.bulk_modulus, "
-         "fluid.sound_speed, fluid.time_step, fluid.tau; 0: not set)")
-      .non_negative();
-  t.real("fluid.sound_speed", 0.0, "m/s", "lbm: lattice sound speed c_s = dx / (sqrt(3) dt) (0: not set)").non_negative();
-  t.real("fluid.time_step", 0.0, "s", "lbm: LBM step (0: not set)").non_negative();
-  t.real("fluid.tau", 0.0, "-", "lbm: relaxation time, dt = (tau - 1/2) dx^2 / (3 nu) (0: not set)").non_negative();
-  t.real("fluid.background_pressure", 0.0, "Pa", "lbm: pore pressure p0 outside the populations: p = p0 + K_eff (rho_lb - 1)");
-  t.real("fluid.dx", 0.0, "m", "lbm: lattice spacing (0: sample.radius_min / fluid.cells_per_radius)").non_negative();
-  t.real("fluid.cells_per_radius", 1.5, "-", "lbm: cells per smallest particle radius when fluid.dx = 0 (seed 002: >= 1)")
-      .positive();
-  t.string("fluid.scheme", "interpolated",
-           "lbm: particles in the fluid: interpolated (Bouzidi bounce-back, solid cells), stairwise (half-way "
-           "bounce-back), psm (partially saturated cells: intact rock leaks, docs/coupling.md)")
-      .one_of({"interpolated", "stairwise", "psm"});
-  t.string("fluid.psm_weighting", "tau",
-           "lbm, scheme psm: Noble & Torczynski's weighting of a partly covered cell, tau (B(eps, tau), their "
-           "preferred one) or linear (B = eps: tighter throats; at tau 0.6 a sphere packing's permeability within "
-           "-3..+32 % of Kozeny-Carman at 4 cells per radius, where tau gives +97..+181 %; docs/coupling.md)")
-      .one_of({"tau", "linear"});
-  t.boolean("fluid.moving_walls", false,
-            "lbm: the particles' velocities enter the fluid's wall condition (false: quasi-static walls; true diverged "
-            "on the test block, docs/hydrofrac.md)");
-  t.string("fluid.faces", "closed",
-           "lbm: the lattice's outer faces (the block's faces plus one cell): closed (bounce-back; fluid that reaches "
-           "them pushes the servo walls, as on a lab cell's platens) or drained (held at the pore pressure p0: the far "
-           "field of a borehole in a permeable formation; the fluid that seeps out leaves)")
-      .one_of({"closed", "drained"});
-  t.real("fluid.reference_velocity", 0.0, "m/s", "lbm: expected largest fluid speed, for the Mach check (0: no check)")
-      .non_negative();
-  t.real("fluid.pressure_range", 0.0, "Pa",
-         "lbm: largest p - p0 expected, for the density-variation check (0: injection.max_pressure)")
-      .non_negative();
-  t.string("injection.mode", "ramp", "ramp: pressure rises at injection.ramp_rate; rate: pumped at injection.rate into a compressible borehole")
-      .one_of({"ramp", "rate"});
-  t.real("injection.ramp_rate", 1e10, "Pa/s", "pressure rise rate (ramp mode)").positive();
-  t.real("injection.initial_pressure", 0, "Pa", "borehole pressure when injection starts").non_negative();
-  t.real("injection.rate", 1e-3, "m^3/s", "pumped volume rate (rate mode; 2D: per metre of thickness)").positive();
-  t.real("injection.fluid_bulk_modulus", 2.2e9, "Pa", "fluid bulk modulus K_f (water 2.2e9): dp/dt = K_f/V (Q - dV/dt)").positive();
-  t.boolean("injection.penetration", false,
-            "fluid enters cracks connected to the hole (pressure on their faces); false: sleeve test, the wall only");
-  t.integer("injection.update_interval", 20, "steps", "steps between searches for cracks newly connected to the hole").positive();
-  t.real("injection.breakdown_length", 0, "m",
-         "ramp mode: breakdown = pressure when the connected fracture first reaches this far beyond the hole's wall (0: one "
-         "borehole radius)")
-      .non_negative();
-  t.real("injection.peak_drop", 0.05, "-", "rate mode: breakdown = the first pressure peak followed by a drop of this fraction")
-      .open_range(0, 1);
-  t.real("injection.stop_fraction", 0.5, "-", "rate mode: stop when the pressure fell below this fraction of its peak").open_range(0, 1);
-  t.real("injection.stop_extent", 0.8, "-",
-         "stop when the connected fracture reaches this fraction of the distance from the hole's wall to the nearest block face")
-      .open_range(0, 1)
-      .at_most(1);
-  t.real("injection.max_pressure", 500e6, "Pa", "stop at this borehole pressure in any case").positive();
-  t.real("injection.max_time", 0.05, "s", "stop after this injection time in any case").positive();
-  t.real_list("measure.radii", {1.8, 2.5, 3.5}, "-",
-              "distances of the measurement circles (spheres) from the hole's axis, in borehole radii (Kirsch comparison)")
-      .positive();
-  t.real_list("measure.angles", {0, 45, 90}, "deg", "azimuths of the measurement circles from x (sigma_H)");
-  t.real("measure.circle_radius", 0.4, "-", "radius of each measurement circle (sphere), in borehole radii").positive();
-  t.real("measure.pressure", 0, "Pa",
-         "a second elastic-state snapshot when the borehole pressure first reaches this (0: only the in-situ snapshot)")
-      .non_negative();
-  t.integer("hydrofrac.series_interval", 100, "steps", "steps between rows of series.csv (and stage checks)").positive();
-  t.integer("hydrofrac.vtk_interval", 0, "steps",
-            "steps between VTK snapshots during injection (0: at the start of injection, at breakdown and at the end)")
-      .non_negative();
-  t.integer("hydrofrac.checkpoint_interval", 0, "steps",
-            "steps between extra checkpoints (0: by wall clock only, output.checkpoint_wall_interval, and at the end)")
-      .non_negative();
-}
-
-// Geometry of the block from the sample keys: 2D box (x: width, y: height), 3D box (x: width,
-// y: depth, z: height); the borehole on the axis through the middle (3D: along z).
-struct Block {
-  Real lx = 0, ly = 0, lz = 0;
-  Vec3 centre = Vec3::Zero();
-};
-Block block_of(const Config& cfg) {
-  Block b;
-  const int dim = static_cast<int>(cfg.integer("dem.dim"));
-  b.lx = cfg.real("sample.width");
-  b.ly = dim == 3 ? cfg.real("sample.depth") : cfg.real("sample.height");
-  b.lz = dim == 3 ? cfg.real("sample.height") : 0;
-  b.centre = Vec3(0.5 * b.lx, 0.5 * b.ly, 0);
-  return b;
-}
-
-// The fluid of injection.fluid = "lbm" (keys fluid.*), in SI.
-coupling::FluidSpec lbm_fluid_spec(const Config& cfg) {
-  coupling::FluidSpec f;
-  f.density = cfg.real("fluid.density");
-  f.viscosity = cfg.real("fluid.viscosity");
-  f.dynamic_viscosity = cfg.real("fluid.dynamic_viscosity");
-  f.dx = cfg.real("fluid.dx") > 0 ? cfg.real("fluid.dx") : cfg.real("sample.radius_min") / cfg.real("fluid.cells_per_radius");
-  f.bulk_modulus = cfg.real("fluid.bulk_modulus");
-  f.sound_speed = cfg.real("fluid.sound_speed");
-  f.time_step = cfg.real("fluid.time_step");
-  f.tau = cfg.real("fluid.tau");
-  f.background_pressure = cfg.real("fluid.background_pressure");
-  f.reference_velocity = cfg.real("fluid.reference_velocity");
-  f.pressure_range = cfg.real("fluid.pressure_range") > 0 ? cfg.real("fluid.pressure_range") : cfg.real("injection.max_pressure");
-  return f;
-}
-
-void validate(const Config& cfg) {
-  dem::validate_dem_sample(cfg);
-  if (cfg.string("sample.shape") != "box")
-    cfg.fail("sample.shape", "the hydrofrac block is a box: shape = \"box\" (2D rectangle in x-y; 3D box with the borehole along z)");
-  // The fluid's own checks (tau, Mach, density variation; the DEM step rounds dt_lbm later).
-  if (cfg.string("injection.fluid") == "lbm") {
-    (void)coupling::derive_scales(lbm_fluid_spec(cfg));
-    // `fracflow check`: the LBM and DEM steps as `run` logs them (the DEM step needs the sample).
-    if (FlowCheckReport::active()) {
-      const bool q = log::quiet();
-      log::quiet() = true;
-      dem::DemSystem sys;
-      sys.settings = dem::build_settings(cfg);
-      sys.materials = dem::build_materials(cfg);
-      (void)dem::build_sample(cfg, sys);
-      dem::choose_time_step(cfg, sys);
-      log::quiet() = q;
-      hydrofrac::LbmSettings l;
-      l.fluid = lbm_fluid_spec(cfg);
-      hydrofrac::LbmInfo in = hydrofrac::lbm_info(l, sys.settings.dt);
-      hydrofrac::size_lattice(sys.particles, l.fluid.dx, sys.settings.dim, in);
-      FlowCheckReport::append(fmt::format("hydrofrac: lattice Boltzmann fluid ({}): {}\n(lattice from the packing before the "
-                                          "hole is carved and the walls servo: the run's may differ by a cell)\n",
-                                          cfg.string("fluid.scheme"), in.describe()));
-    }
-  }
-  const Block b = block_of(cfg);
-  const Real R = cfg.real("borehole.radius"), rmax = cfg.real("sample.radius_max");
-  const Real lmin = std::min(b.lx, b.ly);
-  if (R < 2 * rmax)
-    cfg.fail("borehole.radius", fmt::format("{} m is below 2 sample.radius_max ({} m): the hole must be several grains wide", R, 2 * rmax));
-  const Real reach = R + cfg.real("borehole.perforation_length");
-  if (reach > 0.35 * lmin)
-    cfg.fail(cfg.real("borehole.perforation_length") > 0 ? "borehole.perforation_length" : "borehole.radius",
-             fmt::format("the hole and its perforations reach {} m from the axis; keep that below 0.35 x the block's smaller "
-                         "side ({} m) so that the block is much larger than the hole",
-                         reach, lmin));
-  const Real rho = cfg.real("measure.circle_radius");
-  for (double r : cfg.real_list("measure.radii")) {
-    if ((r - rho) * R < R + rmax)
-      cfg.fail("measure.radii", fmt::format("a circle at {} borehole radii with measure.circle_radius = {} reaches within "
-                                            "sample.radius_max of the wall; use radii >= {:.3g}",
-                                            r, rho, 1 + rho + rmax / R));
-    if ((r + rho) * R > 0.5 * lmin)
-      cfg.fail("measure.radii", fmt::format("a circle at {} borehole radii (circle radius {} radii) leaves the block's inner "
-                                            "half-width {} m; use smaller radii",
-                                            r, rho, 0.5 * lmin));
-  }
-  if (cfg.integer("dem.dim") == 3 && cfg.real("sample.height") < 4 * rmax)
-    cfg.fail("sample.height", "the 3D block must be at least 4 sample.radius_max high");
-  if (!cfg.string("dfn.file").empty() || cfg.integer("dfn.count") > 0) {
-    const int dim = static_cast<int>(cfg.integer("dem.dim"));
-    hydrofrac::make_joints(cfg, Vec3::Zero(), Vec3(b.lx, b.ly, b.lz), b.centre, R, dim);
-  }
-}
+using hydrofrac::Block;
+using hydrofrac::block_of;
+using hydrofrac::lbm_fluid_spec;
 
 const std::vector<std::string> kColumns = {
     "step", "time_s", "stage", "pressure_Pa", "injected_volume_m3", "borehole_volume_m3", "sigma_xx_wall_Pa",
@@ -1124,7 +894,7 @@ void HydrofracRun::plots() {
 RunStatus run(const Config& cfg, const RunOptions& opt) {
   // On resume the scenario is the results folder's copy: files it names (dfn.file) are relative
   // to the original scenario's folder, and the block is in the checkpoint.
-  if (!opt.resume) validate(cfg);
+  if (!opt.resume) hydrofrac::validate_scenario(cfg);
   return HydrofracRun(cfg, opt).run();
 }
 
@@ -1133,7 +903,7 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
 Driver hydrofrac_driver() {
   return Driver{"hydrofrac",
                 "hydraulic fracturing from a borehole in a bonded block under servo-controlled in-situ stresses (sleeve pressure)",
-                declare, run, validate};
+                hydrofrac::declare_params, run, hydrofrac::validate_scenario};
 }
 
 }  // namespace ff::drivers
