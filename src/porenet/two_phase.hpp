@@ -150,8 +150,9 @@ class TwoPhaseFlow {
   Real saturation();  // sum alpha V / sum V
   Real injected_liquid() const { return injected_; }
 
-  // Shared pressure (B23) for masses m_q, m_p in a void V: returns alpha, writes p.
-  Real solve_shared_pressure(Real mq, Real mp, Real V, Real alpha_guess, Real& p) const;
+  // Shared pressure (B23) for masses m_q, m_p in a void V: returns alpha, writes p (and, if asked,
+  // the iterations it took).
+  Real solve_shared_pressure(Real mq, Real mp, Real V, Real alpha_guess, Real& p, int* iterations = nullptr) const;
 
  private:
   void compute_rates();
