@@ -216,7 +216,8 @@ TEST(SaturatedUcs2D, ResumeBitIdentical) {
 
 namespace {
 
-// A key of the other dimension is an error naming it (not silently ignored), as in `fracflow check`.
+// A key of the other dimension is an error naming it (not silently ignored), as in `fracflow check`;
+// so is a liquid layout the 3D flow cannot step.
 TEST(SaturatedUcs, KeysOfTheOtherDimensionAreRefused) {
   const auto out = test::scratch("sat_keys");
   try {
@@ -234,6 +235,13 @@ TEST(SaturatedUcs, KeysOfTheOtherDimensionAreRefused) {
     FAIL() << "a 3D-only key was accepted for a 2D sample";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("fluid.pfv_factor"), std::string::npos) << e.what();
+  }
+  // The smallest-pores-first layout is 2D only for now (the 3D implicit flow halves every step for it).
+  try {
+    test::run_scenario(scenario_3d("saturation = 0.5\nliquid_placement = \"smallest_pores_first\"\n"), {}, out, 1);
+    FAIL() << "smallest_pores_first was accepted for a 3D sample";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("fluid.liquid_placement"), std::string::npos) << e.what();
   }
   std::filesystem::remove_all(out);
 }
