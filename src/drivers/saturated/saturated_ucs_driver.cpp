@@ -40,7 +40,7 @@ void declare(ParamTable& t) {
   t.string("fluid.liquid_placement", "uniform",
            "where a saturation below 1 puts the liquid: uniform (every pore holds that fraction) or "
            "smallest_pores_first (capillary equilibrium of a wetting liquid: the smallest pores full, the largest "
-           "gas only; docs/saturated.md)")
+           "gas only; 2D samples only for now; docs/saturated.md)")
       .one_of({"uniform", "smallest_pores_first"});
   t.real("fluid.liquid_viscosity", 1e-3, "Pa s", "dynamic viscosity of the liquid (water: 1e-3)").positive();
   t.real("fluid.gas_viscosity", 1.8e-5, "Pa s", "dynamic viscosity of the gas (air: 1.8e-5)").positive();
