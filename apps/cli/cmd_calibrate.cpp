@@ -15,6 +15,7 @@
 #include "batch/sweep.hpp"
 #include "commands.hpp"
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "core/log.hpp"
 #include "io/json_out.hpp"
 #include "io/run_folder.hpp"
@@ -189,7 +190,8 @@ int run_calibrate_command(const CalibrateArgs& a) {
     }
     if (sweep_thread.joinable()) sweep_thread.join();
     if (status != RunStatus::Finished)
-      throw Error(fmt::format("calibration run {} was interrupted (ABORT file?); its folder is {}", it,
+      throw Error(fmt::format("calibration run {} was interrupted ({}); its folder is {}", it,
+                              stop_requested() ? stop_signal_name() : std::string("an ABORT file?"),
                               run.out_dir.string()));
     const RunSummary s = read_run_summary(run.out_dir);
     // A run without a peak or an elastic fit has nothing to update from (null in summary.json).

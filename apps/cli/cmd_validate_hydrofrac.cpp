@@ -20,6 +20,7 @@
 #include "batch/run_case.hpp"
 #include "commands.hpp"
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "core/log.hpp"
 #include "drivers/hydrofrac/breakdown_theory.hpp"
 #include "io/plot.hpp"
@@ -117,7 +118,10 @@ nlohmann::json run_one(const fs::path& scenario, const std::vector<std::string>&
   r.out_dir = dir;
   r.threads = threads;
   log::info("validate-hydrofrac: running {}", dir.string());
-  batch::run_in_process(scenario.string(), sets, r);
+  if (batch::run_in_process(scenario.string(), sets, r) != RunStatus::Finished)
+    throw Error(fmt::format("validate-hydrofrac: the run {} stopped before its end ({}); nothing is reported, run "
+                            "the command again with --overwrite",
+                            dir.string(), stop_requested() ? stop_signal_name() : std::string("an ABORT file")));
   std::ifstream f(dir / "summary.json");
   return nlohmann::json::parse(f);
 }

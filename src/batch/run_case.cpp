@@ -14,6 +14,7 @@
 #include <limits>
 
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "core/log.hpp"
 #include "io/run_folder.hpp"
 #include "io/scenario.hpp"
@@ -69,6 +70,7 @@ class ThreadsAndQuiet {
 RunStatus run_in_process(const std::string& scenario_path, const std::vector<std::string>& overrides,
                          const InProcessRun& run) {
   auto l = load_scenario_for_run(scenario_path, overrides);  // every key validated before anything is written
+  if (stop_requested()) return RunStatus::Interrupted;      // a batch told to stop starts no new run
   // The same folder rules as `fracflow run` (never --overwrite here): created, with its marker,
   // lock and scenario.toml, only when the driver's set-up has passed (opt.begin_output).
   NewRunFolder folder(run.out_dir, false, scenario_path);
@@ -81,7 +83,12 @@ RunStatus run_in_process(const std::string& scenario_path, const std::vector<std
   opt.max_wall_s = run.max_wall_s;
   opt.abort_file = run.out_dir / "ABORT";
   opt.progress_interval_s = run.quiet ? 0 : l->config.real("output.progress_interval");
-  opt.begin_output = [&folder, resolved = l->config.resolved_toml(), command] { folder.begin(resolved, command); };
+  opt.begin_output = [&folder, resolved = l->config.resolved_toml(), command] {
+    // As `fracflow run`: from here on SIGINT/SIGTERM ask the driver for a checkpoint and a stop
+    // (before, the process just ends: nothing is written yet). A second signal still kills.
+    install_stop_signal_handlers();
+    folder.begin(resolved, command);
+  };
   const ThreadsAndQuiet scoped(opt.threads, run.quiet);
   try {
     return l->driver->run(l->config, opt);
@@ -106,6 +113,8 @@ RunStatus resume_in_process(const fs::path& dir, const InProcessRun& run) {
   opt.progress_interval_s = run.quiet ? 0 : l->config.real("output.progress_interval");
   std::error_code ec;
   fs::remove(opt.abort_file, ec);  // the request that stopped it, as `fracflow resume` does
+  if (stop_requested()) return RunStatus::Interrupted;
+  install_stop_signal_handlers();  // a signal now stops the run after a checkpoint, as above
   const ThreadsAndQuiet scoped(opt.threads, run.quiet);
   return l->driver->run(l->config, opt);
 }

@@ -42,7 +42,9 @@ struct InProcessRun {
 // Runs a scenario in this process: validate, check out_dir as `fracflow run` does
 // (io/run_folder.hpp), call the driver, which creates out_dir with its marker, lock and
 // scenario.toml once its set-up has passed. Input errors leave no out_dir behind; driver errors
-// (ff::InputError from cross-parameter checks, ff::NumericalError) propagate.
+// (ff::InputError from cross-parameter checks, ff::NumericalError) propagate. From then on SIGINT
+// and SIGTERM stop the run after a checkpoint (RunStatus::Interrupted); once a stop has been
+// requested (core/interrupt.hpp), it returns Interrupted at once and makes no folder.
 RunStatus run_in_process(const std::string& scenario_path, const std::vector<std::string>& overrides,
                          const InProcessRun& run);
 

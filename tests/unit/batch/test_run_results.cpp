@@ -4,16 +4,20 @@
 // default scenario as the README describes it.
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <thread>
 
 #include "../program_runner.hpp"
 #include "batch/run_case.hpp"
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "dem/presets.hpp"
 namespace fs = std::filesystem;
 
@@ -261,6 +265,49 @@ TEST(RunResults, InProcessRunStoppedAndResumedEqualsTheWholeRun) {
   EXPECT_GT(sa.str().size(), 100u);
   EXPECT_EQ(sa.str(), sb.str());
   EXPECT_THROW(ff::batch::resume_in_process(scratch("inproc_none"), r), ff::InputError);
+  fs::remove_all(whole);
+  fs::remove_all(parts);
+}
+
+// A SIGTERM during an in-process run (validate-saturated, validate-hydrofrac, calibrate) asks for a
+// checkpoint and a stop, as with `fracflow run`, instead of ending the process at once (it did: the
+// study lost everything since its runs' last 60-s checkpoints). Without the handler this test dies of
+// the signal. The stopped run resumes to the uninterrupted run's series.csv, byte for byte; once a
+// stop is requested, no further run starts (no folder).
+TEST(RunResults, InProcessRunStopsOnSigtermWithACheckpoint) {
+  const std::vector<std::string> tiny = {"sample.diameter=5e-3", "sample.height=8e-3", "sample.porosity=0.45",
+                                         "output.vtk=false",     "output.plots=false", "output.progress_interval=0",
+                                         "ucs.max_strain=0.01"};
+  const auto whole = scratch("sig_whole"), parts = scratch("sig_parts"), after = scratch("sig_after");
+  for (const auto& d : {whole, parts, after}) fs::remove_all(d);
+  ff::batch::InProcessRun r;
+  r.out_dir = whole;
+  ASSERT_EQ(ff::batch::run_in_process("", tiny, r), ff::RunStatus::Finished);
+  // The signal as soon as the run has begun its output (its scenario.toml is written then).
+  std::thread killer([&] {
+    for (int k = 0; k < 200000 && !fs::exists(parts / "scenario.toml"); ++k)
+      std::this_thread::sleep_for(std::chrono::microseconds(50));
+    std::raise(SIGTERM);
+  });
+  r.out_dir = parts;
+  const auto st = ff::batch::run_in_process("", tiny, r);
+  killer.join();
+  ASSERT_EQ(st, ff::RunStatus::Interrupted) << "the run ended before the signal arrived";
+  EXPECT_TRUE(ff::stop_requested());
+  EXPECT_TRUE(fs::exists(parts / "checkpoint"));
+  EXPECT_FALSE(fs::exists(parts / "summary.json"));
+  r.out_dir = after;
+  EXPECT_EQ(ff::batch::run_in_process("", tiny, r), ff::RunStatus::Interrupted);
+  EXPECT_FALSE(fs::exists(after)) << "a run started after the stop request";
+  EXPECT_EQ(ff::batch::resume_in_process(parts, r), ff::RunStatus::Interrupted);
+  ff::clear_stop_request();
+  ASSERT_EQ(ff::batch::resume_in_process(parts, r), ff::RunStatus::Finished);
+  std::ifstream a(whole / "series.csv"), b(parts / "series.csv");
+  std::stringstream sa, sb;
+  sa << a.rdbuf();
+  sb << b.rdbuf();
+  EXPECT_GT(sa.str().size(), 100u);
+  EXPECT_EQ(sa.str(), sb.str());
   fs::remove_all(whole);
   fs::remove_all(parts);
 }

@@ -36,6 +36,10 @@ TEST(ValidateSaturated, TinyStudyWritesTheReportAndResumes) {
                            "fluid.pressure_forces = void_gradient"})
     EXPECT_NE(text.find(part), std::string::npos) << part << "\n" << text;
   EXPECT_EQ(text.find("--resume"), std::string::npos);
+  // The header gives the command as it can be typed again: every option that differs from its default.
+  const std::string cmd = "`fracflow validate-saturated --saturations 0,1 --viscosities 0.001 --width 0.004 "
+                          "--height 0.008 --velocity 0.02 --packings 1`";
+  EXPECT_NE(text.find(cmd), std::string::npos) << text.substr(0, 400);
   const std::string dry = slurp(out / "S0_mu0.001_seed7" / "summary.json");
   EXPECT_NE(dry.find("\"cavitations\": 0"), std::string::npos) << dry;
 
