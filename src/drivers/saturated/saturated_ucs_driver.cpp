@@ -68,9 +68,15 @@ void declare(ParamTable& t) {
       .positive()
       .fallback();
   t.string("fluid.flow_scheme", "auto",
-           "time stepping of the pore flow: auto (2D explicit with sub-steps, 3D implicit), explicit or implicit "
-           "(3D only: one backward-Euler step per DEM step)")
+           "time stepping of the pore flow: auto (2D explicit sub-steps, one implicit step past fluid.implicit_above "
+           "of them; 3D implicit), explicit (2D: sub-steps only, the seed's scheme) or implicit (3D only: one "
+           "backward-Euler step per DEM step)")
       .one_of({"auto", "explicit", "implicit"});
+  t.integer("fluid.implicit_above", 4, "-",
+            "2D, flow_scheme auto: a DEM step whose explicit flow would need more than this many sub-steps gets one "
+            "implicit (backward-Euler pressure) step instead (0 = always explicit sub-steps)")
+      .non_negative()
+      .fallback();
   t.integer("fluid.flow_every", 0, "-",
             "3D: one flow step (network update, flow, pressure forces) every this many DEM steps, the forces held in "
             "between (1: every step); 0 = automatic: at most 0.3 of the stiffest grain-fluid period (re-evaluated "
@@ -126,7 +132,7 @@ void declare(ParamTable& t) {
 // them unset unless the user set them.
 const std::vector<std::string> k2DOnly = {"fluid.aperture_h0", "fluid.aperture_hinf", "fluid.aperture_gamma",
                                           "fluid.shear_forces", "fluid.cavitation_pressure", "fluid.force_height",
-                                          "fluid.remap"};
+                                          "fluid.remap", "fluid.implicit_above"};
 const std::vector<std::string> k3DOnly = {"fluid.pfv_factor", "fluid.cg_tolerance", "fluid.flow_every"};
 
 porenet::TwoPhaseParams fluid_params(const Config& cfg) {
@@ -172,6 +178,8 @@ coupling::PorenetCouplingParams coupling_params(const Config& cfg) {
   p.force_height = diameter ? coupling::ForceHeight::Diameter : coupling::ForceHeight::Thickness;
   p.pressure_force = pressure_force(cfg, false);
   p.remap = cfg.string("fluid.remap") == "mass" ? porenet::RemapConserve::Mass : porenet::RemapConserve::Pressure;
+  // flow_scheme = explicit: the seed's explicit sub-steps only.
+  p.implicit_above = cfg.string("fluid.flow_scheme") == "explicit" ? 0 : cfg.integer("fluid.implicit_above");
   return p;
 }
 
@@ -458,6 +466,9 @@ class SaturatedUcsRun final : public UcsRun {
     } else {
       const auto& st = fluid_.c2().stats();
       f["flow_stable_dt_s"] = st.last_stable_dt;
+      f["flow_scheme"] = fluid_.c2().params().implicit_above > 0 ? "auto" : "explicit";
+      f["implicit_above"] = fluid_.c2().params().implicit_above;
+      f["implicit_flow_steps"] = st.implicit_steps;
 
       f["cavitations"] = st.cavitations;
       f["vapour_mass_kg_per_m"] = st.vapour_mass;
@@ -504,7 +515,10 @@ void validate(const Config& cfg) {
   for (const auto& k : dim3 ? k2DOnly : k3DOnly)
     if (cfg.has(k)) cfg.fail(k, fmt::format("applies to {} samples only; this one has dem.dim = {}", dim3 ? "2D" : "3D", cfg.integer("dem.dim")));
   if (!dim3 && cfg.string("fluid.flow_scheme") == "implicit")
-    cfg.fail("fluid.flow_scheme", "the 2D coupling steps the flow explicitly (sub-steps); use auto or explicit");
+    cfg.fail("fluid.flow_scheme", "the 2D coupling steps the flow explicitly (sub-steps, one implicit step past "
+                                  "fluid.implicit_above of them); use auto or explicit");
+  if (!dim3 && cfg.string("fluid.flow_scheme") == "explicit" && cfg.has("fluid.implicit_above"))
+    cfg.fail("fluid.implicit_above", "applies with fluid.flow_scheme = auto; explicit means sub-steps only");
   // 3D: with the smallest pores liquid-full and the rest gas, the implicit two-phase step halved every
   // DEM step ~8 times once gas traces entered the wet pores (214-243 solves per step, 60 steps in 473 s
   // on a 5,032-pore sample); limiting the traces instead left the pressure CG without convergence.
