@@ -477,7 +477,9 @@ int run_validate(Args a) {
       if (g.size() > 1) noise = std::max(noise, range_of(g, &Case::ucs) / m);
     }
   md += fmt::format("- packing-to-packing range of the UCS itself (largest over the cases, relative to the mean): {}\n\n",
-                    a.packings > 1 ? fmt::format("{:.2f} %", 100 * noise) : std::string("one packing only (--quick)"));
+                    a.packings > 1 ? fmt::format("{:.2f} %", 100 * noise)
+                    : a.quick      ? std::string("one packing only (--quick)")
+                                   : std::string("one packing only (--packings 1)"));
   md += fmt::format("Seed 004's trends (paired means; a difference smaller than the paired range is not resolved): dry "
                     "specimen the strongest: **{}**; strength falls as saturation rises: **{}**; strength falls as "
                     "viscosity rises: **{}**.\n\n",
