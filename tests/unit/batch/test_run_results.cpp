@@ -30,6 +30,16 @@ const std::string kTiny =
 
 fs::path scratch(const std::string& name) { return ff::test::fresh_out_dir("test_results", name); }
 
+// The resumed run's series.csv equals the whole run's, byte for byte (and is not empty).
+void expect_same_series(const fs::path& whole, const fs::path& resumed) {
+  std::ifstream a(whole / "series.csv"), b(resumed / "series.csv");
+  std::stringstream sa, sb;
+  sa << a.rdbuf();
+  sb << b.rdbuf();
+  EXPECT_GT(sa.str().size(), 100u);
+  EXPECT_EQ(sa.str(), sb.str());
+}
+
 using Result = ff::test::ProgramResult;
 Result run_cli(const std::string& args) { return ff::test::run_program(args); }
 
@@ -258,12 +268,7 @@ TEST(RunResults, InProcessRunStoppedAndResumedEqualsTheWholeRun) {
   r.max_steps = 0;
   std::ofstream(parts / "ABORT") << "stop\n";  // a stop request of the earlier run is not repeated
   ASSERT_EQ(ff::batch::resume_in_process(parts, r), ff::RunStatus::Finished);
-  std::ifstream a(whole / "series.csv"), b(parts / "series.csv");
-  std::stringstream sa, sb;
-  sa << a.rdbuf();
-  sb << b.rdbuf();
-  EXPECT_GT(sa.str().size(), 100u);
-  EXPECT_EQ(sa.str(), sb.str());
+  expect_same_series(whole, parts);
   EXPECT_THROW(ff::batch::resume_in_process(scratch("inproc_none"), r), ff::InputError);
   fs::remove_all(whole);
   fs::remove_all(parts);
@@ -302,12 +307,7 @@ TEST(RunResults, InProcessRunStopsOnSigtermWithACheckpoint) {
   EXPECT_EQ(ff::batch::resume_in_process(parts, r), ff::RunStatus::Interrupted);
   ff::clear_stop_request();
   ASSERT_EQ(ff::batch::resume_in_process(parts, r), ff::RunStatus::Finished);
-  std::ifstream a(whole / "series.csv"), b(parts / "series.csv");
-  std::stringstream sa, sb;
-  sa << a.rdbuf();
-  sb << b.rdbuf();
-  EXPECT_GT(sa.str().size(), 100u);
-  EXPECT_EQ(sa.str(), sb.str());
+  expect_same_series(whole, parts);
   fs::remove_all(whole);
   fs::remove_all(parts);
 }
