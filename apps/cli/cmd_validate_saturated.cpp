@@ -133,6 +133,7 @@ struct Case {
   double p_max_prepeak = 0, p_mean_at_peak = 0, strain_at_pmax = 0;
   double cracks_at_peak = 0, cracks_final = 0, tensile_final = 0, shear_final = 0, wall = 0;
   double steps = 0, implicit_steps = 0;  // DEM steps, and those whose flow was one implicit step
+  long implicit_above = 0;                // the run's fluid.implicit_above (summary.json)
   long particles = 0, bonds = 0;
   enum class Source : std::uint8_t { Run, Continued, Read } source = Source::Run;  // Continued, Read: --resume
 };
@@ -183,7 +184,10 @@ Case run_case(const fs::path& scen, const Args& a, double s, double mu, int seed
   if (j.contains("layer") && j["layer"].contains("ucs_Pa")) c.ucs_layer = j["layer"]["ucs_Pa"];
   c.wall = j.value("wall_time_s", 0.0);
   c.steps = j.value("steps", 0.0);
-  if (j.contains("fluid")) c.implicit_steps = j["fluid"].value("implicit_flow_steps", 0.0);
+  if (j.contains("fluid")) {
+    c.implicit_steps = j["fluid"].value("implicit_flow_steps", 0.0);
+    c.implicit_above = j["fluid"].value("implicit_above", 0L);
+  }
   if (j.contains("sample")) {
     c.particles = j["sample"].value("particles", 0L);
     c.bonds = j["sample"].value("bonds", 0L);
@@ -417,9 +421,9 @@ int run_validate(Args a) {
       "counts the pore fluid's stiffness on each grain (`fluid.stiffness_in_time_step`; a liquid-full pore adds "
       "about two contact stiffnesses per face, so the saturated specimens' step is the shorter). The flow: explicit "
       "sub-steps within each DEM step (seed 004's scheme), or one backward-Euler step where more than "
-      "`fluid.implicit_above` = 4 would be needed (the share of such DEM steps is in the runs' table). Interpretation "
+      "`fluid.implicit_above` = {} would be needed (the share of such DEM steps is in the runs' table). Interpretation "
       "and the checks behind it: docs/saturated.md.\n\n",
-      a.safety);
+      a.safety, c0.implicit_above);
   md += "## Strength by saturation and viscosity\n\n";
   md += "| S | mu [Pa s] | UCS, 1 m discs [kPa] (range) | UCS layer [MPa] | vs dry (paired) | strain at peak [%] | max p before peak "
         "[MPa] | mean p at peak [MPa] | cracks at peak | cracks final (tensile/shear) | runs |\n";
