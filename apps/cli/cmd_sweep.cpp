@@ -7,6 +7,7 @@
 
 #include "batch/sweep.hpp"
 #include "commands.hpp"
+#include "core/interrupt.hpp"
 #include "core/log.hpp"
 
 namespace fs = std::filesystem;
@@ -17,7 +18,7 @@ struct SweepArgs {
   std::string scenario, out;
   std::vector<std::string> vary, sets;
   int jobs = 0, threads_per_job = 1;
-  bool overwrite = false, quiet = false, no_plots = false;
+  bool overwrite = false, resume = false, quiet = false, no_plots = false;
 };
 
 int run_sweep_command(const SweepArgs& a) {
@@ -33,6 +34,7 @@ int run_sweep_command(const SweepArgs& a) {
   opt.jobs = a.jobs;
   opt.threads_per_job = a.threads_per_job;
   opt.overwrite = a.overwrite;
+  opt.resume = a.resume;
   opt.plots = !a.no_plots;
   opt.quiet = a.quiet;
   const auto r = ff::batch::run_sweep(opt);
@@ -41,10 +43,19 @@ int run_sweep_command(const SweepArgs& a) {
                   "{:.3f} MPa, R^2 {:.4f}",
                   r.fit->points, r.fit->friction_angle_deg, 1e-6 * r.fit->cohesion_Pa, 1e-6 * r.fit->intercept_Pa,
                   r.fit->r_squared);
-  ff::log::info("sweep: {} of {} cases finished; results in {}/sweep.csv and sweep.json", r.cases.size() - r.failed,
-                r.cases.size(), fs::absolute(opt.out_dir).string());
+  const std::size_t finished = r.cases.size() - r.failed - r.interrupted - r.not_started;
+  ff::log::info("sweep: {} of {} cases finished{}; results in {}/sweep.csv and sweep.json", finished, r.cases.size(),
+                opt.resume ? fmt::format(" ({} read as finished before, {} continued from a checkpoint)", r.read_before,
+                                         r.continued)
+                           : std::string(),
+                fs::absolute(opt.out_dir).string());
   if (r.failed > 0) ff::log::error("{} case(s) failed; see the logs named in sweep.json", r.failed);
-  return r.failed > 0 ? 1 : 0;
+  if (r.interrupted + r.not_started > 0)
+    ff::log::error("sweep stopped by {}: {} case(s) interrupted after a checkpoint, {} not started; continue with "
+                   "the same command and --resume",
+                   ff::stop_requested() ? ff::stop_signal_name() : std::string("ABORT files in the case folders"),
+                   r.interrupted, r.not_started);
+  return r.failed + r.interrupted + r.not_started > 0 ? 1 : 0;
 }
 
 const bool registered = ff::cli::register_command({"sweep", [](CLI::App& app) {
@@ -62,6 +73,9 @@ const bool registered = ff::cli::register_command({"sweep", [](CLI::App& app) {
   sub->add_option("--threads-per-job", a->threads_per_job, "OpenMP threads of each case (default 1)")
       ->check(CLI::PositiveNumber);
   sub->add_flag("--overwrite", a->overwrite, "replace an existing sweep folder");
+  sub->add_flag("--resume", a->resume,
+                "continue a stopped sweep in --out (same scenario, --set and --vary): finished cases are read, "
+                "interrupted ones continue from their checkpoints, the rest run");
   sub->add_flag("--no-plots", a->no_plots, "do not draw plots/peak_vs_confinement.png");
   sub->add_flag("--quiet,-q", a->quiet, "no line per finished case");
   return ff::cli::Command::Run([a] { return run_sweep_command(*a); });

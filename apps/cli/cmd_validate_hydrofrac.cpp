@@ -24,6 +24,7 @@
 #include "core/log.hpp"
 #include "drivers/hydrofrac/breakdown_theory.hpp"
 #include "io/plot.hpp"
+#include "io/run_folder.hpp"
 
 namespace fs = std::filesystem;
 using namespace ff;
@@ -130,11 +131,8 @@ double number_or_nan(const nlohmann::json& j) { return j.is_number() ? j.get<dou
 
 int run_validate(const Args& a) {
   const fs::path out = a.out;
-  if (fs::exists(out)) {
-    if (!a.overwrite) throw InputError(fmt::format("'{}' exists; pass --overwrite to replace it", out.string()));
-    fs::remove_all(out);
-  }
-  fs::create_directories(out);
+  // --overwrite replaces only a folder of ours (its marker), never the current directory or home.
+  const FolderLock out_lock = prepare_batch_folder(out, a.overwrite, "validate-hydrofrac folder");
   const fs::path block = out / "block.toml", tension = out / "tension.toml";
   write_text(block, block_scenario(a));
   write_text(tension, tension_scenario(a));

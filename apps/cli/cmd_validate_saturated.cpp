@@ -29,6 +29,7 @@
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
 #include "core/log.hpp"
+#include "io/run_folder.hpp"
 #include "io/scenario.hpp"
 
 namespace fs = std::filesystem;
@@ -307,6 +308,7 @@ int run_validate(Args a) {
   const fs::path out = a.out;
   const fs::path scen = out / "specimen.toml";
   if (a.resume && a.overwrite) throw InputError("--resume continues the study in --out; --overwrite replaces it: not both");
+  FolderLock out_lock;  // one study per folder at a time
   if (a.resume) {
     if (!fs::exists(scen))
       throw InputError(fmt::format("--resume: '{}' holds no study (no specimen.toml)", out.string()));
@@ -315,14 +317,13 @@ int run_validate(Args a) {
                                    "differs from what these options give: width, height, velocity, bond gap, time "
                                    "step safety, --quick); give the same options, or a new --out",
                                    out.string()));
+    out_lock = FolderLock::acquire(out);
   } else {
-    if (fs::exists(out)) {
-      if (!a.overwrite)
-        throw InputError(fmt::format("'{}' exists; pass --overwrite to replace it, or --resume to continue it",
-                                     out.string()));
-      fs::remove_all(out);
-    }
-    fs::create_directories(out);
+    if (!a.overwrite && fs::is_directory(out) && !fs::is_empty(out))
+      throw InputError(fmt::format("'{}' exists; pass --overwrite to replace it, or --resume to continue it",
+                                   out.string()));
+    // --overwrite replaces only a folder of ours (its marker), never the current directory or home.
+    out_lock = prepare_batch_folder(out, a.overwrite, "validate-saturated study folder");
     write_text(scen, scenario(a));
   }
   const auto t0 = std::chrono::steady_clock::now();

@@ -21,6 +21,7 @@
 #include "batch/triaxial_validation.hpp"
 #include "commands.hpp"
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "core/log.hpp"
 #include "io/run_folder.hpp"
 
@@ -64,7 +65,12 @@ std::vector<std::string> calibrated_sets(const nlohmann::json& cal) {
 
 void check_sweep(const SweepResult& r) {
   for (auto& c : r.cases)
-    if (c.status != "ok") throw Error(fmt::format("validation run {} failed (exit code {}); log {}:\n{}", c.dir.string(),
+    if (c.status == "interrupted" || c.status == "not started")
+      throw Error(fmt::format("validation stopped by {}: run {} {}; start the validation again (it has no --resume; "
+                              "`fracflow resume` continues a single run)",
+                              stop_requested() ? stop_signal_name() : std::string("an ABORT file"), c.dir.string(),
+                              c.status == "interrupted" ? "stopped after a checkpoint" : "not started"));
+    else if (c.status != "ok") throw Error(fmt::format("validation run {} failed (exit code {}); log {}:\n{}", c.dir.string(),
                                                   c.exit_code, c.log.string(), c.error));
 }
 
@@ -163,6 +169,14 @@ int run_validate(const ValidateArgs& a) {
   fs::create_directories(out / "scenarios");
   fs::create_directories(out / "logs");
   const auto& s = a.sample;
+  // SIGINT/SIGTERM now stop the validation after its children have stopped (they are passed the
+  // request: run_child_process); the default action would end this process and leave them running.
+  install_stop_signal_handlers();
+  auto stop_check = [&](const std::string& stage) {
+    if (stop_requested())
+      throw Error(fmt::format("validation stopped by {} during {}; start it again (it has no --resume)",
+                              stop_signal_name(), stage));
+  };
 
   // 1. Synthetic samples (voxel stacks) and scenarios.
   for (const char* kind : {"c1", "c4"}) {
@@ -172,6 +186,7 @@ int run_validate(const ValidateArgs& a) {
                                       fmt::format("{}", s.voxel_size_m), "--format", "voxels", "--out",
                                       (out / "samples" / kind).string()},
                                      out / "logs" / fmt::format("make_sample_{}.log", kind));
+    stop_check("make-sample");
     if (rc != 0) throw Error(fmt::format("make-sample {} failed; see {}", kind, (out / "logs").string()));
   }
   {  // what --report-only needs to describe the runs
@@ -216,6 +231,7 @@ int run_validate(const ValidateArgs& a) {
          "dem.bond.matrix-matrix.tensile_strength=22e6", "--set", "dem.bond.matrix-matrix.cohesion=5.5e6", "--set",
          "dem.bond.matrix-matrix.friction_angle=40"},
         out / "logs" / "calibration.log");
+    stop_check("the calibration (its runs keep their checkpoints in " + (out / "calibration").string() + ")");
     if (rc != 0 && rc != 1) throw Error(fmt::format("calibration failed (exit code {}); see {}", rc, (out / "logs" / "calibration.log").string()));
     cal = read_json(out / "calibration" / "calibration.json");
     log::info("validation: calibration {} after {} iterations", cal.value("converged", false) ? "converged" : "NOT converged",

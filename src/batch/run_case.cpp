@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <csignal>
 #include <cmath>
 #include <deque>
 #include <fstream>
@@ -172,7 +173,8 @@ std::optional<StrengthPoint> peak_strength(const RunSummary& s) {
   return p;
 }
 
-int run_child_process(const fs::path& executable, const std::vector<std::string>& args, const fs::path& log) {
+int run_child_process(const fs::path& executable, const std::vector<std::string>& args, const fs::path& log,
+                      const fs::path& run_dir) {
   posix_spawn_file_actions_t fa;
   posix_spawn_file_actions_init(&fa);
   posix_spawn_file_actions_addopen(&fa, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
@@ -190,8 +192,22 @@ int run_child_process(const fs::path& executable, const std::vector<std::string>
   posix_spawn_file_actions_destroy(&fa);
   if (rc != 0) return -1;
   int status = 0;
-  while (waitpid(pid, &status, 0) < 0)
-    if (errno != EINTR) return -1;
+  bool passed_on = false;
+  // Polled, not a blocking waitpid: the stop handlers use SA_RESTART, so a blocked waitpid would
+  // never see the request.
+  for (;;) {
+    const pid_t w = waitpid(pid, &status, WNOHANG);
+    if (w == pid) break;
+    if (w < 0 && errno != EINTR) return -1;
+    if (!passed_on && stop_requested()) {
+      passed_on = true;
+      if (!run_dir.empty() && is_fracflow_run(run_dir))
+        std::ofstream(run_dir / "ABORT") << "stop request passed on by the batch command (" << stop_signal_name() << ")\n";
+      else
+        ::kill(pid, SIGTERM);
+    }
+    ::usleep(20000);
+  }
   if (WIFEXITED(status)) return WEXITSTATUS(status);
   if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
   return -1;

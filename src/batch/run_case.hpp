@@ -80,8 +80,13 @@ std::optional<StrengthPoint> peak_strength(const RunSummary& s);
 
 // Starts `executable args...` with stdout and stderr appended to `log` and waits for it.
 // Returns its exit status, 128 + signal when it was killed, or -1 when it could not start.
+// A stop request to this process while the child runs (stop_requested(): SIGINT/SIGTERM once
+// install_stop_signal_handlers() is in place) is passed on once: as the file run_dir/ABORT when
+// the child's run folder has begun (its marker), so that it checkpoints and stops; before that as
+// SIGTERM (the child has written nothing yet). Not a signal: Ctrl-C already reaches the child (same
+// process group), and a second signal would kill it without its checkpoint.
 int run_child_process(const std::filesystem::path& executable, const std::vector<std::string>& args,
-                      const std::filesystem::path& log);
+                      const std::filesystem::path& log, const std::filesystem::path& run_dir = {});
 
 // The last `lines` non-empty lines of a text file ("" when unreadable): a failed run's reason.
 std::string tail_of_file(const std::filesystem::path& path, int lines);

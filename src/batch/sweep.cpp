@@ -12,6 +12,7 @@
 
 #include "batch/jobs.hpp"
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "core/log.hpp"
 #include "io/json_out.hpp"
 #include "io/plot.hpp"
@@ -120,6 +121,37 @@ nlohmann::json fit_json(const MohrCoulombFit& f) {
           {"points", f.points}};
 }
 
+// What makes the cases of a sweep: --resume must be given the same.
+nlohmann::json options_json(const SweepOptions& opt) {
+  nlohmann::json j;
+  j["scenario"] = opt.scenario.empty() ? "<built-in default scenario>" : opt.scenario;
+  j["sets"] = opt.sets;
+  j["vary"] = nlohmann::json::array();
+  for (auto& a : opt.axes) j["vary"].push_back({{"key", a.key}, {"values", a.values}});
+  return j;
+}
+
+// --resume: `out` must hold a sweep of ours made with the same scenario, --set and --vary.
+void check_resumable(const fs::path& out, const SweepOptions& opt) {
+  const fs::path file = out / "sweep.json";
+  if (!is_fracflow_run(out) || !fs::exists(file))
+    throw InputError(fmt::format("sweep --resume: '{}' holds no sweep to continue (no {} or no sweep.json); start it "
+                                 "without --resume", out.string(), run_marker_file(out).string()));
+  nlohmann::json before;
+  try {
+    std::ifstream f(file);
+    before = nlohmann::json::parse(f);
+  } catch (const std::exception& e) {
+    throw InputError(fmt::format("sweep --resume: '{}' is not valid JSON ({})", file.string(), e.what()));
+  }
+  const nlohmann::json now = options_json(opt);
+  for (const char* k : {"scenario", "sets", "vary"})
+    if (!before.contains(k) || before[k] != now[k])
+      throw InputError(fmt::format("sweep --resume: the sweep in '{}' was started with other options ({}: {} then, {} "
+                                   "now); give the same scenario, --set and --vary, or a new --out",
+                                   out.string(), k, before.contains(k) ? before[k].dump() : "absent", now[k].dump()));
+}
+
 void write_outputs(const SweepOptions& opt, const SweepResult& r) {
   {
     std::ofstream f(opt.out_dir / "sweep.csv");
@@ -137,14 +169,12 @@ void write_outputs(const SweepOptions& opt, const SweepResult& r) {
     }
     if (!f) throw Error(fmt::format("cannot write '{}'", (opt.out_dir / "sweep.csv").string()));
   }
-  nlohmann::json j;
-  j["scenario"] = opt.scenario.empty() ? "<built-in default scenario>" : opt.scenario;
-  j["sets"] = opt.sets;
-  j["vary"] = nlohmann::json::array();
-  for (auto& a : opt.axes) j["vary"].push_back({{"key", a.key}, {"values", a.values}});
+  nlohmann::json j = options_json(opt);
   j["jobs"] = opt.jobs;
   j["threads_per_job"] = opt.threads_per_job;
   j["failed"] = r.failed;
+  j["interrupted"] = r.interrupted;
+  j["not_started"] = r.not_started;
   j["cases"] = nlohmann::json::array();
   for (auto& c : r.cases) {
     nlohmann::json cj;
@@ -231,35 +261,61 @@ SweepResult run_sweep(const SweepOptions& opt) {
   }
   if (!fs::exists(opt.executable))
     throw InputError(fmt::format("sweep: the fracflow program '{}' does not exist", opt.executable.string()));
-  // Replaces only a folder of ours; held locked while the sweep writes it.
-  const FolderLock out_lock = prepare_batch_folder(opt.out_dir, opt.overwrite, "sweep folder");
+  if (opt.resume && opt.overwrite)
+    throw InputError("sweep: --resume continues the sweep in --out, --overwrite replaces it: not both");
   const fs::path out = fs::absolute(opt.out_dir);
-  fs::create_directories(out / "logs");
-  for (auto& c : r.cases) {
-    c.dir = out / c.name;
-    c.log = out / "logs" / (c.name + ".log");
-  }
-
   SweepOptions resolved = opt;
   resolved.out_dir = out;
   if (resolved.jobs == 0)
     resolved.jobs = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / opt.threads_per_job);
   resolved.jobs = std::min<int>(resolved.jobs, static_cast<int>(r.cases.size()));
+  // Replaces only a folder of ours; held locked while the sweep writes it.
+  FolderLock out_lock;
+  if (opt.resume) {
+    check_resumable(out, resolved);
+    out_lock = FolderLock::acquire(out);
+  } else {
+    out_lock = prepare_batch_folder(opt.out_dir, opt.overwrite, "sweep folder");
+  }
+  fs::create_directories(out / "logs");
+  for (auto& c : r.cases) {
+    c.dir = out / c.name;
+    c.log = out / "logs" / (c.name + ".log");
+    c.status = "not started";
+  }
+  if (!opt.resume) write_outputs(resolved, r);  // the options on record before the first case (--resume checks them)
   if (!opt.quiet)
     log::info("sweep: {} cases, {} at a time with {} thread(s) each, in {}", r.cases.size(), resolved.jobs,
               opt.threads_per_job, out.string());
 
+  // From here on SIGINT/SIGTERM stop the sweep with checkpoints (run_child_process passes the
+  // request on); before, nothing but the options is written.
+  install_stop_signal_handlers();
   // Workers take the next case; each case is one child process that the worker waits for.
-  std::atomic<int> done{0};
+  std::atomic<int> done{0}, read_before{0}, continued{0};
   std::mutex print;
   run_jobs(r.cases.size(), resolved.jobs, [&](std::size_t i) {
     SweepCase& c = r.cases[i];
-    std::vector<std::string> args = {"run"};
-    if (!opt.scenario.empty()) args.push_back(opt.scenario);
-    args.insert(args.end(), {"--out", c.dir.string(), "--threads", std::to_string(opt.threads_per_job)});
-    for (auto& o : c.overrides) args.insert(args.end(), {"--set", o});
-    c.exit_code = run_child_process(opt.executable, args, c.log);
-    if (c.exit_code == 0) {
+    if (stop_requested()) return;  // "not started"
+    std::vector<std::string> args;
+    bool read = false;
+    if (opt.resume && fs::exists(c.dir / "summary.json")) {
+      read = true;  // finished before: read as it is
+      c.exit_code = 0;
+      ++read_before;
+    } else if (opt.resume && fs::exists(c.dir / "checkpoint")) {
+      args = {"resume", c.dir.string(), "--threads", std::to_string(opt.threads_per_job)};
+      ++continued;
+    } else {
+      args = {"run"};
+      if (!opt.scenario.empty()) args.push_back(opt.scenario);
+      args.insert(args.end(), {"--out", c.dir.string(), "--threads", std::to_string(opt.threads_per_job)});
+      // --resume: a case stopped before its first checkpoint starts again (a folder of ours only).
+      if (opt.resume && fs::exists(c.dir)) args.push_back("--overwrite");
+      for (auto& o : c.overrides) args.insert(args.end(), {"--set", o});
+    }
+    if (!read) c.exit_code = run_child_process(opt.executable, args, c.log, c.dir);
+    if (c.exit_code == 0 && fs::exists(c.dir / "summary.json")) {
       try {
         c.summary = read_run_summary(c.dir);
         c.status = "ok";
@@ -267,8 +323,12 @@ SweepResult run_sweep(const SweepOptions& opt) {
         c.status = "no summary";
         c.error = e.what();
       }
+    } else if (c.exit_code == 0 && fs::exists(c.dir / "checkpoint")) {
+      c.status = "interrupted";  // stopped with a checkpoint (our stop request, or an ABORT file)
+    } else if (stop_requested() && !fs::exists(c.dir)) {
+      c.status = "not started";  // ended by the passed-on SIGTERM before its folder existed
     } else {
-      c.status = "failed";
+      c.status = c.exit_code == 0 ? "no summary" : "failed";
       c.error = tail_of_file(c.log, 5);
       if (c.exit_code == -1 && c.error.empty()) c.error = "could not start " + opt.executable.string();
     }
@@ -279,16 +339,25 @@ SweepResult run_sweep(const SweepOptions& opt) {
     for (auto& kv : c.values) vals += fmt::format(" {}={}", kv.first, kv.second);
     if (c.status == "ok") {
       const auto p = peak_strength(*c.summary);
-      log::info("[{}/{}] {}{}: peak {:.3f} MPa, E {:.3f} GPa, nu {:.3f}", n, r.cases.size(), c.name, vals,
-                p ? 1e-6 * p->sigma_p : std::nan(""), 1e-9 * c.summary->youngs_modulus_Pa, c.summary->poisson_ratio);
+      log::info("[{}/{}] {}{}: {}peak {:.3f} MPa, E {:.3f} GPa, nu {:.3f}", n, r.cases.size(), c.name, vals,
+                read ? "(finished before) " : "", p ? 1e-6 * p->sigma_p : std::nan(""),
+                1e-9 * c.summary->youngs_modulus_Pa, c.summary->poisson_ratio);
+    } else if (c.status == "interrupted" || c.status == "not started") {
+      log::warn("[{}/{}] {}{}: {}", n, r.cases.size(), c.name, vals, c.status);
     } else {
       log::warn("[{}/{}] {}{}: {} (exit code {}); log {}:\n{}", n, r.cases.size(), c.name, vals, c.status, c.exit_code,
                 c.log.string(), c.error);
     }
   });
+  r.read_before = read_before;
+  r.continued = continued;
 
   std::set<double> pressures;
   for (auto& c : r.cases) {
+    if (c.status == "interrupted" || c.status == "not started") {
+      ++(c.status == "interrupted" ? r.interrupted : r.not_started);
+      continue;
+    }
     if (c.status != "ok") {
       ++r.failed;
       continue;
@@ -298,7 +367,10 @@ SweepResult run_sweep(const SweepOptions& opt) {
       pressures.insert(p->sigma3);
     }
   }
-  if (pressures.size() >= 2) {
+  if (r.interrupted + r.not_started > 0) {
+    r.fit_note = fmt::format("no Mohr-Coulomb fit: the sweep was stopped ({} case(s) interrupted, {} not started); "
+                             "continue it with --resume", r.interrupted, r.not_started);
+  } else if (pressures.size() >= 2) {
     try {
       r.fit = fit_mohr_coulomb(r.strength_points);
     } catch (const InputError& e) {

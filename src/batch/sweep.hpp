@@ -42,6 +42,7 @@ struct SweepOptions {
   int jobs = 0;                         // cases at a time; 0 = cores / threads_per_job
   int threads_per_job = 1;              // OpenMP threads of each case
   bool overwrite = false;               // replace an existing non-empty out_dir
+  bool resume = false;                  // continue the sweep in out_dir (same scenario, --set and --vary)
   bool plots = true;                    // draw plots/peak_vs_confinement.png when there is a fit
   bool quiet = false;                   // no line per finished case
 };
@@ -52,7 +53,8 @@ struct SweepCase {
   std::vector<std::string> overrides;                      // --set list given to the run
   std::filesystem::path dir, log;
   int exit_code = -1;
-  std::string status;                  // "ok", "failed", "no summary"
+  std::string status;                  // "ok", "failed", "no summary", "interrupted" (a checkpoint:
+                                       // --resume continues it), "not started" (stopped before it)
   std::string error;                   // last lines of the log when not ok
   std::optional<RunSummary> summary;
 };
@@ -60,6 +62,8 @@ struct SweepCase {
 struct SweepResult {
   std::vector<SweepCase> cases;
   int failed = 0;
+  int interrupted = 0, not_started = 0;  // after a stop request (SIGINT/SIGTERM): continue with --resume
+  int read_before = 0, continued = 0;    // --resume: cases finished before, cases continued from a checkpoint
   std::optional<MohrCoulombFit> fit;
   std::string fit_note;                // why there is no fit, when there is none
   std::vector<StrengthPoint> strength_points;
@@ -74,6 +78,11 @@ bool plot_peak_vs_confinement(const std::filesystem::path& out_dir, std::span<co
 // Validates every case (scenario + overrides) before anything is written, then runs them,
 // `jobs` at a time, and writes sweep.csv, sweep.json and the plot. A failing case is recorded
 // with its exit code and log; the others go on. Throws ff::InputError for bad options.
+// SIGINT/SIGTERM (handlers installed here) stop the sweep: each running case is asked to
+// checkpoint and stop (run_child_process), no new case starts, sweep.json records which cases
+// are interrupted or not started, and `resume` continues: finished cases are read, interrupted
+// ones resumed from their checkpoints, the others run (a sweep.json is written before the first
+// case, so that --resume can check the options even after a kill -9).
 SweepResult run_sweep(const SweepOptions& opt);
 
 }  // namespace ff::batch

@@ -1,14 +1,18 @@
 // Real sweeps through the fracflow program on a tiny UCS sample (a few seconds each).
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <thread>
 
 #include "batch/sweep.hpp"
 #include "core/error.hpp"
+#include "core/interrupt.hpp"
 #include "core/log.hpp"
 
 #include "../program_runner.hpp"
@@ -111,4 +115,58 @@ TEST(SweepRuns, EnvelopePlotIsDrawn) {
   if (!drawn) GTEST_SKIP() << "python3 with matplotlib is not available here";
   EXPECT_GT(fs::file_size(out / "plots" / "peak_vs_confinement.png"), 1000u);
   fs::remove_all(out);
+}
+
+// SIGTERM to the sweep (what a batch scheduler sends at its wall-time limit): the running cases
+// checkpoint and stop (the request passed on as their ABORT file), no new case starts, sweep.json
+// says which, and --resume finishes the sweep. Before, the signal ended the sweep process at once
+// and left its children running to their ends (this test process died of it).
+TEST(SweepRuns, SigtermStopsTheCasesWithCheckpointsAndResumeFinishesThem) {
+  ff::log::quiet() = true;
+  SweepOptions opt;
+  opt.sets = kTinySample;
+  opt.axes = {parse_vary("ucs.platen_velocity=0.05,0.06,0.07")};  // ~5 s per case
+  opt.out_dir = scratch("stop");
+  opt.executable = FRACFLOW_BIN;
+  opt.jobs = 2;
+  opt.quiet = true;
+  std::thread killer([&] {  // the signal once case_000 has begun its folder
+    const fs::path marker = opt.out_dir / "case_000" / ".fracflow" / "run.json";
+    for (int k = 0; k < 1200 && !fs::exists(marker); ++k) std::this_thread::sleep_for(std::chrono::milliseconds(25));
+    std::raise(SIGTERM);
+  });
+  const auto r = run_sweep(opt);
+  killer.join();
+  ASSERT_TRUE(ff::stop_requested());
+  ASSERT_EQ(r.cases.size(), 3u);
+  EXPECT_EQ(r.cases[0].status, "interrupted") << r.cases[0].error;
+  EXPECT_TRUE(fs::exists(r.cases[0].dir / "checkpoint"));
+  EXPECT_FALSE(fs::exists(r.cases[0].dir / "summary.json"));
+  EXPECT_EQ(r.cases[2].status, "not started");
+  EXPECT_FALSE(fs::exists(r.cases[2].dir));
+  EXPECT_EQ(r.failed, 0);
+  std::ifstream log0(r.cases[0].log);
+  const std::string log_text((std::istreambuf_iterator<char>(log0)), std::istreambuf_iterator<char>());
+  EXPECT_NE(log_text.find("ABORT"), std::string::npos) << log_text;
+  const auto j = read_json(opt.out_dir / "sweep.json");
+  EXPECT_EQ(j["cases"][0]["status"], "interrupted");
+  EXPECT_EQ(j["cases"][2]["status"], "not started");
+  EXPECT_EQ(j["not_started"].get<int>() + j["interrupted"].get<int>(), 3 - (r.cases[1].status == "ok" ? 1 : 0));
+  ff::clear_stop_request();
+
+  // --resume with other --vary values: refused, nothing run.
+  SweepOptions other = opt;
+  other.resume = true;
+  other.axes = {parse_vary("ucs.platen_velocity=0.05,0.06")};
+  EXPECT_THROW(run_sweep(other), ff::InputError);
+  EXPECT_FALSE(fs::exists(r.cases[2].dir));
+  // --resume: case_000 continues from its checkpoint, case_002 runs; every case finishes.
+  opt.resume = true;
+  const auto again = run_sweep(opt);
+  EXPECT_EQ(again.failed + again.interrupted + again.not_started, 0);
+  for (auto& c : again.cases) EXPECT_EQ(c.status, "ok") << c.name << ": " << c.error;
+  EXPECT_GE(again.continued, 1);
+  EXPECT_TRUE(fs::exists(r.cases[0].dir / "summary.json"));
+  EXPECT_EQ(read_json(opt.out_dir / "sweep.json")["interrupted"], 0);
+  fs::remove_all(opt.out_dir);
 }

@@ -34,3 +34,18 @@ TEST(ValidateHydrofrac, SmallSweepWritesTheReport) {
   EXPECT_NE(again.code, 0);
   EXPECT_NE(again.output.find("--overwrite"), std::string::npos) << again.output;
 }
+
+// --overwrite replaces only a folder of ours: someone else's files are refused and left whole (they
+// were deleted with the folder before).
+TEST(ValidateHydrofrac, OverwriteNeverDeletesAForeignFolder) {
+  ff::test::TestScratch s("validate-hydrofrac-foreign");
+  const fs::path out = s / "mine";
+  fs::create_directories(out);
+  { std::ofstream(out / "core_logs.csv") << "depth,UCS\n"; }
+  const auto r = ff::test::run_program("validate-hydrofrac --overwrite --out " + out.string() + " --doc " +
+                                       (s / "doc.md").string() + " --packings 1 --sigma-h 1e6");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("holds no fracflow results"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(out / "core_logs.csv"));
+  EXPECT_FALSE(fs::exists(s / "doc.md"));
+}

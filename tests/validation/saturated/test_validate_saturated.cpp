@@ -66,3 +66,18 @@ TEST(ValidateSaturated, TinyStudyWritesTheReportAndResumes) {
   const std::string text2 = slurp(doc);
   EXPECT_NE(text2.find("1 run(s) read as finished before, 0 continued"), std::string::npos) << text2;
 }
+
+// --overwrite replaces only a study of ours: a folder of someone else's files is refused and left
+// whole (it was deleted with everything in it before).
+TEST(ValidateSaturated, OverwriteNeverDeletesAForeignFolder) {
+  ff::test::TestScratch s("validate-saturated-foreign");
+  const fs::path out = s / "mine";
+  fs::create_directories(out);
+  { std::ofstream(out / "thesis.tex") << "years of work\n"; }
+  const auto r = ff::test::run_program("validate-saturated --quick --overwrite --out " + out.string() + " --doc " +
+                                       (s / "doc.md").string());
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("holds no fracflow results"), std::string::npos) << r.output;
+  EXPECT_EQ(slurp(out / "thesis.tex"), "years of work\n");
+  EXPECT_FALSE(fs::exists(s / "doc.md"));
+}
