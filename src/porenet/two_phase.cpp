@@ -139,14 +139,20 @@ Real TwoPhaseFlow::solve_shared_pressure(Real mq, Real mp, Real V, Real a0, Real
   // 1) starts at the trace's volume at the pressure of the other phase alone, next to the root: Newton
   // from 0 or 1 crept up by a factor (1 + ln) per iteration and stopped far from a root near 1e-30
   // (p = -1.6e11 Pa in a gas pore that had received 1e-25 kg of a barotropic liquid).
+  // A trace below alpha's resolution (1 - alpha under one ulp: 1e-24 kg of gas beside 1e-4 kg of
+  // water) starts at the bracket's end: one evaluation confirms the root lies past it. Started at
+  // the midpoint instead, such a pore took 31-200 bisections per step (test
+  // GasTraceBelowAlphaResolutionStopsAtOnce).
   if (a0 < 1e-6) {
     const Real aq = mq / (V * L.density(Gs.pressure(mp / V), true));
     if (aq > lo && aq < hi) a = aq;
+    else if (aq <= lo) a = lo;
   } else if (a0 > 1 - 1e-6) {
     const Real pl = L.pressure(mq / V);
     if (pl > 0 && std::isfinite(pl)) {
       const Real ag = 1 - mp / (V * Gs.density(pl, false));
       if (ag > lo && ag < hi) a = ag;
+      else if (ag >= hi) a = hi;
     }
   }
   int it = 0;

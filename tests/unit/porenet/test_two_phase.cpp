@@ -234,3 +234,37 @@ TEST(PorenetTwoPhase, SharedPressureFromItsOwnRootStopsAtOnce) {
     EXPECT_NEAR(p2, p1, 1e-9 * p1);
   }
 }
+
+// A gas trace below alpha's resolution: 2e-24 kg of gas beside 9.5e-5 kg of water (a pore of a
+// saturated specimen's run, session 33: the trace came with the flow), so 1 - alpha ~ 2e-17, under
+// the ulp of alpha next to 1. The root lies past the largest alpha below 1; from that alpha (its
+// last result) the solve took 31-200 bisections per pore and step (the S 1 study run: 40 % of its
+// solves past 40 iterations). It must take one evaluation and give the liquid-alone pressure (to
+// K ulp ~ 1e-6 Pa).
+TEST(PorenetTwoPhase, GasTraceBelowAlphaResolutionStopsAtOnce) {
+  auto s = test_packings::hex_packing(4, 4, 1e-3, 0.45e-3, 0.0, 0.0);
+  const Network2D net = build_network_2d(s.view(), {});
+  TwoPhaseParams prm;
+  prm.liquid = Eos::barotropic(1000, 1e5, 2.2e9);
+  prm.gas = Eos::ideal_gas(293.15, 28.9586);
+  TwoPhaseFlow f(net, prm);
+  const Real below_one = std::nextafter(1.0, 0.0);
+  const std::array<Real, 4> cases[] = {{9.4655341008404519e-05, 2.0208994896592586e-24, 9.4659176850600283e-08, below_one},
+                                       {1.2494269830952843e-04, 2.229681822018718e-25, 1.2494824353574728e-07, 0.99999978380760768},
+                                       {5.4445822338767344e-05, 8.6526306996779833e-26, 5.444823040194265e-08, 0.99999973169099343}};
+  for (const auto& [mq, mp, V, last] : cases) {
+    Real p = 0;
+    int n = 0;
+    const Real a = f.solve_shared_pressure(mq, mp, V, last, p, &n);
+    EXPECT_LE(n, 2) << "m_p " << mp;
+    EXPECT_EQ(a, below_one);
+    EXPECT_NEAR(p, prm.liquid.pressure(mq / V), 1e-5) << "m_p " << mp;
+  }
+  // A trace that alpha does resolve (1 - alpha ~ 1e-12) still converges to its own root from there.
+  const Real V = 1e-7, mq = (1 - 1e-12) * V * prm.liquid.density(1e5, true), mp = 1.0001e-12 * V * prm.gas.density(1e5, false);
+  Real p = 0;
+  int n = 0;
+  const Real a = f.solve_shared_pressure(mq, mp, V, below_one, p, &n);
+  EXPECT_LE(n, 4);
+  EXPECT_NEAR(1 - a, mp / (V * prm.gas.density(p, false)), 1e-3 * (1 - a));
+}
