@@ -11,6 +11,12 @@
 
 namespace ff::porenet {
 
+namespace {
+// A phase below this share of a pore's void is a trace: under 1e-9 of gas in a liquid pore adds
+// 1e-14 1/Pa to the liquid's 4.5e-10 1/Pa compressibility at 0.1 MPa.
+constexpr Real kTraceFraction = 1e-9;
+}  // namespace
+
 StratifiedRates stratified_channel_flow(Real G, Real hq, Real hp, Real muq, Real mup) {
   StratifiedRates r;
   if (hq <= 0 && hp <= 0) return r;
@@ -110,11 +116,15 @@ void TwoPhaseFlow::load_masses(std::span<const Real> mq, std::span<const Real> m
 Real TwoPhaseFlow::solve_shared_pressure(Real mq, Real mp, Real V, Real a0, Real& p, int* iterations) const {
   const Eos& L = prm_.liquid;
   const Eos& Gs = prm_.gas;
-  if (mp <= 0) {
+  // A phase under 1e-30 of the other's mass takes no part (its volume share, ~1e-27, is below what
+  // a double resolves next to the other's): a liquid trace that the outflow limiter shrank step by
+  // step reached 5e-324 kg, its alpha 1e-316, and its density m / (alpha V) overflowed to inf (3D,
+  // the smallest pores liquid-full). It stays in the pore, immobile (no volume, no mobility).
+  if (mp <= 0 || mp < 1e-30 * mq) {
     p = L.pressure(mq / V);
     return 1;
   }
-  if (mq <= 0) {
+  if (mq <= 0 || mq < 1e-30 * mp) {
     p = Gs.pressure(mp / V);
     return 0;
   }
@@ -267,9 +277,9 @@ void TwoPhaseFlow::step_explicit(Real dt) {
 // the transport bound of stable_dt(): the rates changed since it was evaluated, e.g. the sub-steps of
 // a DEM step), its outgoing rates of that phase are scaled down to its mass (1 - 1e-12). Each channel's
 // rate is scaled once, by its upstream pore: conservative to round-off. Returns the pores limited.
-Index TwoPhaseFlow::limit_outflow(Real dt, bool apply) {
-  Index limited = 0;
-#pragma omp parallel for schedule(static) reduction(+ : limited) if (np_ > kParallelMin)
+Index TwoPhaseFlow::limit_outflow(Real dt, bool apply, Index* bulk) {
+  Index limited = 0, limited_bulk = 0;
+#pragma omp parallel for schedule(static) reduction(+ : limited, limited_bulk) if (np_ > kParallelMin)
   for (Index i = 0; i < np_; ++i) {
     lim_q_[i] = lim_p_[i] = 1;
     if (bc_[i] == PoreBc::Pressure) continue;
@@ -285,7 +295,11 @@ Index TwoPhaseFlow::limit_outflow(Real dt, bool apply) {
     if (oq > mq_[i]) lim_q_[i] = (1 - 1e-12) * mq_[i] / oq;
     if (op > mp_[i]) lim_p_[i] = (1 - 1e-12) * mp_[i] / op;
     limited += (oq > mq_[i] || op > mp_[i]) ? 1 : 0;
+    // A trace (a phase under kTraceFraction of the void) is limited but never asks for a halving:
+    // it changes neither the pore's pressure nor its other phase.
+    limited_bulk += ((oq > mq_[i] && alpha_[i] > kTraceFraction) || (op > mp_[i] && 1 - alpha_[i] > kTraceFraction)) ? 1 : 0;
   }
+  if (bulk) *bulk = limited_bulk;
   if (apply && limited > 0) {
 #pragma omp parallel for schedule(static) if (nc_ > kParallelMin)
     for (Index c = 0; c < nc_; ++c) {
@@ -427,8 +441,9 @@ void TwoPhaseFlow::implicit_substep(Real dt, int depth) {
   }
   // Outflow limit: a pore gives away at most the mass of each phase it holds (the transport bound of
   // the frozen mobilities: also what keeps IMPES stable; a net-outflow bound let the 3D test diverge).
-  const Index limited = limit_outflow(dt, false);
-  if (limited > 0 && depth < prm_.max_halvings) {
+  Index bulk = 0;
+  const Index limited = limit_outflow(dt, false, &bulk);
+  if (bulk > 0 && depth < prm_.max_halvings) {
     implicit_substep(0.5 * dt, depth + 1);
     implicit_substep(0.5 * dt, depth + 1);
     return;

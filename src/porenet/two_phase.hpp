@@ -159,7 +159,9 @@ class TwoPhaseFlow {
   void channel_mobilities(Index c, Index u, Real& lq, Real& lp) const;
   void update_pore_states(Real dt, const char* scheme);
   void implicit_substep(Real dt, int depth);
-  Index limit_outflow(Real dt, bool apply);
+  // Limits each pore's outflow of a phase to its mass (apply: scales the rates). Returns the pores
+  // limited; `bulk` (optional) counts those limited in a phase above a trace (kTraceFraction).
+  Index limit_outflow(Real dt, bool apply, Index* bulk = nullptr);
 
   const Network2D& net_;
   TwoPhaseParams prm_;

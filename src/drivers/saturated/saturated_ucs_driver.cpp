@@ -40,7 +40,7 @@ void declare(ParamTable& t) {
   t.string("fluid.liquid_placement", "uniform",
            "where a saturation below 1 puts the liquid: uniform (every pore holds that fraction) or "
            "smallest_pores_first (capillary equilibrium of a wetting liquid: the smallest pores full, the largest "
-           "gas only; 2D samples only for now; docs/saturated.md)")
+           "gas only; docs/saturated.md)")
       .one_of({"uniform", "smallest_pores_first"});
   t.real("fluid.liquid_viscosity", 1e-3, "Pa s", "dynamic viscosity of the liquid (water: 1e-3)").positive();
   t.real("fluid.gas_viscosity", 1.8e-5, "Pa s", "dynamic viscosity of the gas (air: 1.8e-5)").positive();
@@ -519,13 +519,6 @@ void validate(const Config& cfg) {
                                   "fluid.implicit_above of them); use auto or explicit");
   if (!dim3 && cfg.string("fluid.flow_scheme") == "explicit" && cfg.has("fluid.implicit_above"))
     cfg.fail("fluid.implicit_above", "applies with fluid.flow_scheme = auto; explicit means sub-steps only");
-  // 3D: with the smallest pores liquid-full and the rest gas, the implicit two-phase step halved every
-  // DEM step ~8 times once gas traces entered the wet pores (214-243 solves per step, 60 steps in 473 s
-  // on a 5,032-pore sample); limiting the traces instead left the pressure CG without convergence.
-  const Real S = cfg.real("fluid.saturation");
-  if (dim3 && S > 0 && S < 1 && cfg.string("fluid.liquid_placement") == "smallest_pores_first")
-    cfg.fail("fluid.liquid_placement", "smallest_pores_first is for 2D samples only for now (3D: the implicit two-phase "
-                                       "flow halves every step for this layout, docs/saturated.md); use uniform");
 }
 
 RunStatus run(const Config& cfg, const RunOptions& opt) {

@@ -268,3 +268,20 @@ TEST(PorenetTwoPhase, GasTraceBelowAlphaResolutionStopsAtOnce) {
   EXPECT_LE(n, 4);
   EXPECT_NEAR(1 - a, mp / (V * prm.gas.density(p, false)), 1e-3 * (1 - a));
 }
+
+// A phase under 1e-30 of the other's mass takes no part in B23: a liquid trace of 5e-324 kg (what
+// the outflow limiter left of one, step by step, in a 3D run) gave alpha 1e-316 and a liquid
+// density m / (alpha V) of inf, and the implicit step's matrix inf (CG failed). It must give the gas
+// pore's pressure and alpha 0 (and the mirror case alpha 1, the liquid's pressure).
+TEST(PorenetTwoPhase, DenormalTraceTakesNoPart) {
+  auto s = test_packings::hex_packing(4, 4, 1e-3, 0.45e-3, 0.0, 0.0);
+  const Network2D net = build_network_2d(s.view(), {});
+  TwoPhaseParams prm;  // PR water and air
+  TwoPhaseFlow f(net, prm);
+  const Real V = 6.19202e-11, mp = 7.36129e-11, mq = 5.80589e-08;
+  Real p = 0;
+  EXPECT_EQ(f.solve_shared_pressure(4.94066e-324, mp, V, 9.8499318432636783e-317, p), 0.0);
+  EXPECT_DOUBLE_EQ(p, prm.gas.pressure(mp / V));
+  EXPECT_EQ(f.solve_shared_pressure(mq, 1e-45, V, 1 - 1e-16, p), 1.0);
+  EXPECT_DOUBLE_EQ(p, prm.liquid.pressure(mq / V));
+}

@@ -130,6 +130,7 @@ TEST(SaturatedUcs3D, DrainedSidesRelieveThePressure) {
 // Tolerance 2 %. Each phase's mass is conserved to round-off.
 TEST(SaturatedUcs3D, TwoPhaseClosedSampleGasCushion) {
   for (const std::string eos : {"barotropic", "peng_robinson"}) {
+    const std::string placement = "uniform";
     const std::string gas = eos == "barotropic" ? "ideal" : "peng_robinson";
     const Result r = run3d("sat3d_two_" + eos, "saturation = 0.5\ndrainage = \"closed\"\nliquid_eos = \"" + eos +
                                                    "\"\ngas_eos = \"" + gas + "\"\n");
@@ -140,10 +141,14 @@ TEST(SaturatedUcs3D, TwoPhaseClosedSampleGasCushion) {
     const double dp = r.fluid["mean_pore_pressure_final_Pa"].get<double>() - p0, pred = p - p0;
     const double eq = std::abs(r.fluid["liquid_mass_kg"].get<double>() / r.fluid["liquid_mass_initial_kg"].get<double>() - 1);
     const double eg = std::abs(r.fluid["gas_mass_kg"].get<double>() / r.fluid["gas_mass_initial_kg"].get<double>() - 1);
-    std::printf("3D two-phase S = 0.5 (%s liquid, %s gas): dV/V0 = %.4g, mean dp = %.5g Pa, predicted %.5g Pa (rel err "
-                "%.3g); saturation %.6f -> %.6f; mass errors liquid %.3g gas %.3g\n",
-                eos.c_str(), gas.c_str(), (V0 - V) / V0, dp, pred, std::abs(dp / pred - 1),
-                r.fluid["saturation_initial"].get<double>(), r.fluid["saturation_final"].get<double>(), eq, eg);
+    const auto& solves = r.series.column("flow_substeps");
+    double mean_solves = 0;
+    for (double n : solves) mean_solves += n / static_cast<double>(solves.size());
+    std::printf("3D two-phase S = 0.5 (%s, %s liquid, %s gas): dV/V0 = %.4g, mean dp = %.5g Pa, predicted %.5g Pa (rel "
+                "err %.3g); saturation %.6f -> %.6f; mass errors liquid %.3g gas %.3g; %.2f flow solves per DEM step\n",
+                placement.c_str(), eos.c_str(), gas.c_str(), (V0 - V) / V0, dp, pred, std::abs(dp / pred - 1),
+                r.fluid["saturation_initial"].get<double>(), r.fluid["saturation_final"].get<double>(), eq, eg,
+                mean_solves);
     EXPECT_EQ(r.fluid["saturation_initial"], 0.5);
     EXPECT_GT(r.fluid["saturation_final"].get<double>(), 0.5);  // the gas shrinks, the liquid barely
     EXPECT_LT(r.fluid["saturation_final"].get<double>(), 0.51);
@@ -152,6 +157,37 @@ TEST(SaturatedUcs3D, TwoPhaseClosedSampleGasCushion) {
     EXPECT_LT(eq, 1e-12);
     EXPECT_LT(eg, 1e-12);
   }
+}
+
+// The liquid in the smallest pores (fluid.liquid_placement = smallest_pores_first), drained sides,
+// the example's narrow throats (pfv_factor 1e-4), PR water and air. Its implicit steps once halved
+// every DEM step ~8 times around the gas traces that entered the liquid-full pores (the 3D example:
+// 60 DEM steps in 473 s, so the layout was refused in 3D); limiting the traces instead overflowed a
+// 5e-324 kg liquid trace's density to inf (CG failed). A trace (under 1e-9 of the void) is now limited
+// without a halving, and a phase under 1e-30 of the other's mass takes no part in B23: the run must
+// finish with under 4 flow solves per DEM step on average (measured 2026-11-29: 2.8, the first steps
+// of the pressure transient taking up to 20), the
+// saturation staying in [0.5, 0.51] and the pressure rising under the compaction.
+TEST(SaturatedUcs3D, SmallestPoresFirstDrainedStepsWithoutHalving) {
+  const Result r = run3d("sat3d_spf", "saturation = 0.5\nliquid_placement = \"smallest_pores_first\"\n"
+                                      "liquid_eos = \"peng_robinson\"\ngas_eos = \"peng_robinson\"\n"
+                                      "drainage = \"sides\"\npfv_factor = 1e-4\n");
+  const auto& solves = r.series.column("flow_substeps");
+  double mean_solves = 0, max_solves = 0;
+  for (double n : solves) {
+    mean_solves += n / static_cast<double>(solves.size());
+    max_solves = std::max(max_solves, n);
+  }
+  const auto& pmax = r.series.column("max_pore_pressure_Pa");
+  std::printf("3D S = 0.5 smallest pores first, drained sides: %.2f flow solves per DEM step (max %.0f); saturation "
+              "%.6f -> %.6f; max pore pressure %.4g -> %.4g Pa\n", mean_solves, max_solves,
+              r.fluid["saturation_initial"].get<double>(), r.fluid["saturation_final"].get<double>(), pmax.front(),
+              pmax.back());
+  EXPECT_LT(mean_solves, 4.0);
+  EXPECT_NEAR(r.fluid["saturation_initial"].get<double>(), 0.5, 1e-12);
+  EXPECT_GE(r.fluid["saturation_final"].get<double>(), 0.5);
+  EXPECT_LT(r.fluid["saturation_final"].get<double>(), 0.51);
+  EXPECT_GT(pmax.back(), 1e5);
 }
 
 // Interrupted at step 150 on one thread and resumed on two = uninterrupted on two (every DEM loop
@@ -243,9 +279,11 @@ TEST(SaturatedUcs2D, ImplicitStepsPastSubStepsAgreeWithExplicit) {
   EXPECT_GT(je["fluid"]["flow_substeps"].get<long>(), 4) << "the explicit run should need sub-steps";
   EXPECT_GT(ji["fluid"]["implicit_flow_steps"].get<long>(), 1000);
   const CsvTable a = read_csv(expl / "series.csv"), b = read_csv(impl / "series.csv");
-  ASSERT_EQ(a.rows(), b.rows());
+  // (The runs end where each one's stress has fallen to ucs.stop_fraction: not at the same row.)
   std::size_t compared = 0;
-  for (std::size_t r = 0; r < a.rows() && a.column("cracks_total")[r] == 0 && b.column("cracks_total")[r] == 0; ++r) {
+  for (std::size_t r = 0; r < std::min(a.rows(), b.rows()) && a.column("cracks_total")[r] == 0 &&
+                          b.column("cracks_total")[r] == 0;
+       ++r) {
     if (a.column("axial_stress_Pa")[r] < 1e6) continue;  // the platens' first contact
     for (const char* c : {"axial_stress_Pa", "max_pore_pressure_Pa", "mean_pore_pressure_Pa"})
       EXPECT_NEAR(b.column(c)[r] / a.column(c)[r], 1.0, 5e-3) << c << " at row " << r;
@@ -263,8 +301,7 @@ TEST(SaturatedUcs2D, ImplicitStepsPastSubStepsAgreeWithExplicit) {
 
 namespace {
 
-// A key of the other dimension is an error naming it (not silently ignored), as in `fracflow check`;
-// so is a liquid layout the 3D flow cannot step.
+// A key of the other dimension is an error naming it (not silently ignored), as in `fracflow check`.
 TEST(SaturatedUcs, KeysOfTheOtherDimensionAreRefused) {
   const auto out = test::scratch("sat_keys");
   try {
@@ -282,13 +319,6 @@ TEST(SaturatedUcs, KeysOfTheOtherDimensionAreRefused) {
     FAIL() << "a 3D-only key was accepted for a 2D sample";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("fluid.pfv_factor"), std::string::npos) << e.what();
-  }
-  // The smallest-pores-first layout is 2D only for now (the 3D implicit flow halves every step for it).
-  try {
-    test::run_scenario(scenario_3d("saturation = 0.5\nliquid_placement = \"smallest_pores_first\"\n"), {}, out, 1);
-    FAIL() << "smallest_pores_first was accepted for a 3D sample";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("fluid.liquid_placement"), std::string::npos) << e.what();
   }
   std::filesystem::remove_all(out);
 }
