@@ -518,7 +518,8 @@ int run_validate(Args a) {
     md += "(the pictures could not be drawn: /usr/bin/python3 with matplotlib is needed)\n\n";
   }
   md += "## Runs\n\n| case | UCS, 1 m discs [kPa] | max p before peak [MPa] at strain [%] | cracks final | DEM steps "
-        "| implicit flow steps [%] | wall [s] |\n|---|---|---|---|---|---|---|\n";
+        "| implicit flow steps [%] | wall [s] (since the run's last start: after a stop, the resumed part) "
+        "|\n|---|---|---|---|---|---|---|\n";
   for (const auto& c : cases)
     md += fmt::format("| `{}` | {:.3f} | {:.3f} at {:.4f} | {:.0f} | {:.0f} | {:.1f} | {:.1f} |\n", c.dir.filename().string(),
                       1e-3 * c.ucs, 1e-6 * c.p_max_prepeak, 100 * c.strain_at_pmax, c.cracks_final, c.steps,
