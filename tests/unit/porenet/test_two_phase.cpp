@@ -207,6 +207,16 @@ TEST(PorenetTwoPhase, SharedPressureWithATraceOfOnePhase) {
   }
 }
 
+// Barotropic water (K 2.2 GPa) and ideal-gas air: the study's fluids, for single-pore B23 checks.
+namespace {
+TwoPhaseParams water_air() {
+  TwoPhaseParams prm;
+  prm.liquid = Eos::barotropic(1000, 1e5, 2.2e9);
+  prm.gas = Eos::ideal_gas(293.15, 28.9586);
+  return prm;
+}
+}  // namespace
+
 // Newton converged on the end of its bracket (every pore whose last alpha is already the root)
 // must stop there: it went to a bisection and back, 128 iterations per pore for the pores of a
 // partly saturated specimen with a gas fraction ~1e-6 (80 % of its step). A pore of that run
@@ -214,9 +224,7 @@ TEST(PorenetTwoPhase, SharedPressureWithATraceOfOnePhase) {
 TEST(PorenetTwoPhase, SharedPressureFromItsOwnRootStopsAtOnce) {
   auto s = test_packings::hex_packing(4, 4, 1e-3, 0.45e-3, 0.0, 0.0);
   const Network2D net = build_network_2d(s.view(), {});
-  TwoPhaseParams prm;
-  prm.liquid = Eos::barotropic(1000, 1e5, 2.2e9);
-  prm.gas = Eos::ideal_gas(293.15, 28.9586);
+  const TwoPhaseParams prm = water_air();
   TwoPhaseFlow f(net, prm);
   // The pore's masses, void and last alpha as the run's checkpoint held them.
   const std::array<Real, 4> cases[] = {{9.979970897626098e-05, 5.260836026557399e-12, 9.964939981297731e-08, 0.9999987002693413},
@@ -244,9 +252,7 @@ TEST(PorenetTwoPhase, SharedPressureFromItsOwnRootStopsAtOnce) {
 TEST(PorenetTwoPhase, GasTraceBelowAlphaResolutionStopsAtOnce) {
   auto s = test_packings::hex_packing(4, 4, 1e-3, 0.45e-3, 0.0, 0.0);
   const Network2D net = build_network_2d(s.view(), {});
-  TwoPhaseParams prm;
-  prm.liquid = Eos::barotropic(1000, 1e5, 2.2e9);
-  prm.gas = Eos::ideal_gas(293.15, 28.9586);
+  const TwoPhaseParams prm = water_air();
   TwoPhaseFlow f(net, prm);
   const Real below_one = std::nextafter(1.0, 0.0);
   const std::array<Real, 4> cases[] = {{9.4655341008404519e-05, 2.0208994896592586e-24, 9.4659176850600283e-08, below_one},
