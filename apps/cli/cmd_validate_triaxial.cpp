@@ -65,7 +65,7 @@ std::vector<std::string> calibrated_sets(const nlohmann::json& cal) {
 
 void check_sweep(const SweepResult& r) {
   for (auto& c : r.cases)
-    if (c.status == "interrupted" || c.status == "not started")
+    if (c.stopped())
       throw Error(fmt::format("validation stopped by {}: run {} {}; start the validation again (it has no --resume; "
                               "`fracflow resume` continues a single run)",
                               stop_requested() ? stop_signal_name() : std::string("an ABORT file"), c.dir.string(),

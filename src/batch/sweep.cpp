@@ -342,7 +342,7 @@ SweepResult run_sweep(const SweepOptions& opt) {
       log::info("[{}/{}] {}{}: {}peak {:.3f} MPa, E {:.3f} GPa, nu {:.3f}", n, r.cases.size(), c.name, vals,
                 read ? "(finished before) " : "", p ? 1e-6 * p->sigma_p : std::nan(""),
                 1e-9 * c.summary->youngs_modulus_Pa, c.summary->poisson_ratio);
-    } else if (c.status == "interrupted" || c.status == "not started") {
+    } else if (c.stopped()) {
       log::warn("[{}/{}] {}{}: {}", n, r.cases.size(), c.name, vals, c.status);
     } else {
       log::warn("[{}/{}] {}{}: {} (exit code {}); log {}:\n{}", n, r.cases.size(), c.name, vals, c.status, c.exit_code,
@@ -354,7 +354,7 @@ SweepResult run_sweep(const SweepOptions& opt) {
 
   std::set<double> pressures;
   for (auto& c : r.cases) {
-    if (c.status == "interrupted" || c.status == "not started") {
+    if (c.stopped()) {
       ++(c.status == "interrupted" ? r.interrupted : r.not_started);
       continue;
     }

@@ -57,6 +57,7 @@ struct SweepCase {
                                        // --resume continues it), "not started" (stopped before it)
   std::string error;                   // last lines of the log when not ok
   std::optional<RunSummary> summary;
+  bool stopped() const { return status == "interrupted" || status == "not started"; }  // by a stop request
 };
 
 struct SweepResult {

@@ -269,15 +269,16 @@ Real TwoPhaseFlow::stable_dt() {
 
 void TwoPhaseFlow::step_explicit(Real dt) {
   compute_rates();
-  limited_ = limit_outflow(dt, true);
+  limited_ = find_outflow_limits(dt);
+  if (limited_ > 0) apply_outflow_limits();
   update_pore_states(dt, "explicit");
 }
 
 // Transport limiter: where a pore would give away more of a phase in dt than it holds (a step above
 // the transport bound of stable_dt(): the rates changed since it was evaluated, e.g. the sub-steps of
 // a DEM step), its outgoing rates of that phase are scaled down to its mass (1 - 1e-12). Each channel's
-// rate is scaled once, by its upstream pore: conservative to round-off. Returns the pores limited.
-Index TwoPhaseFlow::limit_outflow(Real dt, bool apply, Index* bulk) {
+// rate is scaled once, by its upstream pore (apply_outflow_limits): conservative to round-off.
+Index TwoPhaseFlow::find_outflow_limits(Real dt, Index* bulk) {
   Index limited = 0, limited_bulk = 0;
 #pragma omp parallel for schedule(static) reduction(+ : limited, limited_bulk) if (np_ > kParallelMin)
   for (Index i = 0; i < np_; ++i) {
@@ -300,15 +301,16 @@ Index TwoPhaseFlow::limit_outflow(Real dt, bool apply, Index* bulk) {
     limited_bulk += ((oq > mq_[i] && alpha_[i] > kTraceFraction) || (op > mp_[i] && 1 - alpha_[i] > kTraceFraction)) ? 1 : 0;
   }
   if (bulk) *bulk = limited_bulk;
-  if (apply && limited > 0) {
-#pragma omp parallel for schedule(static) if (nc_ > kParallelMin)
-    for (Index c = 0; c < nc_; ++c) {
-      const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
-      fq_[c] *= fq_[c] > 0 ? lim_q_[a] : lim_q_[b];
-      fp_[c] *= fp_[c] > 0 ? lim_p_[a] : lim_p_[b];
-    }
-  }
   return limited;
+}
+
+void TwoPhaseFlow::apply_outflow_limits() {
+#pragma omp parallel for schedule(static) if (nc_ > kParallelMin)
+  for (Index c = 0; c < nc_; ++c) {
+    const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
+    fq_[c] *= fq_[c] > 0 ? lim_q_[a] : lim_q_[b];
+    fp_[c] *= fp_[c] > 0 ? lim_p_[a] : lim_p_[b];
+  }
 }
 
 // Phase masses from the channel rates fq_, fp_ (B18), then the shared pressure (B23) at the new void
@@ -442,7 +444,7 @@ void TwoPhaseFlow::implicit_substep(Real dt, int depth) {
   // Outflow limit: a pore gives away at most the mass of each phase it holds (the transport bound of
   // the frozen mobilities: also what keeps IMPES stable; a net-outflow bound let the 3D test diverge).
   Index bulk = 0;
-  const Index limited = limit_outflow(dt, false, &bulk);
+  const Index limited = find_outflow_limits(dt, &bulk);
   if (bulk > 0 && depth < prm_.max_halvings) {
     implicit_substep(0.5 * dt, depth + 1);
     implicit_substep(0.5 * dt, depth + 1);
@@ -450,7 +452,7 @@ void TwoPhaseFlow::implicit_substep(Real dt, int depth) {
   }
   limited_ = limited;
   ++substeps_;
-  if (limited > 0) limit_outflow(dt, true);
+  if (limited > 0) apply_outflow_limits();  // the limits just found: nothing has changed since
   update_pore_states(dt, "implicit");
 }
 

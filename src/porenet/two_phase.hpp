@@ -159,9 +159,11 @@ class TwoPhaseFlow {
   void channel_mobilities(Index c, Index u, Real& lq, Real& lp) const;
   void update_pore_states(Real dt, const char* scheme);
   void implicit_substep(Real dt, int depth);
-  // Limits each pore's outflow of a phase to its mass (apply: scales the rates). Returns the pores
-  // limited; `bulk` (optional) counts those limited in a phase above a trace (kTraceFraction).
-  Index limit_outflow(Real dt, bool apply, Index* bulk = nullptr);
+  // Each pore's outflow limit per phase over dt (lim_q_, lim_p_: the share of its rates it may pass
+  // on). Returns the pores limited; `bulk` (optional) counts those limited in a phase above a trace
+  // (kTraceFraction). apply_outflow_limits() scales the channel rates by them.
+  Index find_outflow_limits(Real dt, Index* bulk = nullptr);
+  void apply_outflow_limits();
 
   const Network2D& net_;
   TwoPhaseParams prm_;
