@@ -25,6 +25,7 @@
 #include "core/error.hpp"
 #include "coupling/porenet/dem_porenet3d.hpp"
 #include "dem/dem_params.hpp"
+#include "dem/diagnostics.hpp"
 #include "dem/sample_builder.hpp"
 #include "geometry/packing.hpp"
 #include "io/scenario.hpp"
@@ -421,12 +422,20 @@ int main(int argc, char** argv) {
   cp.fluid.cg_tolerance = 1e-8;
   coupling::DemPorenet3D cpl;
   cpl.init(d3->sys, cp);
+  // The DEM step counts the stiffness the pore fluid adds to each sphere, as the saturated_ucs driver
+  // does (fluid.stiffness_in_time_step): at the dry sample's step a liquid-full sample is unstable (the
+  // pore pressures oscillate and grow ~10x per step until the pressure system is indefinite).
+  const Real dt_dry = d3->sys.settings.dt;
+  const Real dt_wet = dt_dry * dem::critical_time_step(d3->sys, cpl.fluid_stiffness(!cp.implicit)) /
+                      dem::critical_time_step(d3->sys);
+  d3->sys.settings.dt = std::min(dt_dry, dt_wet);
   const int nc = flow_every == 0 ? 40 : S == 1.0 ? 10 : 3;
   const auto tc = std::chrono::steady_clock::now();
   try {
     cpl.run(d3->sys, nc);
   } catch (const NumericalError& e) {  // reported, not hidden: the 3D saturated solve can stall (docs §8)
     std::printf("coupled 3D, S %.1f: stopped: %s\n", S, e.what());
+    d3->sys.settings.dt = dt_dry;
     continue;
   }
   const double t_run = std::chrono::duration<double>(std::chrono::steady_clock::now() - tc).count();
@@ -447,6 +456,10 @@ int main(int argc, char** argv) {
   std::printf("  flow step / DEM step = %.2f; retriangulation every %.0f steps at %.2f m/s: share of the run %.3f%%\n",
               st.t_flow / nc / (t_dem3 * 1e-3), steps_between, v,
               100 * t_tri / (t_tri + steps_between * per_step));
+  if (dt_wet < dt_dry)
+    std::printf("  DEM step %.3e s with the pore fluid's stiffness (%.3e s dry): %.2f dry DEM steps per unit time\n",
+                dt_wet, dt_dry, dt_dry / dt_wet);
+  d3->sys.settings.dt = dt_dry;
   }
   return 0;
 }

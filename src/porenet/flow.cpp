@@ -28,7 +28,7 @@ SinglePhaseFlow::SinglePhaseFlow(const Network2D& net, const SinglePhaseParams& 
   flux_.assign(static_cast<std::size_t>(nc_), 0);
   g_.assign(static_cast<std::size_t>(nc_), 0);
   rhs_.assign(n, 0);
-  x_ = pnew_ = rhs_;
+  x_ = pnew_ = storage_ = rhs_;
   scratch_.assign(static_cast<std::size_t>(std::max<Index>(reduce_blocks(np_), 1)), 0);
 }
 
@@ -187,10 +187,15 @@ void SinglePhaseFlow::step_implicit(Real dt) {
   // Rows (= columns: symmetric). Pressure pores: diagonal rows, their columns moved to the rhs; the
   // row keeps the scale of a free row (storage + dt sum G, in kg/Pa), so that the residual norm
   // weighs it like the others (an identity row with rhs in Pa would dominate ||b|| and stop CG early).
-#pragma omp parallel for schedule(static) if (np_ > kParallelMin)
+  Index unstable = -1;  // a pore with dp/drho <= 0: negative storage, an indefinite matrix
+  Real p_scale = 0;     // largest |p|: the scale of the solve's state check
+#pragma omp parallel for schedule(static) reduction(max : unstable, p_scale) if (np_ > kParallelMin)
   for (Index i = 0; i < np_; ++i) {
     const bool fixed_i = bc_[i] == PoreBc::Pressure;
     Real diag = storage(i), rhs = 0;
+    storage_[i] = fixed_i ? 0 : diag;
+    p_scale = std::max(p_scale, std::abs(p_[i]));
+    if (!fixed_i && !(prm_.fluid.bulk_modulus(rho_[i]) > 0)) unstable = std::max(unstable, i);
     if (!fixed_i) {
       const Real Vnew = void_at(i, p_[i]);
       rhs = m_[i] - rho_[i] * Vnew + (bc_[i] == PoreBc::Flux ? dt * bc_value_[i] : 0);
@@ -218,6 +223,12 @@ void SinglePhaseFlow::step_implicit(Real dt) {
       if (inner[k] == i) val[k] = diag;
     rhs_[i] = fixed_i ? diag * (bc_value_[i] - p_[i]) : rhs;
   }
+  if (unstable >= 0)
+    throw NumericalError(fmt::format(
+        "porenet: pore {} at {:.4g} Pa: its fluid ({:.6g} kg/m^3) lies in the equation of state's unstable region "
+        "(dp/drho <= 0: a liquid stretched past the spinodal; cavitation is not modelled): the pore pressures have "
+        "gone unstable; in a coupled run lower the DEM time step (dem.time_step / dem.time_step_safety)",
+        unstable, p_[unstable], rho_[unstable]));
   if (prm_.solver == LinearSolver::LDLT) {
     if (!ldlt_analysed_) {
       ldlt_.analyzePattern(A);
@@ -229,7 +240,8 @@ void SinglePhaseFlow::step_implicit(Real dt) {
     x = ldlt_.solve(b);
   } else {
     if (!prm_.warm_start) std::fill(x_.begin(), x_.end(), 0.0);
-    cg_iters_ = sys_.solve(rhs_, x_, prm_.preconditioner, prm_.cg_tolerance, prm_.cg_max_iterations);
+    cg_iters_ = sys_.solve(rhs_, x_, prm_.preconditioner, prm_.cg_tolerance, prm_.cg_max_iterations, storage_,
+                           kStateTolerance * p_scale);
   }
 #pragma omp parallel for schedule(static) if (np_ > kParallelMin)
   for (Index i = 0; i < np_; ++i) pnew_[i] = p_[i] + x_[i];

@@ -100,7 +100,7 @@ class SinglePhaseFlow {
   PressureSystem sys_;
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<Real>> ldlt_;
   bool ldlt_analysed_ = false;
-  std::vector<Real> rhs_, x_, pnew_, scratch_;
+  std::vector<Real> rhs_, x_, pnew_, scratch_, storage_;  // storage_: each row's C_i (the solve's state check)
   int cg_iters_ = 0;
 };
 

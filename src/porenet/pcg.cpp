@@ -113,7 +113,8 @@ void PressureSystem::apply_preconditioner(Preconditioner pc, const std::vector<R
   }
 }
 
-int PressureSystem::solve(std::span<const Real> b, std::span<Real> x, Preconditioner pc, Real tol, int max_it) {
+int PressureSystem::solve(std::span<const Real> b, std::span<Real> x, Preconditioner pc, Real tol, int max_it,
+                          std::span<const Real> storage, Real state_tol) {
   const Real* val = A_.valuePtr();
   const auto* outer = A_.outerIndexPtr();
   const auto* inner = A_.innerIndexPtr();
@@ -142,19 +143,37 @@ int PressureSystem::solve(std::span<const Real> b, std::span<Real> x, Preconditi
     }
     return its;
   };
-  matvec(x.data(), ad_);
-#pragma omp parallel for schedule(static) if (n_ > kDicBlock)
-  for (Index i = 0; i < n_; ++i) r_[i] = b[i] - ad_[i];
-  if (fixed_order_sum(n_, [&](Index i) { return r_[i] * r_[i]; }, scratch_) <= tol2) return 0;
-  // Round-off floor of the residual: 16 eps ||A||_inf ||x||_2 (max: order-independent).
+  constexpr Real kFloor = 16 * std::numeric_limits<Real>::epsilon();
+  const bool state = !storage.empty();
+  // Row sums |A| (the round-off floors); max: order-independent.
+  row_abs_.resize(n_);
   Real anorm = 0;
 #pragma omp parallel for schedule(static) reduction(max : anorm) if (n_ > kDicBlock)
   for (Index i = 0; i < n_; ++i) {
     Real s = 0;
     for (Index k = outer[i]; k < outer[i + 1]; ++k) s += std::abs(val[k]);
+    row_abs_[i] = s;
     anorm = std::max(anorm, s);
   }
-  const Real floor2 = std::pow(16 * std::numeric_limits<Real>::epsilon() * anorm, 2);
+  // True when a row's residual is above its pressure-mismatch bound (the state check).
+  auto state_unmet = [&]() {
+    if (!state) return false;
+    Real xmax = 0;
+#pragma omp parallel for schedule(static) reduction(max : xmax) if (n_ > kDicBlock)
+    for (Index i = 0; i < n_; ++i) xmax = std::max(xmax, std::abs(x[i]));
+    Real excess = 0;
+#pragma omp parallel for schedule(static) reduction(max : excess) if (n_ > kDicBlock)
+    for (Index i = 0; i < n_; ++i)
+      if (storage[i] > 0)
+        excess = std::max(excess, std::abs(r_[i]) - std::max(state_tol * storage[i], kFloor * row_abs_[i] * xmax));
+    return excess > 0;
+  };
+  matvec(x.data(), ad_);
+#pragma omp parallel for schedule(static) if (n_ > kDicBlock)
+  for (Index i = 0; i < n_; ++i) r_[i] = b[i] - ad_[i];
+  if (fixed_order_sum(n_, [&](Index i) { return r_[i] * r_[i]; }, scratch_) <= tol2 && !state_unmet()) return 0;
+  // Round-off floor of the residual: 16 eps ||A||_inf ||x||_2.
+  const Real floor2 = std::pow(kFloor * anorm, 2);
   // AMG guard: a stalled or indefinite AMG-CG (seen once on a closed saturated 3D sample) falls back to
   // DIC from the same start; the aggregates are rebuilt at the next solve.
   const int amg_try = std::min(max_it, kAmgMaxIterations);
@@ -163,7 +182,7 @@ int PressureSystem::solve(std::span<const Real> b, std::span<Real> x, Preconditi
     ++amg_fallbacks_;
     amg_rebuild_ = true;
     std::copy(x0_.begin(), x0_.end(), x.begin());
-    return solve(b, x, Preconditioner::DIC, tol, max_it);
+    return solve(b, x, Preconditioner::DIC, tol, max_it, storage, state_tol);
   };
   setup_preconditioner(pc);
   apply_preconditioner(pc, r_, z_);
@@ -180,13 +199,18 @@ int PressureSystem::solve(std::span<const Real> b, std::span<Real> x, Preconditi
       r_[i] -= alpha * ad_[i];
     }
     const Real rr = fixed_order_sum(n_, [&](Index i) { return r_[i] * r_[i]; }, scratch_);
-    if (rr <= tol2) return finished(it + 1);
-    if (rr <= 64 * tol2 || (it & 15) == 15) {  // the floor matters near the end or when stalling
+    bool done = rr <= tol2, at_floor = false;
+    if (!done && (rr <= 64 * tol2 || (it & 15) == 15)) {  // the floor matters near the end or when stalling
       const Real xx = fixed_order_sum(n_, [&](Index i) { return x[i] * x[i]; }, scratch_);
-      if (rr <= floor2 * xx) {
-        ++floor_stops_;
-        return finished(it + 1);
-      }
+      done = at_floor = rr <= floor2 * xx;
+    }
+    if (done && state_unmet()) {
+      done = false;
+      ++state_iterations_;
+    }
+    if (done) {
+      floor_stops_ += at_floor ? 1 : 0;
+      return finished(it + 1);
     }
     apply_preconditioner(pc, r_, z_);
     const Real rz_new = fixed_order_sum(n_, [&](Index i) { return r_[i] * z_[i]; }, scratch_);
@@ -195,8 +219,9 @@ int PressureSystem::solve(std::span<const Real> b, std::span<Real> x, Preconditi
 #pragma omp parallel for schedule(static) if (n_ > kDicBlock)
     for (Index i = 0; i < n_; ++i) d_[i] = z_[i] + beta * d_[i];
   }
-  throw NumericalError(fmt::format("porenet: conjugate gradients did not converge in {} iterations; raise "
-                                   "cg_max_iterations or use the LDLT solver", max_it));
+  throw NumericalError(fmt::format("porenet: conjugate gradients did not converge in {} iterations{}; raise "
+                                   "cg_max_iterations or use the LDLT solver", max_it,
+                                   state && state_unmet() ? " (a pore's pressure mismatch above its bound)" : ""));
 }
 
 }  // namespace ff::porenet

@@ -366,7 +366,7 @@ void TwoPhaseFlow::prepare_implicit() {
   tq_.assign(m, 0);
   tp_ = tq_;
   rhs_.assign(n, 0);
-  dp_ = pnew_ = lim_q_ = lim_p_ = rhs_;
+  dp_ = pnew_ = lim_q_ = lim_p_ = storage_ = rhs_;
 }
 
 void TwoPhaseFlow::step_implicit(Real dt) {
@@ -394,15 +394,20 @@ void TwoPhaseFlow::implicit_substep(Real dt, int depth) {
     tq_[c] = lq;  // volumetric for now; densities applied below
     tp_[c] = lp;
   }
-#pragma omp parallel for schedule(static) if (np_ > kParallelMin)
+  Index unstable = -1;  // a pore whose phase has dp/drho <= 0: its storage, and the matrix, indefinite
+  Real p_scale = 0;     // largest |p|: the scale of the solve's state check
+#pragma omp parallel for schedule(static) reduction(max : unstable, p_scale) if (np_ > kParallelMin)
   for (Index i = 0; i < np_; ++i) {
     const bool fixed_i = bc_[i] == PoreBc::Pressure;
     const Real vq = mq_[i] / rq_[i], vp = mp_[i] / rp_[i];  // phase volumes at t^n
     // The volume balance times the pore's liquid density (mass units): with the channel's upstream
     // liquid density in W the liquid part is the exact liquid mass balance and stays symmetric.
     const Real rq = rq_[i];
-    Real diag = rq * ((vq > 0 ? vq / prm_.liquid.bulk_modulus(rq_[i]) : 0) +
-                      (vp > 0 ? vp / prm_.gas.bulk_modulus(rp_[i]) : 0));
+    const Real Kq = vq > 0 ? prm_.liquid.bulk_modulus(rq_[i]) : 1, Kp = vp > 0 ? prm_.gas.bulk_modulus(rp_[i]) : 1;
+    if (!fixed_i && !(Kq > 0 && Kp > 0)) unstable = std::max(unstable, i);
+    Real diag = rq * ((vq > 0 ? vq / Kq : 0) + (vp > 0 ? vp / Kp : 0));
+    storage_[i] = fixed_i ? 0 : diag;
+    p_scale = std::max(p_scale, std::abs(p_[i]));
     Real rhs = 0;
     if (!fixed_i) rhs = rq * (vq + vp - net_.pore_void[i]) + (bc_[i] == PoreBc::Flux ? dt * bc_value_[i] : 0);
     // Pressure pores: a diagonal row at the scale of a free row [kg/Pa] (see flow.cpp).
@@ -430,7 +435,9 @@ void TwoPhaseFlow::implicit_substep(Real dt, int depth) {
       if (inner[k] == i) val[k] = diag;
     rhs_[i] = fixed_i ? diag * (bc_value_[i] - p_[i]) : rhs;
   }
-  cg_iters_ = sys_->solve(rhs_, dp_, prm_.preconditioner, prm_.cg_tolerance, prm_.cg_max_iterations);
+  if (unstable >= 0) throw_unstable_state(unstable);
+  cg_iters_ = sys_->solve(rhs_, dp_, prm_.preconditioner, prm_.cg_tolerance, prm_.cg_max_iterations, storage_,
+                          kStateTolerance * p_scale);
 #pragma omp parallel for schedule(static) if (np_ > kParallelMin)
   for (Index i = 0; i < np_; ++i) pnew_[i] = p_[i] + dp_[i];
   // Mass rates with p^{n+1} and the t^n upstream densities.
@@ -454,6 +461,18 @@ void TwoPhaseFlow::implicit_substep(Real dt, int depth) {
   ++substeps_;
   if (limited > 0) apply_outflow_limits();  // the limits just found: nothing has changed since
   update_pore_states(dt, "implicit");
+}
+
+void TwoPhaseFlow::throw_unstable_state(Index i) const {
+  const auto k = static_cast<std::size_t>(i);
+  const bool liquid = mq_[k] > 0 && !(prm_.liquid.bulk_modulus(rq_[k]) > 0);
+  throw NumericalError(fmt::format(
+      "porenet: pore {} at {:.4g} Pa: its {} ({:.6g} kg/m^3) lies in the equation of state's unstable region "
+      "(dp/drho <= 0{}): the pore pressures have gone unstable. In a coupled run the DEM time step is likely above the "
+      "critical step with the pore fluid's stiffness: keep that stiffness in the time step (saturated_ucs: "
+      "fluid.stiffness_in_time_step = true) or lower dem.time_step / dem.time_step_safety",
+      i, p_[k], liquid ? "liquid" : "gas", liquid ? rq_[k] : rp_[k],
+      liquid ? ": stretched past the spinodal; cavitation is not modelled" : ""));
 }
 
 Real TwoPhaseFlow::total_liquid_mass() { return fixed_order_sum(np_, [&](Index i) { return mq_[i]; }, scratch_); }

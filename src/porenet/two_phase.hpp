@@ -159,6 +159,7 @@ class TwoPhaseFlow {
   void channel_mobilities(Index c, Index u, Real& lq, Real& lp) const;
   void update_pore_states(Real dt, const char* scheme);
   void implicit_substep(Real dt, int depth);
+  [[noreturn]] void throw_unstable_state(Index pore) const;
   // Each pore's outflow limit per phase over dt (lim_q_, lim_p_: the share of its rates it may pass
   // on). Returns the pores limited; `bulk` (optional) counts those limited in a phase above a trace
   // (kTraceFraction). apply_outflow_limits() scales the channel rates by them.
@@ -173,7 +174,7 @@ class TwoPhaseFlow {
   Real injected_ = 0;
   // implicit
   std::unique_ptr<PressureSystem> sys_;
-  std::vector<Real> tq_, tp_, rhs_, dp_, pnew_, lim_q_, lim_p_;
+  std::vector<Real> tq_, tp_, rhs_, dp_, pnew_, lim_q_, lim_p_, storage_;  // storage_: each row's C_i (state check)
   int cg_iters_ = 0, substeps_ = 0;
   Index limited_ = 0;
 };
