@@ -35,6 +35,7 @@ void DemRun::write_checkpoint(const fs::path& dir) {
   save_before_dem(w);
   dem::save_dem(w, sys);
   save_after_dem(w);
+  w.put_value(RunControl::kWallTag, control_.run_wall_s());
   w.commit();
 }
 
@@ -172,6 +173,7 @@ RunStatus DemRun::run() {
     load_before_dem(r);
     dem::load_dem(r, sys);
     load_after_dem(r);
+    if (r.has(RunControl::kWallTag)) control_.resumed_after(r.get_value<double>(RunControl::kWallTag));
     if (*c_.finished) {
       log::info("this run had already finished; nothing to resume");
       return RunStatus::Finished;
@@ -247,7 +249,7 @@ void DemRun::finish(const std::string& stop_reason) {
   j["sample"] = sample_json(sys, info, sample_particles > 0 ? static_cast<long>(sample_particles) : -1L);
   j["time_step_s"] = sys.settings.dt;
   j["steps"] = sys.step_count;
-  j["wall_time_s"] = control_.elapsed_s();
+  j["wall_time_s"] = control_.run_wall_s();  // every session of the run
   j["threads"] = opt.threads;
   j["parameters"] = params_json(cfg);
   add_run_record(j, opt);

@@ -23,12 +23,18 @@ class RunControl {
   bool checkpoint_due() const;
   // Restarts the wall-clock interval (call after every checkpoint written).
   void checkpoint_written();
-  double elapsed_s() const;  // wall-clock seconds since construction
+  double elapsed_s() const;  // wall-clock seconds since construction (this session; --max-wall)
+  // The whole run's wall time: the earlier sessions' (as their last checkpoint recorded it: work
+  // done after it was redone, and is counted once) plus this one's. Checkpoints store it
+  // (kWallTag); a resume hands it back with resumed_after().
+  double run_wall_s() const { return earlier_s_ + elapsed_s(); }
+  void resumed_after(double earlier_s) { earlier_s_ = earlier_s; }
+  static constexpr const char* kWallTag = "run.wall_s";
 
  private:
   using Clock = std::chrono::steady_clock;
   const RunOptions& opt_;
-  double wall_interval_s_ = 0;
+  double wall_interval_s_ = 0, earlier_s_ = 0;
   Clock::time_point start_, last_checkpoint_;
 };
 

@@ -501,6 +501,7 @@ void HydrofracRun::save(const fs::path& dir) {
   w.put("hydrofrac.insitu", insitu_);
   w.put("hydrofrac.probe", probe_);
   if (st_.stage == 1) fluid_->save(w);
+  w.put_value(RunControl::kWallTag, control_.run_wall_s());
   w.commit();
 }
 
@@ -514,6 +515,7 @@ void HydrofracRun::load() {
   r.get("hydrofrac.insitu", insitu_);
   r.get("hydrofrac.probe", probe_);
   if (st_.stage == 1) fluid_->load(r, sys);
+  if (r.has(RunControl::kWallTag)) control_.resumed_after(r.get_value<double>(RunControl::kWallTag));
 }
 
 RunStatus HydrofracRun::run() {
@@ -821,7 +823,7 @@ void HydrofracRun::finish(const std::string& stop) {
   j["sample"] = sample_json(sys, info);
   j["time_step_s"] = sys.settings.dt;
   j["steps"] = sys.step_count;
-  j["wall_time_s"] = control_.elapsed_s();
+  j["wall_time_s"] = control_.run_wall_s();  // every session of the run
   j["threads"] = opt.threads;
   j["parameters"] = params_json(cfg);
   add_run_record(j, opt);

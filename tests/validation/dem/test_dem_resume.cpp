@@ -232,3 +232,26 @@ TEST(DemResume, RunControlNamesWhyARunStopsAndWhenToCheckpoint) {
   EXPECT_NE(drivers::RunControl(cfg, walled).stop_reason(0).find("--max-wall"), std::string::npos);
   std::filesystem::remove_all(dir);
 }
+
+TEST(DemResume, WallTimeCountsEverySession) {
+  // Was: summary.json's wall_time_s counted only the last session of a resumed run. Now each
+  // checkpoint records the run's wall time so far, and the resumed run adds its own.
+  const std::string text = test::small_ucs_scenario(2);
+  const auto a = test::scratch("wall_whole"), b = test::scratch("wall_cut");
+  ASSERT_EQ(test::run_scenario(text, {}, a, 1), RunStatus::Finished);
+  const long n = steps_of(a);
+  ASSERT_EQ(test::run_scenario(text, {}, b, 1, 9 * n / 10), RunStatus::Interrupted);
+  CheckpointReader r(b / "checkpoint" / "state.ffcp");
+  ASSERT_TRUE(r.has(drivers::RunControl::kWallTag));
+  const double first = r.get_value<double>(drivers::RunControl::kWallTag);
+  EXPECT_GT(first, 0);
+  ASSERT_EQ(test::run_scenario(text, {}, b, 1, 0, true), RunStatus::Finished);
+  const double whole = test::collect(a).summary["wall_time_s"].get<double>();
+  const double resumed = test::collect(b).summary["wall_time_s"].get<double>();
+  std::printf("wall time: uninterrupted %.3f s; first session %.3f s (to 9/10 of the steps), whole resumed run %.3f s\n",
+              whole, first, resumed);
+  EXPECT_GE(resumed, first);
+  test::expect_same_results(a, b, "resumed for the wall time");
+  std::filesystem::remove_all(a);
+  std::filesystem::remove_all(b);
+}
