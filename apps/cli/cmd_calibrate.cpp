@@ -191,7 +191,7 @@ int run_calibrate_command(const CalibrateArgs& a) {
     if (sweep_thread.joinable()) sweep_thread.join();
     if (status != RunStatus::Finished)
       throw Error(fmt::format("calibration run {} was interrupted ({}); its folder is {}", it,
-                              stop_requested() ? stop_signal_name() : std::string("an ABORT file?"),
+                              stop_cause_or("an ABORT file?"),
                               run.out_dir.string()));
     const RunSummary s = read_run_summary(run.out_dir);
     // A run without a peak or an elastic fit has nothing to update from (null in summary.json).

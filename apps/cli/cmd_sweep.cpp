@@ -53,7 +53,7 @@ int run_sweep_command(const SweepArgs& a) {
   if (r.interrupted + r.not_started > 0)
     ff::log::error("sweep stopped by {}: {} case(s) interrupted after a checkpoint, {} not started; continue with "
                    "the same command and --resume",
-                   ff::stop_requested() ? ff::stop_signal_name() : std::string("ABORT files in the case folders"),
+                   ff::stop_cause_or("ABORT files in the case folders"),
                    r.interrupted, r.not_started);
   return r.failed + r.interrupted + r.not_started > 0 ? 1 : 0;
 }

@@ -122,7 +122,7 @@ nlohmann::json run_one(const fs::path& scenario, const std::vector<std::string>&
   if (batch::run_in_process(scenario.string(), sets, r) != RunStatus::Finished)
     throw Error(fmt::format("validate-hydrofrac: the run {} stopped before its end ({}); nothing is reported, run "
                             "the command again with --overwrite",
-                            dir.string(), stop_requested() ? stop_signal_name() : std::string("an ABORT file")));
+                            dir.string(), stop_cause_or("an ABORT file")));
   std::ifstream f(dir / "summary.json");
   return nlohmann::json::parse(f);
 }

@@ -68,7 +68,7 @@ void check_sweep(const SweepResult& r) {
     if (c.stopped())
       throw Error(fmt::format("validation stopped by {}: run {} {}; start the validation again (it has no --resume; "
                               "`fracflow resume` continues a single run)",
-                              stop_requested() ? stop_signal_name() : std::string("an ABORT file"), c.dir.string(),
+                              stop_cause_or("an ABORT file"), c.dir.string(),
                               c.status == "interrupted" ? "stopped after a checkpoint" : "not started"));
     else if (c.status != "ok") throw Error(fmt::format("validation run {} failed (exit code {}); log {}:\n{}", c.dir.string(),
                                                   c.exit_code, c.log.string(), c.error));

@@ -42,6 +42,8 @@ std::string stop_signal_name() {
   }
 }
 
+std::string stop_cause_or(const std::string& otherwise) { return stop_requested() ? stop_signal_name() : otherwise; }
+
 void request_stop(int signal) { g_signal.store(signal); }
 void clear_stop_request() { g_signal.store(-1); }
 

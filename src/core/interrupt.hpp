@@ -18,6 +18,9 @@ int stop_signal();
 // What asked to stop, for messages: "SIGINT (Ctrl-C)", "SIGTERM", "signal N", or "a stop
 // request" (request_stop() without a signal, or no request).
 std::string stop_signal_name();
+// The signal's name when one asked to stop, else `otherwise` (what else can stop a child run: an
+// ABORT file): for the batch commands' messages about stopped cases.
+std::string stop_cause_or(const std::string& otherwise);
 // Sets the flag from code (tests); `signal` is what stop_signal() then reports.
 void request_stop(int signal = 0);
 // Clears the flag (tests that run several drivers in one process).
