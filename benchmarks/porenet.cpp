@@ -114,6 +114,12 @@ void matrix_diagnostics(const char* name, const PressureSystem& ps) {
               q(ratio, 1), q(diag, 1) / q(diag, 0), q(diag, 0.5) / q(diag, 0), asym / amax);
 }
 
+// Repetitions of the 2D timings, times FF_BENCH_REPEAT (default 1; larger for a profiler).
+int reps(int n) {
+  static const int k = std::getenv("FF_BENCH_REPEAT") ? std::max(1, std::atoi(std::getenv("FF_BENCH_REPEAT"))) : 1;
+  return n * k;
+}
+
 double median_ms(int reps, const std::function<void()>& f) {
   std::vector<double> t;
   for (int r = 0; r < reps; ++r) {
@@ -157,7 +163,7 @@ int main(int argc, char** argv) {
   }
   Network2D net;
   const double t_build = median_ms(5, [&] { net = build_network_2d(parts, pairs); });
-  const double t_update = median_ms(11, [&] { update_network_2d(net, parts, pairs); });
+  const double t_update = median_ms(reps(11), [&] { update_network_2d(net, parts, pairs); });
 
   SinglePhaseParams sp;
   sp.fluid = Eos::barotropic(1000, 1e5, 2.2e9);
@@ -166,7 +172,7 @@ int main(int argc, char** argv) {
     if (net.pore_cx[k] < 1e-3) f.set_bc(k, PoreBc::Pressure, 2e5);
   f.init(1e5);
   const Real dt = 0.5 * f.stable_dt();
-  const double t_expl = median_ms(51, [&] { f.step_explicit(dt); });
+  const double t_expl = median_ms(reps(51), [&] { f.step_explicit(dt); });
   SinglePhaseParams spa = sp;
   spa.preconditioner = Preconditioner::AMG;
   SinglePhaseFlow fa(net, spa);
@@ -184,9 +190,9 @@ int main(int argc, char** argv) {
   for (Index k = 0; k < net.n_pores(); ++k)
     if (net.pore_cx[k] < 2e-3) tp.set_pore_state(k, 2e5, 0.9);
   const Real dt2 = 0.5 * tp.stable_dt();
-  const double t_two = median_ms(21, [&] { tp.step_explicit(dt2); });
+  const double t_two = median_ms(reps(21), [&] { tp.step_explicit(dt2); });
   std::vector<Real> fx(x.size()), fy(x.size());
-  const double t_force = median_ms(51, [&] {
+  const double t_force = median_ms(reps(51), [&] {
     add_pressure_forces(net, parts, f.pressure(), fx, fy);
     add_shear_forces(net, parts, f.pressure(), fx, fy);
   });

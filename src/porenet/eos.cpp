@@ -166,6 +166,18 @@ Real Eos::bulk_modulus(Real rho) const {
   return 0;
 }
 
+Real Eos::pressure_and_modulus(Real rho, Real& modulus) const {
+  if (kind != EosKind::PengRobinson) {
+    modulus = bulk_modulus(rho);
+    return pressure(rho);
+  }
+  // pr_p and pr_dpdV at V = M / rho - s, their common terms once (each expression as there).
+  const Real V = molar_mass / rho - s;
+  const Real RT = kGasConstant * T, vb = V - b, d = V * V + 2 * b * V - b * b;
+  modulus = -(molar_mass / rho) * (-RT / (vb * vb) + a * (2 * V + 2 * b) / (d * d));
+  return RT / vb - a / d;
+}
+
 Real Eos::max_density() const {
   return kind == EosKind::PengRobinson ? molar_mass / (b + s) : std::numeric_limits<Real>::infinity();
 }

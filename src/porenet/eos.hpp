@@ -51,6 +51,8 @@ struct Eos {
   Real density_near(Real p, bool liquid, Real guess) const;
   // Isothermal bulk modulus rho dp/drho [Pa].
   Real bulk_modulus(Real rho) const;
+  // pressure(rho) and bulk_modulus(rho) together (the same bits; PR shares its terms).
+  Real pressure_and_modulus(Real rho, Real& modulus) const;
   // Largest admissible density (PR: V -> b), +inf for the other laws.
   Real max_density() const;
   // Smallest density on the PR liquid branch (at the liquid spinodal); 0 where there is none.

@@ -50,7 +50,7 @@ void add_shear_forces(const Network2D& net, const Particles2D& p, std::span<cons
       const Real L = net.ch_length[c];
       const Real tau = 0.5 * net.ch_aperture[c] * (P[a] - P[b]) / L;  // B25
       const Real lx = net.pore_cx[b] - net.pore_cx[a], ly = net.pore_cy[b] - net.pore_cy[a];
-      const Real l = std::hypot(lx, ly);
+      const Real l = length_2d(lx, ly);
       if (l <= 0) continue;
       const Real w = tau * 2 * p.radius[j] * L / l;  // B28: tau I A_k, A_k = 2 r_j L
       sx += w * lx;

@@ -27,7 +27,7 @@ inline void arc_span_2d(const Network2D& net, const Particles2D& p, Index j, Ind
   const Index b = net.pore_v[3 * k + (c + 1) % 3], d = net.pore_v[3 * k + (c + 2) % 3];
   Real u1x = p.x[b] - p.x[j], u1y = p.y[b] - p.y[j];
   Real u2x = p.x[d] - p.x[j], u2y = p.y[d] - p.y[j];
-  const Real l1 = std::hypot(u1x, u1y), l2 = std::hypot(u2x, u2y);
+  const Real l1 = length_2d(u1x, u1y), l2 = length_2d(u2x, u2y);
   u1x /= l1, u1y /= l1, u2x /= l2, u2y /= l2;
   dx = u2x - u1x;
   dy = u2y - u1y;

@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "core/error.hpp"
+#include "porenet/atan2_batch.hpp"
 #include "porenet/reduce.hpp"
 
 namespace ff::porenet {
@@ -46,26 +47,40 @@ void check_pairs(const PairList& pr, Index n) {
                                    "indices in [0, {})", k, pr.i[k], pr.j[k], n));
 }
 
-// Pore geometry from its three corners (counter-clockwise): area, void, centroid (METHODS §5.2).
-void pore_geometry(Network2D& net, const Particles2D& p, Index k) {
-  const Index* v = &net.pore_v[3 * k];
-  const Real t = net.params.thickness;
-  Real solid = 0;
-  for (int c = 0; c < 3; ++c) {
-    const Index a = v[c], b = v[(c + 1) % 3], d = v[(c + 2) % 3];
-    const Real ux = p.x[b] - p.x[a], uy = p.y[b] - p.y[a];
-    const Real wx = p.x[d] - p.x[a], wy = p.y[d] - p.y[a];
-    const Real theta = std::atan2(std::abs(ux * wy - uy * wx), ux * wx + uy * wy);  // interior angle
-    solid += 0.5 * theta * p.radius[a] * p.radius[a];                                // disc sector
+// Pore geometry from its three corners (counter-clockwise): area, void, centroid (METHODS §5.2),
+// for pores [k0, k1) (at most kAngleBlock): the interior angles of the disc sectors in one vectorised
+// atan2 call (libm's scalar atan2, three per pore, was the larger part of the 2D geometry update).
+constexpr Index kAngleBlock = 256;
+void pore_geometry(Network2D& net, const Particles2D& p, Index k0, Index k1) {
+  Real ys[3 * kAngleBlock], xs[3 * kAngleBlock], theta[3 * kAngleBlock];
+  for (Index k = k0; k < k1; ++k) {
+    const Index* v = &net.pore_v[3 * k];
+    for (int c = 0; c < 3; ++c) {
+      const Index a = v[c], b = v[(c + 1) % 3], d = v[(c + 2) % 3];
+      const Real ux = p.x[b] - p.x[a], uy = p.y[b] - p.y[a];
+      const Real wx = p.x[d] - p.x[a], wy = p.y[d] - p.y[a];
+      ys[3 * (k - k0) + c] = std::abs(ux * wy - uy * wx);  // the interior angle at corner c
+      xs[3 * (k - k0) + c] = ux * wx + uy * wy;
+    }
   }
-  const Real area = 0.5 * ((p.x[v[1]] - p.x[v[0]]) * (p.y[v[2]] - p.y[v[0]]) -
-                           (p.y[v[1]] - p.y[v[0]]) * (p.x[v[2]] - p.x[v[0]]));
-  net.pore_area[k] = area;
-  net.pore_cell[k] = area * t;
-  // Overlapping discs count their lens twice: floor the void at a fraction of the cell.
-  net.pore_void[k] = std::max(area - solid, net.params.min_void_fraction * area) * t;
-  net.pore_cx[k] = (p.x[v[0]] + p.x[v[1]] + p.x[v[2]]) / 3;
-  net.pore_cy[k] = (p.y[v[0]] + p.y[v[1]] + p.y[v[2]]) / 3;
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // the loop above fills every argument
+  atan2_nonneg(ys, xs, theta, static_cast<int>(3 * (k1 - k0)));
+#pragma GCC diagnostic pop
+  const Real t = net.params.thickness;
+  for (Index k = k0; k < k1; ++k) {
+    const Index* v = &net.pore_v[3 * k];
+    Real solid = 0;
+    for (int c = 0; c < 3; ++c) solid += 0.5 * theta[3 * (k - k0) + c] * p.radius[v[c]] * p.radius[v[c]];  // sectors
+    const Real area = 0.5 * ((p.x[v[1]] - p.x[v[0]]) * (p.y[v[2]] - p.y[v[0]]) -
+                             (p.y[v[1]] - p.y[v[0]]) * (p.x[v[2]] - p.x[v[0]]));
+    net.pore_area[k] = area;
+    net.pore_cell[k] = area * t;
+    // Overlapping discs count their lens twice: floor the void at a fraction of the cell.
+    net.pore_void[k] = std::max(area - solid, net.params.min_void_fraction * area) * t;
+    net.pore_cx[k] = (p.x[v[0]] + p.x[v[1]] + p.x[v[2]]) / 3;
+    net.pore_cy[k] = (p.y[v[0]] + p.y[v[1]] + p.y[v[2]]) / 3;
+  }
 }
 
 void channel_geometry(Network2D& net, const Particles2D& p, const PairList& pairs, Index c) {
@@ -73,8 +88,8 @@ void channel_geometry(Network2D& net, const Particles2D& p, const PairList& pair
   const Index a = net.ch_part[2 * c], b = net.ch_part[2 * c + 1];
   const Real lx = net.pore_cx[pb] - net.pore_cx[pa], ly = net.pore_cy[pb] - net.pore_cy[pa];
   const Real ex = p.x[b] - p.x[a], ey = p.y[b] - p.y[a];
-  const Real e = std::hypot(ex, ey);
-  const Real l = std::hypot(lx, ly);
+  const Real e = length_2d(ex, ey);
+  const Real l = length_2d(lx, ly);
   // A vanishing centre line (degenerate pair of triangles) would give infinite conductance.
   const Real L = std::max(l, 1e-3 * e);
   const Real sin_omega = l > 0 ? std::abs(ex * ly - ey * lx) / (e * l) : 1.0;
@@ -279,8 +294,9 @@ void update_network_2d(Network2D& net, const Particles2D& p, const PairList& pai
     throw InputError(fmt::format("porenet: update with {} pairs, network built with {}; pass the same pair list "
                                  "(same order) with updated states", pairs.size(), net.n_pairs));
   const Index np = net.n_pores(), nc = net.n_channels();
+  const Index nb = (np + kAngleBlock - 1) / kAngleBlock;
 #pragma omp parallel for schedule(static) if (np > kParallelMin)
-  for (Index k = 0; k < np; ++k) pore_geometry(net, p, k);
+  for (Index b = 0; b < nb; ++b) pore_geometry(net, p, b * kAngleBlock, std::min(np, (b + 1) * kAngleBlock));
   Real mean_cell = 0;  // serial: a fixed-order sum
   for (Index k = 0; k < np; ++k) mean_cell += net.pore_cell[k];
   mean_cell /= static_cast<Real>(np);

@@ -174,6 +174,7 @@ class TwoPhaseFlow {
   Real injected_ = 0;
   // implicit
   std::unique_ptr<PressureSystem> sys_;
+  Real liquid_max_density_ = 0, gas_max_density_ = 0, liquid_min_density_ = 0;  // the laws' bounds (B23's bracket)
   std::vector<Real> tq_, tp_, rhs_, dp_, pnew_, lim_q_, lim_p_, storage_;  // storage_: each row's C_i (state check)
   int cg_iters_ = 0, substeps_ = 0;
   Index limited_ = 0;
