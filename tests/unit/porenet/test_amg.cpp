@@ -14,8 +14,8 @@
 #include <cmath>
 #include <cstring>
 
+#include "box_network.hpp"
 #include "core/rng.hpp"
-#include "geometry/packing.hpp"
 #include "porenet/flow.hpp"
 #include "porenet/two_phase.hpp"
 
@@ -23,28 +23,9 @@ using namespace ff;
 using namespace ff::porenet;
 
 namespace {
-Network2D network_3d(Real side, std::uint64_t seed) {
-  PackingSpec spec;
-  spec.dim = 3;
-  spec.container = PackingSpec::Container::Box;
-  spec.box_lo = {0, 0, 0};
-  spec.box_hi = {side, side, side};
-  spec.radius_min = 0.4e-3;
-  spec.radius_max = 0.6e-3;
-  spec.porosity = 0.42;
-  spec.seed = seed;
-  const Packing pk = dense_random_packing(spec);
-  std::vector<Real> x, y, z;
-  for (const Vec3& c : pk.position) {
-    x.push_back(c.x());
-    y.push_back(c.y());
-    z.push_back(c.z());
-  }
-  return build_network_3d({x, y, z, pk.radius, {}});
-}
 
 const Network2D& net3() {
-  static const Network2D net = network_3d(12e-3, 3);
+  static const Network2D net = test_packings::box_network_3d(12e-3, 3);
   return net;
 }
 

@@ -18,6 +18,7 @@
 
 #include "core/error.hpp"
 #include "geometry/packing.hpp"
+#include "box_network.hpp"
 #include "packings.hpp"
 #include "porenet/flow.hpp"
 #include "porenet/two_phase.hpp"
@@ -61,6 +62,7 @@ Real explicit_dt(const Network2D& net, const TwoPhaseParams& prm, Real S_lo, Rea
     if (net.pore_cx[k] < x_split) f.set_pore_state(k, 3e5, S_hi);
   return f.stable_dt();
 }
+
 
 }  // namespace
 
@@ -114,29 +116,13 @@ TEST(PorenetTwoPhaseImplicit, MatchesExplicitOnSoftFluid) {
 }
 
 TEST(PorenetTwoPhaseImplicit, Network3DConservesEachPhase) {
-  PackingSpec spec;
-  spec.dim = 3;
-  spec.container = PackingSpec::Container::Box;
-  spec.box_lo = {0, 0, 0};
-  spec.box_hi = {8e-3, 8e-3, 8e-3};
-  spec.radius_min = 0.4e-3;
-  spec.radius_max = 0.6e-3;
-  spec.porosity = 0.42;
-  spec.seed = 3;
-  const Packing pk = dense_random_packing(spec);
-  std::vector<Real> x, y, z;
-  for (const Vec3& c : pk.position) {
-    x.push_back(c.x());
-    y.push_back(c.y());
-    z.push_back(c.z());
-  }
-  const Network2D net = build_network_3d({x, y, z, pk.radius, {}});
+  const Network2D net = test_packings::box_network_3d(8e-3, 3);
   const TwoPhaseParams prm;
   const Real dte = explicit_dt(net, prm, 0.5, 0.8, 3e-3);
   const Result r1 = run(net, prm, 0.5, 0.8, true, 100 * dte, 30, 1, 3e-3);
   const Result r2 = run(net, prm, 0.5, 0.8, true, 100 * dte, 30, 2, 3e-3);
-  std::printf("3D: %zu spheres, %d pores: implicit dt = 100 x %.3e s x 30: liquid mass error %.2e, gas %.2e; p in "
-              "[%.6e, %.6e] Pa\n", x.size(), net.n_pores(), dte, r1.eq, r1.ep, r1.lo, r1.hi);
+  std::printf("3D: %d pores: implicit dt = 100 x %.3e s x 30: liquid mass error %.2e, gas %.2e; p in "
+              "[%.6e, %.6e] Pa\n", net.n_pores(), dte, r1.eq, r1.ep, r1.lo, r1.hi);
   EXPECT_LT(r1.eq, 1e-13);
   EXPECT_LT(r1.ep, 1e-13);
   EXPECT_GE(r1.lo, 1e5 * (1 - 1e-6));
@@ -201,23 +187,7 @@ TEST(PorenetTwoPhaseImplicit, LiquidPastTheSpinodalStopsWithTheCause) {
 // compression of the pore water, mean p - p0 = K ln(V0 / V) (K of PR water at the mean pressure;
 // the same closed-form check as test_saturated_ucs's undrained case, Wang 2000 with B = 1).
 TEST(PorenetTwoPhaseImplicit, ClosedSaturated3DStaysSmoothAtALooseTolerance) {
-  PackingSpec spec;
-  spec.dim = 3;
-  spec.container = PackingSpec::Container::Box;
-  spec.box_lo = {0, 0, 0};
-  spec.box_hi = {8e-3, 8e-3, 8e-3};
-  spec.radius_min = 0.4e-3;
-  spec.radius_max = 0.6e-3;
-  spec.porosity = 0.42;
-  spec.seed = 5;
-  const Packing pk = dense_random_packing(spec);
-  std::vector<Real> x, y, z;
-  for (const Vec3& c : pk.position) {
-    x.push_back(c.x());
-    y.push_back(c.y());
-    z.push_back(c.z());
-  }
-  Network2D net = build_network_3d({x, y, z, pk.radius, {}});
+  Network2D net = test_packings::box_network_3d(8e-3, 5);
   TwoPhaseParams prm;  // PR water
   prm.preconditioner = Preconditioner::AMG;
   prm.cg_tolerance = 1e-8;
