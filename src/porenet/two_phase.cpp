@@ -65,6 +65,8 @@ TwoPhaseFlow::TwoPhaseFlow(const Network2D& net, const TwoPhaseParams& params)
   fp_ = fq_;
   lim_q_.assign(n, 1);
   lim_p_ = lim_q_;
+  net_q_.assign(n, 0);
+  net_p_ = net_q_;
   scratch_.assign(static_cast<std::size_t>(std::max<Index>(reduce_blocks(std::max(np_, nc_)), 1)), 0);
   liquid_max_density_ = prm_.liquid.max_density();
   gas_max_density_ = prm_.gas.max_density();
@@ -287,7 +289,7 @@ void TwoPhaseFlow::step_explicit(Real dt) {
   compute_rates();
   limited_ = find_outflow_limits(dt);
   if (limited_ > 0) apply_outflow_limits();
-  update_pore_states(dt, "explicit");
+  update_pore_states(dt, "explicit", limited_ == 0);  // unlimited: the net outflows found stand
 }
 
 // Transport limiter: where a pore would give away more of a phase in dt than it holds (a step above
@@ -300,13 +302,18 @@ Index TwoPhaseFlow::find_outflow_limits(Real dt, Index* bulk) {
   for (Index i = 0; i < np_; ++i) {
     lim_q_[i] = lim_p_[i] = 1;
     if (bc_[i] == PoreBc::Pressure) continue;
-    Real oq = 0, op = 0;
+    Real oq = 0, op = 0, nq = 0, np = 0;
     for (Index e = net_.pc_start[i]; e < net_.pc_start[i + 1]; ++e) {
       const Index c = net_.pc_ch[e];
-      const Real sg = net_.ch_pore[2 * c] == i ? 1.0 : -1.0;
+      const bool first = net_.ch_pore[2 * c] == i;
+      const Real sg = first ? 1.0 : -1.0;
       oq += std::max(sg * fq_[c], 0.0);
       op += std::max(sg * fp_[c], 0.0);
+      nq += first ? fq_[c] : -fq_[c];  // the net outflow, as update_pore_states sums it
+      np += first ? fp_[c] : -fp_[c];
     }
+    net_q_[i] = nq;
+    net_p_[i] = np;
     oq *= dt;
     op *= dt;
     if (oq > mq_[i]) lim_q_[i] = (1 - 1e-12) * mq_[i] / oq;
@@ -331,7 +338,7 @@ void TwoPhaseFlow::apply_outflow_limits() {
 
 // Phase masses from the channel rates fq_, fp_ (B18), then the shared pressure (B23) at the new void
 // volume (B19) and the phase densities (B20).
-void TwoPhaseFlow::update_pore_states(Real dt, const char* scheme) {
+void TwoPhaseFlow::update_pore_states(Real dt, const char* scheme, bool net_outflow_ready) {
   Index bad = -1;
 #pragma omp parallel for schedule(static) reduction(max : bad) if (np_ > kParallelMin)
   for (Index i = 0; i < np_; ++i) {
@@ -343,11 +350,16 @@ void TwoPhaseFlow::update_pore_states(Real dt, const char* scheme) {
       continue;
     }
     Real outq = 0, outp = 0;
-    for (Index e = net_.pc_start[i]; e < net_.pc_start[i + 1]; ++e) {
-      const Index c = net_.pc_ch[e];
-      const bool first = net_.ch_pore[2 * c] == i;
-      outq += first ? fq_[c] : -fq_[c];
-      outp += first ? fp_[c] : -fp_[c];
+    if (net_outflow_ready) {
+      outq = net_q_[i];
+      outp = net_p_[i];
+    } else {
+      for (Index e = net_.pc_start[i]; e < net_.pc_start[i + 1]; ++e) {
+        const Index c = net_.pc_ch[e];
+        const bool first = net_.ch_pore[2 * c] == i;
+        outq += first ? fq_[c] : -fq_[c];
+        outp += first ? fp_[c] : -fp_[c];
+      }
     }
     mq_[i] -= dt * outq;  // B18
     mp_[i] -= dt * outp;
@@ -482,7 +494,7 @@ void TwoPhaseFlow::implicit_substep(Real dt, int depth) {
   limited_ = limited;
   ++substeps_;
   if (limited > 0) apply_outflow_limits();  // the limits just found: nothing has changed since
-  update_pore_states(dt, "implicit");
+  update_pore_states(dt, "implicit", limited == 0);
 }
 
 void TwoPhaseFlow::throw_unstable_state(Index i) const {

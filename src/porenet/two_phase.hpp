@@ -157,7 +157,8 @@ class TwoPhaseFlow {
  private:
   void compute_rates();
   void channel_mobilities(Index c, Index u, Real& lq, Real& lp) const;
-  void update_pore_states(Real dt, const char* scheme);
+  // net_outflow_ready: the rates are those find_outflow_limits() summed (no limit applied since).
+  void update_pore_states(Real dt, const char* scheme, bool net_outflow_ready);
   void implicit_substep(Real dt, int depth);
   [[noreturn]] void throw_unstable_state(Index pore) const;
   // Each pore's outflow limit per phase over dt (lim_q_, lim_p_: the share of its rates it may pass
@@ -176,6 +177,7 @@ class TwoPhaseFlow {
   std::unique_ptr<PressureSystem> sys_;
   Real liquid_max_density_ = 0, gas_max_density_ = 0, liquid_min_density_ = 0;  // the laws' bounds (B23's bracket)
   std::vector<Real> tq_, tp_, rhs_, dp_, pnew_, lim_q_, lim_p_, storage_;  // storage_: each row's C_i (state check)
+  std::vector<Real> net_q_, net_p_;  // each pore's net outflow rate per phase [kg/s] (find_outflow_limits)
   int cg_iters_ = 0, substeps_ = 0;
   Index limited_ = 0;
 };
