@@ -35,7 +35,7 @@ void DemRun::write_checkpoint(const fs::path& dir) {
   save_before_dem(w);
   dem::save_dem(w, sys);
   save_after_dem(w);
-  w.put_value(RunControl::kWallTag, control_.run_wall_s());
+  control_.record(w);
   w.commit();
 }
 
@@ -173,7 +173,7 @@ RunStatus DemRun::run() {
     load_before_dem(r);
     dem::load_dem(r, sys);
     load_after_dem(r);
-    if (r.has(RunControl::kWallTag)) control_.resumed_after(r.get_value<double>(RunControl::kWallTag));
+    control_.restore(r);
     if (*c_.finished) {
       log::info("this run had already finished; nothing to resume");
       return RunStatus::Finished;

@@ -21,6 +21,12 @@ bool RunControl::checkpoint_due() const {
 
 void RunControl::checkpoint_written() { last_checkpoint_ = Clock::now(); }
 
+void RunControl::record(CheckpointWriter& w) const { w.put_value(kWallTag, run_wall_s()); }
+
+void RunControl::restore(CheckpointReader& r) {
+  if (r.has(kWallTag)) earlier_s_ = r.get_value<double>(kWallTag);
+}
+
 std::string RunControl::stop_reason(long step) const {
   if (stop_requested()) return fmt::format("{} received", stop_signal_name());
   if (!opt_.abort_file.empty() && std::filesystem::exists(opt_.abort_file))

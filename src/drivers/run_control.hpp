@@ -7,6 +7,7 @@
 #include <string>
 
 #include "drivers/driver.hpp"
+#include "io/checkpoint.hpp"
 #include "io/params.hpp"
 
 namespace ff::drivers {
@@ -25,10 +26,11 @@ class RunControl {
   void checkpoint_written();
   double elapsed_s() const;  // wall-clock seconds since construction (this session; --max-wall)
   // The whole run's wall time: the earlier sessions' (as their last checkpoint recorded it: work
-  // done after it was redone, and is counted once) plus this one's. Checkpoints store it
-  // (kWallTag); a resume hands it back with resumed_after().
+  // done after it was redone, and is counted once) plus this one's. record() stores it in a
+  // checkpoint (kWallTag), restore() reads it back on resume (absent in older checkpoints: 0).
   double run_wall_s() const { return earlier_s_ + elapsed_s(); }
-  void resumed_after(double earlier_s) { earlier_s_ = earlier_s; }
+  void record(CheckpointWriter& w) const;
+  void restore(CheckpointReader& r);
   static constexpr const char* kWallTag = "run.wall_s";
 
  private:

@@ -171,11 +171,11 @@ Real Eos::pressure_and_modulus(Real rho, Real& modulus) const {
     modulus = bulk_modulus(rho);
     return pressure(rho);
   }
-  // pr_p and pr_dpdV at V = M / rho - s, their common terms once (each expression as there).
+  // pressure() and bulk_modulus() at one molar volume: the same expressions, their common terms
+  // evaluated once by the compiler (pr_p and pr_dpdV are inline here).
   const Real V = molar_mass / rho - s;
-  const Real RT = kGasConstant * T, vb = V - b, d = V * V + 2 * b * V - b * b;
-  modulus = -(molar_mass / rho) * (-RT / (vb * vb) + a * (2 * V + 2 * b) / (d * d));
-  return RT / vb - a / d;
+  modulus = -(molar_mass / rho) * pr_dpdV(*this, V);
+  return pr_p(*this, V);
 }
 
 Real Eos::max_density() const {

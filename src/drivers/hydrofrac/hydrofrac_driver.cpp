@@ -501,7 +501,7 @@ void HydrofracRun::save(const fs::path& dir) {
   w.put("hydrofrac.insitu", insitu_);
   w.put("hydrofrac.probe", probe_);
   if (st_.stage == 1) fluid_->save(w);
-  w.put_value(RunControl::kWallTag, control_.run_wall_s());
+  control_.record(w);
   w.commit();
 }
 
@@ -515,7 +515,7 @@ void HydrofracRun::load() {
   r.get("hydrofrac.insitu", insitu_);
   r.get("hydrofrac.probe", probe_);
   if (st_.stage == 1) fluid_->load(r, sys);
-  if (r.has(RunControl::kWallTag)) control_.resumed_after(r.get_value<double>(RunControl::kWallTag));
+  control_.restore(r);
 }
 
 RunStatus HydrofracRun::run() {
