@@ -9,6 +9,8 @@
 #include <chrono>
 #include <filesystem>
 
+#include <unistd.h>
+
 #include "batch/run_case.hpp"
 #include "commands.hpp"
 #include "core/error.hpp"
@@ -126,6 +128,27 @@ int execute(const batch::LoadedScenario& l, RunOptions opt, NewRunFolder* folder
   }
 }
 
+// `fracflow check` after the scenario's own checks: the driver's set-up as `run` does it (the
+// sample, walls, membrane, network or lattice, the time steps), stopped where the run would
+// begin writing, so that what `run` refuses only once the sample exists (a DEM step above the
+// critical one, a lattice too small...) `check` refuses too. The run's folder is a path that is
+// never created: a driver writes nothing before begin_output.
+struct SetUpPassed {};
+
+void check_set_up(const batch::LoadedScenario& l) {
+  RunOptions opt;
+  opt.threads = omp_get_max_threads();
+  opt.out_dir = fs::temp_directory_path() / fmt::format("fracflow_check_{}_not_created", static_cast<long>(::getpid()));
+  opt.progress_interval_s = 0;
+  opt.begin_output = [] { throw SetUpPassed{}; };
+  try {
+    (void)l.driver->run(l.config, opt);
+  } catch (const SetUpPassed&) {
+    return;
+  }
+  throw Error(fmt::format("check: driver '{}' finished its set-up without reaching its output stage", l.driver->name));
+}
+
 // The keys of DIR/scenario.toml edited since the run started (from DIR/.fracflow/scenario.toml,
 // the scenario as resolved then). Refused unless `accept`; accepted ones go to summary.json.
 std::vector<std::string> edited_scenario(const fs::path& dir, const batch::LoadedScenario& now, bool accept) {
@@ -179,6 +202,10 @@ int main(int argc, char** argv) {
   auto* check = app.add_subcommand("check", "validate a scenario and print every resolved parameter");
   check->add_option("scenario", scenario, "scenario file (TOML); none: the built-in default");
   check->add_option("--set,-s", sets, "override a parameter: --set key=value (repeatable)");
+  bool skip_set_up = false;
+  check->add_flag("--skip-set-up", skip_set_up,
+                  "only the checks that need no sample or lattice (quicker for large samples; what run refuses once "
+                  "the sample is built, such as a DEM time step above the critical one, is then not checked)");
 
   auto* resume = app.add_subcommand("resume", "continue a run from its last checkpoint");
   resume->add_option("dir", resume_dir, "results folder of the run")->required();
@@ -228,7 +255,16 @@ int main(int argc, char** argv) {
     if (*check) {
       const drivers::FlowCheckReport derived;  // what a flow driver's validate() derives (dt, tau, Mach...)
       auto l = batch::load_scenario_for_run(scenario, sets);
-      fmt::print("{}: valid; driver '{}' ({})\n\n{}", scenario.empty() ? "built-in default scenario" : scenario,
+      if (!skip_set_up) {
+        try {
+          check_set_up(*l);
+        } catch (const NumericalError& e) {
+          log::error("{}", e.what());
+          return 3;  // as run
+        }
+      }
+      fmt::print("{}: valid{}; driver '{}' ({})\n\n{}", scenario.empty() ? "built-in default scenario" : scenario,
+                 skip_set_up ? " (set-up not built: --skip-set-up)" : " (set-up built as run builds it; nothing written)",
                  l->driver->name, l->driver->summary, l->config.describe());
       if (!derived.text().empty()) fmt::print("\n{}", derived.text());
       return 0;

@@ -139,6 +139,10 @@ std::vector<Bad> bad_scenarios() {
       {"lbm_time_step_too_large", kCavity + "lbm.time_step = 10\n", {"lbm.time_step", "Mach number"}},
       {"lbm_depth_without_d3q19", kCavity + "lbm.depth_cells = 4\n", {"lbm.depth_cells", "D3Q19"}},
       {"cylinder_wider_than_channel", kCylinder + "cylinder.diameter = 0.2\n", {"cylinder.diameter"}},
+      // refused only once the sample exists (check builds the set-up as run does; accepted by check before)
+      {"time_step_above_critical_2d", kUcs2d + "dem.time_step = 1e-3\n", {"dem.time_step", "above the stable limit"}},
+      {"time_step_above_critical_triaxial", kTriaxial + "dem.time_step = 1e-3\n",
+       {"dem.time_step", "above the stable limit"}},
   };
 }
 
