@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -130,7 +131,12 @@ std::string DemRun::curve_row(const DemRowReport& r, double& fraction) {
   ++*c_.rows;
   if (vtk_ && r.strain >= *c_.next_vtk_strain) {
     write_vtk();
-    while (*c_.next_vtk_strain <= r.strain) *c_.next_vtk_strain += vtk_every_;
+    // Step through the intervals passed; a leap of more than a million intervals (a blown-up run:
+    // the interval added to a huge strain would no longer change it) jumps past the strain at once.
+    Real& next = *c_.next_vtk_strain;
+    if (r.strain - next > 1e6 * vtk_every_)  // (finite: check_finite ran)
+      next = std::nextafter(r.strain + vtk_every_, std::numeric_limits<Real>::infinity());
+    while (next <= r.strain) next += vtk_every_;
   }
   std::string stop;
   // The peak must lie 10 rows into the loading: a slow platen's first rows are start-up noise (a
@@ -162,6 +168,21 @@ void DemRun::check_finite(const DemRowReport& r) const {
       sys.step_count, sys.time, what, opt.out_dir.string(), opt.out_dir.string(), spec.long_run_keys));
 }
 
+// A platen that moves a good part of a grain in one step is an impact, not a loading test, and
+// its contacts jump through each other (at 1e300 m/s the strain left the double range).
+void DemRun::refuse_loading_jump() const {
+  if (spec.rate_key.empty() || sys.particles.size() == 0) return;
+  const Real v = cfg.real(spec.rate_key), dt = sys.settings.dt;
+  const auto& r = sys.particles.radius;
+  const Real r_min = *std::min_element(r.begin(), r.end());
+  if (v * dt > kMaxLoadingStep * r_min)
+    cfg.fail(spec.rate_key,
+             fmt::format("{:.4g} m/s moves the platen {:.3g} m in one time step ({:.4g} s), {:.3g} of the smallest particle "
+                         "radius ({:.4g} m); the limit is {}: a loading test needs many steps per grain (quasi-static "
+                         "rates are 1e-3 to 1 m/s)",
+                         v, v * dt, dt, v * dt / r_min, r_min, kMaxLoadingStep));
+}
+
 RunStatus DemRun::run() {
   c_ = counters();
   const std::string& p = spec.name;
@@ -181,6 +202,8 @@ RunStatus DemRun::run() {
     log::info("resuming at step {} (t = {:.6g} s){}", sys.step_count, sys.time, resume_note());
   } else {
     set_up();
+    refuse_endless_run(planned_steps(), spec.long_run_keys, sys.settings.dt);
+    refuse_loading_jump();
     begin_output(opt);  // the sample is built: from here on files go into out_dir
   }
   ready();

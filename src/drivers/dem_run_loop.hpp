@@ -62,6 +62,9 @@ struct DemRunSpec {
   // strain's name in the stop message; an empty lateral column: none (the fit's lateral
   // strain is 0).
   std::string strain_column = "axial_strain", lateral_column = "lateral_strain", strain_name = "axial strain";
+  // The loading speed's key [m/s] (each platen or grip): refused when it moves a platen by more
+  // than kMaxLoadingStep x the smallest radius in one time step. Empty: not checked.
+  std::string rate_key;
 };
 
 class DemRun {
@@ -71,12 +74,15 @@ class DemRun {
   DemRun(const DemRun&) = delete;
   DemRun& operator=(const DemRun&) = delete;
   RunStatus run();  // the loop
+  // Largest platen or grip travel per time step, as a fraction of the smallest radius.
+  static constexpr double kMaxLoadingStep = 0.05;
 
  protected:
   // --- hooks ---
   virtual DemLoopCounters counters() = 0;
   // Fresh run: sample, boundaries, time step, loading velocities (nothing written yet).
   virtual void set_up() = 0;
+  void refuse_loading_jump() const;
   // The driver's checkpoint sections, before and after the DEM system's (restoring what
   // load_dem needs first, e.g. a membrane).
   virtual void save_before_dem(CheckpointWriter&) const {}

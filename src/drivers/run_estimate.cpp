@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "core/error.hpp"
 #include "core/log.hpp"
 
 namespace ff::drivers {
@@ -15,6 +16,7 @@ constexpr long kTimedSteps = 200;
 constexpr double kTimedSeconds = 1.0;
 
 std::string steps_text(double steps) {
+  if (steps >= 1e12) return fmt::format("{:.3g}", steps);
   if (steps >= 1e9) return fmt::format("{:.1f} billion", steps / 1e9);
   return fmt::format("{:.1f} million", steps / 1e6);
 }
@@ -27,6 +29,16 @@ std::string duration_text(double s) {
   if (t >= 3600) return fmt::format("about {} h {} min", t / 3600, (t % 3600) / 60);
   if (t >= 60) return fmt::format("about {} min", std::lround(s / 60));
   return fmt::format("about {} s", t);
+}
+
+void refuse_endless_run(double steps, std::string_view shorten, double dt) {
+  if (steps <= kMaxRunSteps) return;
+  throw InputError(fmt::format("this run would need {:.3g} time steps{}, more than the {:.0e} a run may take (at a million "
+                               "steps a second that is over 11 days): {} shorten it{}",
+                               steps, dt > 0 ? fmt::format(" of {:.3g} s", dt) : std::string(), kMaxRunSteps, shorten,
+                               dt > 0 ? "; a step that short comes from a stiffness, modulus or density far off (the log "
+                                        "above gives the time step and what set it)"
+                                      : ""));
 }
 
 std::string long_run_notice(double steps, double steps_per_s, std::string_view shorten) {

@@ -11,6 +11,16 @@ namespace ff::drivers {
 
 // Runs of more steps than this announce their length.
 constexpr double kLongRunSteps = 1e6;
+// Runs of more steps than this are refused: at a million steps a second (a small 2D sample on
+// one core) they would take over 11 days, and step counters and times lose their meaning long
+// before 1e15 (a step of 1e-154 s from a bulk modulus of 1e300 Pa, an end time of 1e300 s).
+constexpr double kMaxRunSteps = 1e12;
+
+// Throws InputError when `steps` (the run's planned steps, after set-up) exceeds kMaxRunSteps or
+// is not a number, naming `shorten`; called before the run writes anything, so that `check`
+// refuses it too.
+// `dt` (> 0) is named in the message (a step far too short is the usual cause).
+void refuse_endless_run(double steps, std::string_view shorten, double dt = 0);
 
 // "about 3 h 10 min", "about 12 min", "about 40 s".
 std::string duration_text(double seconds);

@@ -84,7 +84,7 @@ class BrazilianRun final : public DemRun {
  public:
   BrazilianRun(const Config& c, const RunOptions& o)
       : DemRun(c, o, {"brazilian", "load", "tensile_stress_Pa", "brazilian.platen_velocity or brazilian.max_strain",
-                      "diametral_strain", "", "diametral strain"}) {
+                      "diametral_strain", "", "diametral strain", "brazilian.platen_velocity"}) {
     D_ = cfg.real("sample.diameter");
     t_ = sys.settings.dim == 3 ? cfg.real("sample.height") : 1.0;  // 2D: disks of unit thickness
     gauge_radius_ = cfg.real("brazilian.centre_gauge_radius") * 0.5 * D_;

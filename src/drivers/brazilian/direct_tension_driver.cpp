@@ -90,7 +90,8 @@ namespace {
 class DirectTensionRun final : public DemRun {
  public:
   DirectTensionRun(const Config& c, const RunOptions& o)
-      : DemRun(c, o, {"direct_tension", "load", "tensile_stress_Pa", "direct_tension.grip_velocity or direct_tension.max_strain"}) {}
+      : DemRun(c, o, {"direct_tension", "load", "tensile_stress_Pa", "direct_tension.grip_velocity or direct_tension.max_strain",
+                      "axial_strain", "lateral_strain", "axial strain", "direct_tension.grip_velocity"}) {}
 
  private:
   DemLoopCounters counters() override {

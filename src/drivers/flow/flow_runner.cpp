@@ -361,6 +361,8 @@ RunStatus Runner<L, T>::run() {
     for (auto& w : chk.warnings) log::warn("{}", w);
     for (auto& w : fc_.warnings()) log::warn("{}", w);
   }
+  const std::string shorten = fmt::format("run.end_time, a smaller {} or a larger {}", fc_.resolution_key(), fu_.key());
+  refuse_endless_run(cfg_.real("run.end_time") / units_.dt(), shorten);
   begin_output(opt_);  // the lattice is built and checked: from here on files go into out_dir
   const long steps_total = std::max(1L, std::lround(cfg_.real("run.end_time") / units_.dt()));
   const long samples = cfg_.integer("output.samples");
@@ -422,9 +424,7 @@ RunStatus Runner<L, T>::run() {
   }
 
   Progress progress(driver_, opt_.progress_interval_s);
-  LongRunNotice long_run(double(steps_total - sol_->time_step()),
-                         fmt::format("run.end_time, a smaller {} or a larger {}", fc_.resolution_key(), fu_.key()),
-                         sol_->time_step());
+  LongRunNotice long_run(double(steps_total - sol_->time_step()), shorten, sol_->time_step());
   if (!opt_.resume) {  // resumable from the start (kill -9 before the first interval)
     write_checkpoint(cp_dir);
     control.checkpoint_written();

@@ -106,6 +106,8 @@ class HydrofracRun {
 
  private:
   void set_up();
+  double planned_steps() const;
+  static constexpr const char* kShortenKeys = "injection.ramp_rate, injection.max_time or insitu.max_steps";
   void make_fluid();
   void servo();
   void advance(long steps);
@@ -518,6 +520,15 @@ void HydrofracRun::load() {
   control_.restore(r);
 }
 
+// Upper bound of the run's steps from step 0: the in-situ cap plus the injection's time.
+double HydrofracRun::planned_steps() const {
+  const bool rate_mode = cfg.string("injection.mode") == "rate";
+  const Real max_t = cfg.real("injection.max_time");
+  return static_cast<double>(cfg.integer("insitu.max_steps")) +
+         (rate_mode ? max_t : std::min(max_t, cfg.real("injection.max_pressure") / cfg.real("injection.ramp_rate"))) /
+             sys.settings.dt;
+}
+
 RunStatus HydrofracRun::run() {
   make_fluid();
   if (opt.resume) {
@@ -529,6 +540,7 @@ RunStatus HydrofracRun::run() {
     log::info("resuming at step {} (t = {:.6g} s), {}", sys.step_count, sys.time, st_.stage == 0 ? "in-situ stage" : "injecting");
   } else {
     set_up();
+    refuse_endless_run(planned_steps(), kShortenKeys, sys.settings.dt);
     begin_output(opt);
   }
   // Outputs; on resume, rows, crack lines and snapshots after the checkpoint are dropped (the
@@ -561,12 +573,8 @@ RunStatus HydrofracRun::run() {
   const Real max_p = cfg.real("injection.max_pressure"), max_t = cfg.real("injection.max_time");
   const Real stop_extent = cfg.real("injection.stop_extent"), stop_fraction = cfg.real("injection.stop_fraction");
   const Real peak_drop = cfg.real("injection.peak_drop");
-  const Real ramp = cfg.real("injection.ramp_rate");
   Progress progress("hydrofrac", opt.progress_interval_s);
-  const double planned = static_cast<double>(insitu_max) +
-                         (rate_mode ? max_t : std::min(max_t, max_p / ramp)) / sys.settings.dt;
-  LongRunNotice long_run(planned - static_cast<double>(sys.step_count), "injection.ramp_rate, injection.max_time or insitu.max_steps",
-                         sys.step_count);
+  LongRunNotice long_run(planned_steps() - static_cast<double>(sys.step_count), kShortenKeys, sys.step_count);
   std::string stop;
   try {
     for (;;) {

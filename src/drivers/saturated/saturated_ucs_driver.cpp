@@ -367,7 +367,7 @@ class SaturatedUcsRun final : public UcsRun {
                            static_cast<double>(fluid_.retriangulations()), static_cast<double>(fluid_.substeps())})
       row.push_back(x);
     if (m.axial_stress >= ucs_state().peak_stress) write_pores("pores_at_peak.csv");
-    fmt::format_to(std::back_inserter(status), "  p_max {:.3f} MPa", 1e-6 * fluid_.max_pressure());
+    fmt::format_to(std::back_inserter(status), "  p_max {:.4g} MPa", 1e-6 * fluid_.max_pressure());
   }
   void save_extra(CheckpointWriter& w) const override {
     w.put_value("saturated.state", ex_);

@@ -13,6 +13,7 @@
 #include "dem/dem_checkpoint.hpp"
 #include "dem/dem_output.hpp"
 #include "drivers/run_control.hpp"
+#include "drivers/run_estimate.hpp"
 #include "drivers/run_record.hpp"
 #include "drivers/summary_values.hpp"
 #include "fracflow/version.hpp"
@@ -363,6 +364,7 @@ RunStatus SedimentationRun<L, T>::run() {
   log::info("lattice {} {} x {} x {} cells ({}), {} particles; DEM step {:.4g} s, {} DEM sub-steps per LBM step",
             L::name, geo_.n[0], geo_.n[1], geo_.n[2], sizeof(T) == 8 ? "double" : "float", np, cpl_->dem_dt(),
             cpl_->sub_steps());
+  refuse_endless_run(cfg_.real("run.end_time") / sc_.dt(), "run.end_time, a larger lbm.dx or a shorter LBM step (fluid.time_step, fluid.sound_speed)");
   begin_output(opt_);  // (the fluid's warnings were logged by validate())
   const char* ax = L::D == 3 ? "xyz" : "xy";
   columns_ = {"step", "time_s", "max_mach"};

@@ -183,7 +183,8 @@ class TriaxialRun final : public DemRun {
   TriaxialRun(const Config& c, const RunOptions& o)
       : DemRun(c, o,
                {"triaxial", "differential stress", "differential_stress_Pa",
-                "triaxial.platen_velocity, triaxial.max_strain or triaxial.isotropic_max_steps"}),
+                "triaxial.platen_velocity, triaxial.max_strain or triaxial.isotropic_max_steps", "axial_strain",
+                "lateral_strain", "axial strain", "triaxial.platen_velocity"}),
         p_(c.real("triaxial.confining_pressure")),
         servo_{c.real("triaxial.servo_velocity"), c.real("triaxial.servo_relaxation")},
         every_(c.integer("triaxial.series_interval")),

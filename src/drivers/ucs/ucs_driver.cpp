@@ -94,9 +94,11 @@ void UcsRun::ready() {
   extra_columns(columns);
 }
 
-// Each platen moves at v: the strain cap is reached after max_strain h0 / (2 v dt) steps.
+// Each platen moves at v: the strain cap is reached after max_strain h / (2 v dt) steps (h the
+// sample's height as built, not the gauge's: a sample that blew up in its set-up must reach the
+// loop, which stops it with the cause, rather than look like a run that cannot end).
 double UcsRun::planned_steps() const {
-  return cfg.real("ucs.max_strain") * st_.h0 / (2 * cfg.real("ucs.platen_velocity") * sys.settings.dt);
+  return cfg.real("ucs.max_strain") * info.height / (2 * cfg.real("ucs.platen_velocity") * sys.settings.dt);
 }
 
 // The same steps as sys.run(steps) when the hooks are the defaults.

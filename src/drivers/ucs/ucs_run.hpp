@@ -27,7 +27,11 @@ struct UcsState {
 class UcsRun : public DemRun {
  public:
   UcsRun(const Config& c, const RunOptions& o)
-      : DemRun(c, o, {"ucs", "stress", "axial_stress_Pa", "ucs.platen_velocity or ucs.max_strain"}) {}
+      : DemRun(c, o, {.name = "ucs",
+                       .stress_name = "stress",
+                       .stress_column = "axial_stress_Pa",
+                       .long_run_keys = "ucs.platen_velocity or ucs.max_strain",
+                       .rate_key = "ucs.platen_velocity"}) {}
 
  protected:
   // --- extension hooks (all no-ops for the plain UCS test) ---

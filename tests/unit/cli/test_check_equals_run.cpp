@@ -143,6 +143,9 @@ std::vector<Bad> bad_scenarios() {
       {"time_step_above_critical_2d", kUcs2d + "dem.time_step = 1e-3\n", {"dem.time_step", "above the stable limit"}},
       {"time_step_above_critical_triaxial", kTriaxial + "dem.time_step = 1e-3\n",
        {"dem.time_step", "above the stable limit"}},
+      {"run_that_cannot_end", kUcs2d + "ucs.platen_velocity = 1e-12\n", {"ucs.platen_velocity", "time steps of"}},
+      {"platen_jumping_grains", kUcs2d + "ucs.platen_velocity = 1e6\n", {"ucs.platen_velocity", "in one time step"}},
+      {"lbm_end_time_overflowing", kCavity + "lbm.tau = 0.52\nrun.end_time = 1e300\n", {"run.end_time", "time steps"}},
   };
 }
 
