@@ -23,6 +23,7 @@
 #include <memory>
 #include <sstream>
 
+#include "batch/curve_peak.hpp"
 #include "batch/jobs.hpp"
 #include "batch/run_case.hpp"
 #include "commands.hpp"
@@ -208,15 +209,12 @@ Case run_case(const fs::path& scen, const Args& a, double s, double mu, int seed
   const auto& stress = cols.at("axial_stress_Pa");
   const auto& strain = cols.at("axial_strain");
   const auto& unbalanced = cols.at("unbalanced_force_ratio");
-  std::size_t peak = 0;
-  bool found = false;
-  for (std::size_t k = 0; k < stress.size(); ++k) {
-    c.burst = std::max(c.burst, stress[k]);
-    if (unbalanced[k] < kQuasiStatic && (!found || stress[k] > stress[peak])) peak = k, found = true;
-  }
-  if (!found)
-    throw Error(fmt::format("validate-saturated: {} has no row in equilibrium (unbalanced-force ratio < {})",
+  for (double v : stress) c.burst = std::max(c.burst, v);
+  const auto qs = batch::quasi_static_peak(stress, unbalanced, kQuasiStatic);
+  if (!qs)
+    throw Error(fmt::format("validate-saturated: {} has no row near equilibrium (unbalanced-force ratio < {})",
                             (dir / "series.csv").string(), kQuasiStatic));
+  const std::size_t peak = *qs;
   // The layer strength scales as the driver's (the same factor: the mean layer thickness).
   if (c.ucs > 0) c.ucs_layer *= stress[peak] / c.ucs;
   c.burst_ratio = c.burst / stress[peak];
