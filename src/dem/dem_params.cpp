@@ -23,7 +23,11 @@ void declare_dem_params(ParamTable& t) {
   t.real("dem.time_step", 0.0, "s", "time step; 0 = time_step_safety x critical time step").non_negative();
   t.real("dem.time_step_safety", 0.8, "-", "fraction of the critical time step used (and allowed)").positive().at_most(1);
   t.boolean("dem.mass_scaling", false, "scale inertial masses so that dem.time_step is stable (quasi-static runs only)");
-  t.real("dem.skin_ratio", 0.3, "-", "Verlet skin as a fraction of the mean particle radius").positive();
+  t.real("dem.skin_ratio", 0.3, "-",
+         "Verlet skin as a fraction of the mean particle radius (above a few radii every near particle is a neighbour "
+         "and the contact search costs more than it saves)")
+      .positive()
+      .at_most(10);
   t.integer("dem.parallel_min", 2048, "-", "loops over fewer particles/contacts/bonds run on one thread (OpenMP fork/join costs more)").non_negative();
   t.boolean("dem.energy_tracking", true,
             "energy bookkeeping: boundary work, kinetic and strain energy, damping, friction, dashpot and bond-breakage "
