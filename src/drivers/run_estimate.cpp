@@ -36,8 +36,8 @@ void refuse_endless_run(double steps, std::string_view shorten, double dt) {
   throw InputError(fmt::format("this run would need {:.3g} time steps{}, more than the {:.0e} a run may take (at a million "
                                "steps a second that is over 11 days): {} shorten it{}",
                                steps, dt > 0 ? fmt::format(" of {:.3g} s", dt) : std::string(), kMaxRunSteps, shorten,
-                               dt > 0 ? "; a step that short comes from a stiffness, modulus or density far off (the log "
-                                        "above gives the time step and what set it)"
+                               dt > 0 ? ", and so does a longer time step (the log above says what set it: a stiffness, "
+                                        "modulus or density far off makes it tiny)"
                                       : ""));
 }
 
