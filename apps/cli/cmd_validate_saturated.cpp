@@ -23,13 +23,13 @@
 #include <memory>
 #include <sstream>
 
-#include "batch/curve_peak.hpp"
 #include "batch/jobs.hpp"
 #include "batch/run_case.hpp"
 #include "commands.hpp"
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
 #include "core/log.hpp"
+#include "drivers/curve_peak.hpp"
 #include "io/run_folder.hpp"
 #include "io/scenario.hpp"
 
@@ -134,7 +134,7 @@ std::map<std::string, std::vector<double>> read_csv(const fs::path& f) {
 // gave 9.9 and 20.7 kPa for it after round-off changes, against 7.674 and 7.670 kPa for the
 // quasi-static peak (docs/saturated.md, "Peak stress"). The rows excluded before the peak are the
 // platens' start-up and small crack events (in the study's 15 runs: at most 0.94 x UCS but one, 1.01).
-constexpr double kQuasiStatic = 0.1;
+constexpr double kQuasiStatic = drivers::kQuasiStaticUnbalance;
 
 struct Case {
   double saturation = 0, viscosity = 0;
@@ -210,7 +210,7 @@ Case run_case(const fs::path& scen, const Args& a, double s, double mu, int seed
   const auto& strain = cols.at("axial_strain");
   const auto& unbalanced = cols.at("unbalanced_force_ratio");
   for (double v : stress) c.burst = std::max(c.burst, v);
-  const auto qs = batch::quasi_static_peak(stress, unbalanced, kQuasiStatic);
+  const auto qs = drivers::quasi_static_peak(stress, unbalanced, kQuasiStatic);
   if (!qs)
     throw Error(fmt::format("validate-saturated: {} has no row near equilibrium (unbalanced-force ratio < {})",
                             (dir / "series.csv").string(), kQuasiStatic));

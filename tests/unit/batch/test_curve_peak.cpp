@@ -1,4 +1,4 @@
-// The strength of a loading curve is its quasi-static peak (batch/curve_peak.hpp): a crack
+// The strength of a loading curve is its quasi-static peak (drivers/curve_peak.hpp): a crack
 // burst's one-row platen spike does not count. The rows below are those of a saturated 2D
 // specimen (validate-saturated, S 1, water, packing 7; series.csv steps 1,393,800-1,409,400,
 // stress in kPa): loading near equilibrium up to 7.670 kPa, then the burst's rows with an
@@ -7,9 +7,9 @@
 
 #include <vector>
 
-#include "batch/curve_peak.hpp"
+#include "drivers/curve_peak.hpp"
 
-using ff::batch::quasi_static_peak;
+using ff::drivers::quasi_static_peak;
 
 TEST(CurvePeak, TheBurstSpikeIsNotTheStrength) {
   const std::vector<double> stress = {7.524, 7.670, 7.645, 7.568, 7.159, 7.813, 9.185, 20.680, 18.310, 6.0};

@@ -140,6 +140,13 @@ TEST(RunResults, UcsSummaryIsTypedAndColumnsCarryUnits) {
   EXPECT_GT(j["ucs_Pa"].get<double>(), 0) << j.dump(2);
   EXPECT_GT(j["youngs_modulus_Pa"].get<double>(), 0);
   EXPECT_TRUE(j["peak"]["reached"].get<bool>());
+  // The peak among rows near equilibrium (drivers/curve_peak.hpp): at most the largest stress, and
+  // a dry sample's peak is quasi-static (within 5 % of it).
+  const auto& q = j["peak"]["quasi_static"];
+  ASSERT_TRUE(q.is_object()) << j.dump(2);
+  EXPECT_LE(q["stress_Pa"].get<double>(), j["ucs_Pa"].get<double>());
+  EXPECT_GT(q["stress_Pa"].get<double>(), 0.95 * j["ucs_Pa"].get<double>());
+  EXPECT_GT(q["axial_strain"].get<double>(), 0);
   const auto& p = j["parameters"];
   EXPECT_TRUE(p["sample.porosity"].is_number_float());
   EXPECT_TRUE(p["ucs.series_interval"].is_number_integer());

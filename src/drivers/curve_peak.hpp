@@ -6,8 +6,11 @@
 #include <cstddef>
 #include <optional>
 #include <span>
+#include <string_view>
 
-namespace ff::batch {
+#include "io/csv.hpp"
+
+namespace ff::drivers {
 
 // Index of the largest stress[k] with unbalanced[k] < threshold (the first on ties); none when no
 // row qualifies. The spans must have the same length.
@@ -19,4 +22,20 @@ inline std::optional<std::size_t> quasi_static_peak(std::span<const double> stre
   return peak;
 }
 
-}  // namespace ff::batch
+// Below this unbalanced-force ratio a row of a loading curve counts as near equilibrium.
+constexpr double kQuasiStaticUnbalance = 0.1;
+
+// The quasi-static peak of a series.csv read back (its stress column, `axial_strain` and
+// `unbalanced_force_ratio`): row, stress and strain; none without such a row.
+struct QuasiStaticPeak {
+  std::size_t row = 0;
+  double stress = 0, strain = 0;
+};
+inline std::optional<QuasiStaticPeak> quasi_static_peak(const CsvTable& t, std::string_view stress_column) {
+  const auto& s = t.column(stress_column);
+  const auto k = quasi_static_peak(s, t.column("unbalanced_force_ratio"), kQuasiStaticUnbalance);
+  if (!k) return std::nullopt;
+  return QuasiStaticPeak{*k, s[*k], t.column("axial_strain")[*k]};
+}
+
+}  // namespace ff::drivers
