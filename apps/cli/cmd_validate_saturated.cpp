@@ -19,9 +19,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
-#include <map>
 #include <memory>
-#include <sstream>
 
 #include "batch/jobs.hpp"
 #include "batch/run_case.hpp"
@@ -30,6 +28,7 @@
 #include "core/interrupt.hpp"
 #include "core/log.hpp"
 #include "drivers/curve_peak.hpp"
+#include "io/csv.hpp"
 #include "io/run_folder.hpp"
 #include "io/scenario.hpp"
 
@@ -104,27 +103,6 @@ void write_text(const fs::path& f, const std::string& t) {
   std::ofstream o(f);
   o << t;
   if (!o) throw Error(fmt::format("cannot write '{}'", f.string()));
-}
-
-// series.csv as columns.
-std::map<std::string, std::vector<double>> read_csv(const fs::path& f) {
-  std::ifstream in(f);
-  if (!in) throw Error(fmt::format("cannot read '{}'", f.string()));
-  std::string line;
-  std::getline(in, line);
-  std::vector<std::string> names;
-  {
-    std::stringstream ss(line);
-    std::string c;
-    while (std::getline(ss, c, ',')) names.push_back(c);
-  }
-  std::map<std::string, std::vector<double>> cols;
-  while (std::getline(in, line)) {
-    std::stringstream ss(line);
-    std::string c;
-    for (std::size_t k = 0; k < names.size() && std::getline(ss, c, ','); ++k) cols[names[k]].push_back(std::atof(c.c_str()));
-  }
-  return cols;
 }
 
 // The strength is the peak of the quasi-static curve: rows whose unbalanced-force ratio is below
@@ -205,33 +183,33 @@ Case run_case(const fs::path& scen, const Args& a, double s, double mu, int seed
     c.particles = j["sample"].value("particles", 0L);
     c.bonds = j["sample"].value("bonds", 0L);
   }
-  const auto cols = read_csv(dir / "series.csv");
-  const auto& stress = cols.at("axial_stress_Pa");
-  const auto& strain = cols.at("axial_strain");
-  const auto& unbalanced = cols.at("unbalanced_force_ratio");
+  const CsvTable cols = read_csv(dir / "series.csv");
+  const auto& stress = cols.column("axial_stress_Pa");
+  const auto& strain = cols.column("axial_strain");
   for (double v : stress) c.burst = std::max(c.burst, v);
-  const auto qs = drivers::quasi_static_peak(stress, unbalanced, kQuasiStatic);
+  const auto qs = drivers::quasi_static_peak(cols, "axial_stress_Pa");
   if (!qs)
     throw Error(fmt::format("validate-saturated: {} has no row near equilibrium (unbalanced-force ratio < {})",
                             (dir / "series.csv").string(), kQuasiStatic));
-  const std::size_t peak = *qs;
+  const std::size_t peak = qs->row;
   // The layer strength scales as the driver's (the same factor: the mean layer thickness).
-  if (c.ucs > 0) c.ucs_layer *= stress[peak] / c.ucs;
-  c.burst_ratio = c.burst / stress[peak];
-  c.ucs = stress[peak];
+  if (c.ucs > 0) c.ucs_layer *= qs->stress / c.ucs;
+  c.burst_ratio = c.burst / qs->stress;
+  c.ucs = qs->stress;
   c.peak_row = peak;
-  c.strain_at_peak = strain[peak];
+  c.strain_at_peak = qs->strain;
+  const auto& p_max = cols.column("max_pore_pressure_Pa");
   for (std::size_t k = 0; k <= peak && k < stress.size(); ++k) {
-    if (cols.at("max_pore_pressure_Pa")[k] > c.p_max_prepeak) {
-      c.p_max_prepeak = cols.at("max_pore_pressure_Pa")[k];
+    if (p_max[k] > c.p_max_prepeak) {
+      c.p_max_prepeak = p_max[k];
       c.strain_at_pmax = strain[k];
     }
   }
-  c.p_mean_at_peak = cols.at("mean_pore_pressure_Pa")[peak];
-  c.cracks_at_peak = cols.at("cracks_total")[peak];
-  c.cracks_final = cols.at("cracks_total").back();
-  c.tensile_final = cols.at("cracks_tensile").back();
-  c.shear_final = cols.at("cracks_shear").back();
+  c.p_mean_at_peak = cols.column("mean_pore_pressure_Pa")[peak];
+  c.cracks_at_peak = cols.column("cracks_total")[peak];
+  c.cracks_final = cols.column("cracks_total").back();
+  c.tensile_final = cols.column("cracks_tensile").back();
+  c.shear_final = cols.column("cracks_shear").back();
   return c;
 }
 
