@@ -18,6 +18,7 @@
 #include "dem/sample_builder.hpp"
 #include "drivers/brazilian/brazilian_driver.hpp"
 #include "drivers/brazilian/tensile_plots.hpp"
+#include "drivers/curve_peak.hpp"
 #include "drivers/dem_results.hpp"
 #include "drivers/dem_run_loop.hpp"
 #include "drivers/ucs/ucs_measure.hpp"
@@ -193,7 +194,9 @@ class DirectTensionRun final : public DemRun {
   }
   void ready() override { columns = kColumns; }
   double planned_steps() const override {
-    return cfg.real("direct_tension.max_strain") * st_.free_length /
+    // The built sample's height (an upper bound of the free length), not the grips' measured
+    // distance: a set-up that blew up must reach the loop's instability stop, not an "endless run".
+    return cfg.real("direct_tension.max_strain") * info.height /
            (2 * cfg.real("direct_tension.grip_velocity") * sys.settings.dt);
   }
   DemRowReport measure() override {
@@ -239,6 +242,8 @@ class DirectTensionRun final : public DemRun {
       j["peak"]["largest_stress_Pa"] = st_.peak_stress;
       log::warn("no tensile strength (null in summary.json): {}", out.no_peak);
     }
+    // The peak among rows near equilibrium (a crack burst's one-row spike is not a strength).
+    j["peak"]["quasi_static"] = peak ? quasi_static_peak_json(opt.out_dir / "series.csv", "tensile_stress_Pa") : nullptr;
     put_elastic_fit(j, out.fit,
                     "least squares on the pre-peak tension curve between 20% and 50% of the peak stress (tension "
                     "positive: Young's modulus in tension; Poisson's ratio from the mid-length lateral gauge)");

@@ -132,12 +132,8 @@ void UcsRun::summarize(nlohmann::json& j, const DemOutcome& out) {
   }
   // The peak among rows near equilibrium: a crack burst's one-row spike (grains thrown onto a
   // platen) is not a strength; in saturated specimens it reached 2.7 x this (drivers/curve_peak.hpp).
-  if (const auto q = quasi_static_peak(read_csv(opt.out_dir / "series.csv"), "axial_stress_Pa"))
-    j["peak"]["quasi_static"] = {{"stress_Pa", q->stress},
-                                 {"axial_strain", q->strain},
-                                 {"unbalanced_force_ratio_below", kQuasiStaticUnbalance}};
-  else
-    j["peak"]["quasi_static"] = nullptr;
+  j["peak"]["quasi_static"] =
+      out.no_peak.empty() ? quasi_static_peak_json(opt.out_dir / "series.csv", "axial_stress_Pa") : nullptr;
   put_elastic_fit(j, out.fit, "least squares on the pre-peak curve between 20% and 50% of the peak stress");
   extra_summary(j, out);
 }

@@ -81,6 +81,7 @@ TEST(RunResults, UcsWithoutFitWindowOrPeakReportsNullWithReason) {
   EXPECT_TRUE(j["strain_at_peak"].is_null());
   EXPECT_FALSE(j["peak"]["reached"].get<bool>());
   EXPECT_TRUE(has(j["peak"]["reason"].get<std::string>(), "ucs.max_strain")) << j.dump(2);
+  EXPECT_TRUE(j["peak"]["quasi_static"].is_null()) << j.dump(2);
   EXPECT_TRUE(has(r.output, "warning: no Young's modulus")) << r.output;
   EXPECT_TRUE(has(r.output, "warning: no UCS")) << r.output;
   EXPECT_TRUE(has(r.output, "no UCS, no E or nu")) << r.output;
@@ -117,6 +118,7 @@ progress_interval = 0
                           "youngs_modulus_Pa", "poisson_ratio"})
     EXPECT_TRUE(j[key].is_null()) << key << ": " << j.dump(2);
   EXPECT_TRUE(has(j["peak"]["reason"].get<std::string>(), "triaxial.max_strain")) << j.dump(2);
+  EXPECT_TRUE(j["peak"]["quasi_static"].is_null()) << j.dump(2);  // no peak: not even a quasi-static one
   EXPECT_TRUE(j["elastic_fit"]["reason"].is_string()) << j.dump(2);
   EXPECT_TRUE(has(r.output, "warning: no peak differential stress")) << r.output;
   EXPECT_TRUE(j["parameters"]["triaxial.confining_pressure"].is_number_float());

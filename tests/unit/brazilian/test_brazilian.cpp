@@ -198,6 +198,16 @@ TEST(Brazilian, TensileStrengthIsRepeatableOverPackings) {
     // The strength is the peak of the curve: 2P/(pi D t) of the peak load, and force / area.
     EXPECT_NEAR(bts.back(), 2 * jb["peak_load_N"].get<double>() / (kPi * 20e-3 * 1.0), 1e-9 * bts.back());
     EXPECT_NEAR(dts.back(), jt["peak_load_N"].get<double>() / (14e-3 * 1.0), 1e-9 * dts.back());
+    // The peak among rows near equilibrium (drivers/curve_peak.hpp): at most the strength, and for
+    // these dry quasi-static tests within 10 % of it.
+    for (const auto* j : {&jb, &jt}) {
+      const auto& q = (*j)["peak"]["quasi_static"];
+      ASSERT_TRUE(q.is_object()) << j->dump(1);
+      EXPECT_LE(q["stress_Pa"].get<double>(), (*j)["tensile_strength_Pa"].get<double>());
+      EXPECT_GT(q["stress_Pa"].get<double>(), 0.9 * (*j)["tensile_strength_Pa"].get<double>());
+    }
+    EXPECT_GT(jb["peak"]["quasi_static"]["diametral_strain"].get<double>(), 0);
+    EXPECT_GT(jt["peak"]["quasi_static"]["axial_strain"].get<double>(), 0);
   }
   const double cb = coefficient_of_variation(bts), ct = coefficient_of_variation(dts);
   std::printf("Brazilian: mean %.3f MPa, CoV %.1f%%; direct tension: mean %.3f MPa, CoV %.1f%%; BTS/DTS %.2f\n",
@@ -261,6 +271,7 @@ TEST(Brazilian, ResumeAfterMaxStepsIsBitIdentical) {
     EXPECT_EQ(j["tensile_strength_Pa"], jp["tensile_strength_Pa"]) << name;
     EXPECT_EQ(j["peak_load_N"], jp["peak_load_N"]) << name;
     EXPECT_EQ(j["cracks_up_to_peak"], jp["cracks_up_to_peak"]) << name;
+    EXPECT_EQ(j["peak"]["quasi_static"], jp["peak"]["quasi_static"]) << name;
     EXPECT_EQ(j["steps"], jp["steps"]) << name;
   }
 }
