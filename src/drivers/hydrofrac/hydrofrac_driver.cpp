@@ -29,6 +29,7 @@
 #include "dem/membrane/flexible_membrane.hpp"
 #include "dem/sample_builder.hpp"
 #include "drivers/dem_results.hpp"
+#include "drivers/flow/flow_runner.hpp"
 #include "drivers/hydrofrac/borehole.hpp"
 #include "drivers/hydrofrac/dfn.hpp"
 #include "drivers/hydrofrac/hydrofrac_params.hpp"
@@ -541,6 +542,15 @@ RunStatus HydrofracRun::run() {
   } else {
     set_up();
     refuse_endless_run(planned_steps(), kShortenKeys, sys.settings.dt);
+    if (lbm_ && FlowCheckReport::active()) {  // `fracflow check`: the LBM and DEM steps as the run will log them
+      hydrofrac::LbmSettings l;
+      l.fluid = hydrofrac::lbm_fluid_spec(cfg);
+      hydrofrac::LbmInfo in = hydrofrac::lbm_info(l, sys.settings.dt);
+      hydrofrac::size_lattice(sys.particles, l.fluid.dx, sys.settings.dim, in);
+      FlowCheckReport::append(fmt::format("hydrofrac: lattice Boltzmann fluid ({}): {}\n(lattice from the block before the "
+                                          "walls servo: the run's may differ by a cell)\n",
+                                          cfg.string("fluid.scheme"), in.describe()));
+    }
     begin_output(opt);
   }
   // Outputs; on resume, rows, crack lines and snapshots after the checkpoint are dropped (the

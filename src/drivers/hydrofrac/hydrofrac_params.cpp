@@ -195,24 +195,8 @@ void validate_scenario(const Config& cfg) {
   // The fluid's own checks (tau, Mach, density variation; the DEM step rounds dt_lbm later).
   if (cfg.string("injection.fluid") == "lbm") {
     (void)coupling::derive_scales(lbm_fluid_spec(cfg));
-    // `fracflow check`: the LBM and DEM steps as `run` logs them (the DEM step needs the sample).
-    if (FlowCheckReport::active()) {
-      const bool q = log::quiet();
-      log::quiet() = true;
-      dem::DemSystem sys;
-      sys.settings = dem::build_settings(cfg);
-      sys.materials = dem::build_materials(cfg);
-      (void)dem::build_sample(cfg, sys);
-      dem::choose_time_step(cfg, sys);
-      log::quiet() = q;
-      hydrofrac::LbmSettings l;
-      l.fluid = lbm_fluid_spec(cfg);
-      hydrofrac::LbmInfo in = hydrofrac::lbm_info(l, sys.settings.dt);
-      hydrofrac::size_lattice(sys.particles, l.fluid.dx, sys.settings.dim, in);
-      FlowCheckReport::append(fmt::format("hydrofrac: lattice Boltzmann fluid ({}): {}\n(lattice from the packing before the "
-                                          "hole is carved and the walls servo: the run's may differ by a cell)\n",
-                                          cfg.string("fluid.scheme"), in.describe()));
-    }
+    // `fracflow check` prints the LBM and DEM steps from the set-up (HydrofracRun::run), which
+    // builds the sample once; here only the fluid's own keys.
   }
   const Block b = block_of(cfg);
   const Real R = cfg.real("borehole.radius"), rmax = cfg.real("sample.radius_max");
