@@ -35,11 +35,16 @@ inline void arc_span_2d(const Network2D& net, const Particles2D& p, Index j, Ind
 
 // The energy-consistent alternative to B26-B27 (coupling::PressureForce::VoidGradient): grain j feels
 // P_i 2 r_j g_ij from pore i, g_ij = d(void per unit depth)/d(x_j), the void being the triangle less the
-// three disc sectors (network.cpp's pore_geometry without its floors). The fluid's work on the grains is
-// then sum_i P_i dV_i: a pore whose pressure follows its void is a conservative spring (the arc force is
-// not, unless the pore is equilateral with equal discs). Zero net force on an interior grain at uniform
-// pressure (the triangles around it tile, and each neighbour's two angles beside it sum to a fixed angle).
-void void_gradient_2d(const Network2D& net, const Particles2D& p, Index j, Index e, Real& gx, Real& gy);
+// three disc sectors, with network.cpp's floors (zero at the relative floor, phi x the triangle's at the
+// fraction floor). The fluid's work on the grains is then sum_i P_i dV_i: a pore whose pressure follows
+// its void is a conservative spring (the arc force is not, unless the pore is equilateral with equal
+// discs). Zero net force on an interior grain at uniform pressure where no pore around it is at a floor
+// (the triangles around it tile, and each neighbour's two angles beside it sum to a fixed angle); a
+// floored pore's share is missing from that sum, as its void no longer changes with the grains.
+// with_floors = false: the triangle's geometric gradient everywhere (what a floored pore will push with
+// once it opens: the bound the time step's fluid stiffness takes).
+void void_gradient_2d(const Network2D& net, const Particles2D& p, Index j, Index e, Real& gx, Real& gy,
+                      bool with_floors = true);
 void add_pressure_forces_void_gradient(const Network2D& net, const Particles2D& particles,
                                        std::span<const Real> pore_pressure, std::span<Real> fx, std::span<Real> fy);
 

@@ -463,7 +463,8 @@ std::vector<Real> DemPorenetCoupling::fluid_stiffness() const {
         force_per_p = r_[j] * std::hypot(dx, dy);
       } else {
         Real gx, gy;
-        porenet::void_gradient_2d(net, parts, j, e, gx, gy);
+        // Floors off: a floored pore counts as if it had just opened (its force then), as before.
+        porenet::void_gradient_2d(net, parts, j, e, gx, gy, false);
         force_per_p = std::hypot(gx, gy);
         if (phi == 1.0) dvoid = force_per_p;
       }

@@ -124,8 +124,8 @@ void DemPorenet3D::compute_fluid_forces(Real p_floor) {
     porenet::add_pressure_forces_3d(*net_, view(), pg_, fx_, fy_, fz_);
     return;
   }
-  // p dV/dx_j, the floors as the fluid stiffness's open_floored (the geometric gradient at the relative
-  // floor: at a fixed pressure it is the gradient of p V, conservative).
+  // p dV/dx_j of the void the flow uses, floors included (zero at the relative floor: the geometric
+  // gradient there let a pore's pressure, raised by inflow, do work it never stored; porenet/forces.cpp).
   const auto& net = *net_;
 #pragma omp parallel for schedule(static) if (net.n_particles > porenet::kParallelMin)
   for (Index j = 0; j < net.n_particles; ++j) {
@@ -133,7 +133,7 @@ void DemPorenet3D::compute_fluid_forces(Real p_floor) {
     for (Index e = net.pp_start[j]; e < net.pp_start[j + 1]; ++e) {
       Real a[3];
       porenet::unit_patch_force_3d(net, e, a);
-      f += pg_[static_cast<std::size_t>(net.pp_pore[e])] * void_gradient(j, e, Vec3(a[0], a[1], a[2]), false);
+      f += pg_[static_cast<std::size_t>(net.pp_pore[e])] * void_gradient(j, e, Vec3(a[0], a[1], a[2]), true);
     }
     fx_[static_cast<std::size_t>(j)] = f.x();
     fy_[static_cast<std::size_t>(j)] = f.y();

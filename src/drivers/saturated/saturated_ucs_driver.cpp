@@ -328,9 +328,19 @@ class SaturatedUcsRun final : public UcsRun {
       log::info("pore network (3D): {} pores, {} throats, {} drained; DEM step {:.3g} s, {} flow", net.n_pores(),
                 net.n_channels(), fluid_.drained_pores(), sys.settings.dt,
                 fluid_.c3().params().implicit ? "implicit" : "explicit");
-    else
-      log::info("pore network: {} pores, {} channels ({} pairs); DEM step {:.3g} s, flow stable step {:.3g} s",
-                net.n_pores(), net.n_channels(), fluid_.c2().pairs().size(), sys.settings.dt, fluid_.flow().stable_dt());
+    else {
+      // Pores whose void is a floor push no grain (porenet/forces.cpp): say how many there are.
+      Index at_relative = 0, at_fraction = 0;
+      for (Index k = 0; k < net.n_pores(); ++k) {
+        if (!(net.pore_void[k] > net.void_floor)) ++at_relative;
+        else if (net.pore_void[k] <= net.params.min_void_fraction * net.pore_cell[k] * (1 + 1e-12)) ++at_fraction;
+      }
+      log::info("pore network: {} pores, {} channels ({} pairs); DEM step {:.3g} s, flow stable step {:.3g} s; {} pores "
+                "at the void floor (fluid.min_void_relative x the mean cell), {} at {} of their triangle (overlapping "
+                "discs)",
+                net.n_pores(), net.n_channels(), fluid_.c2().pairs().size(), sys.settings.dt, fluid_.flow().stable_dt(),
+                at_relative, at_fraction, net.params.min_void_fraction);
+    }
     Real p;
     fluid_.mean_pressure(p, ex_.void0);
     ex_.liquid_mass0 = fluid_.flow().total_liquid_mass();
