@@ -41,6 +41,26 @@ inline std::optional<QuasiStaticPeak> quasi_static_peak(const CsvTable& t, std::
   return QuasiStaticPeak{*k, s[*k], t.column(strain_column)[*k]};
 }
 
+// The stop rule's peak of a loading curve, row by row: the largest stress among the rows that count
+// (near equilibrium where the curve has an unbalanced-force ratio; every row otherwise), and whether a
+// later row has fallen below a fraction of it. The peak must lie min_row rows into the loading: the
+// platens' first rows are start-up noise.
+struct StopPeak {
+  double stress = 0, strain = 0;
+  long row = -1;
+  // counts: the row may be the peak (its unbalanced-force ratio below kQuasiStaticUnbalance).
+  void add(long r, double s, double e, bool counts) {
+    if (counts && s > stress) {
+      stress = s;
+      strain = e;
+      row = r;
+    }
+  }
+  bool fallen(double s, double e, double fraction, long min_row = 10) const {
+    return stress > 0 && row >= min_row && e > strain && s < fraction * stress;
+  }
+};
+
 // summary.json's peak.quasi_static of a loading driver, read back from its series.csv at the end
 // (nothing in the checkpoint): {stress_Pa, <strain column>, unbalanced_force_ratio_below}, or null
 // without such a row (the drivers also give null where the curve did not peak).

@@ -15,6 +15,7 @@
 #include "dem/dem_output.hpp"
 #include "dem/dem_system.hpp"
 #include "dem/sample_builder.hpp"
+#include "drivers/curve_peak.hpp"
 #include "drivers/driver.hpp"
 #include "drivers/run_control.hpp"
 #include "drivers/ucs/ucs_measure.hpp"
@@ -141,6 +142,11 @@ class DemRun {
   bool vtk_ = false;
   Real extent_ = 0, vtk_every_ = 0, stop_fraction_ = 0, max_strain_ = 0;
   std::vector<Real> e_hist_, s_hist_, l_hist_;  // the curve, for the elastic fit
+  // The stop rule's peak: the largest stress among rows near equilibrium (drivers/curve_peak.hpp),
+  // derived from series.csv (recomputed on resume: nothing in the checkpoint). -1: no such column.
+  long ubf_column_ = -1;
+  StopPeak stop_peak_;
+  void find_quasi_static_column();
   void start_energy();
   void add_energy_columns();
   bool energy_columns_ = false;                 // the energy columns follow the driver's (dem/energy.hpp)
