@@ -363,6 +363,13 @@ RunStatus Runner<L, T>::run() {
   }
   const std::string shorten = fmt::format("run.end_time, a smaller {} or a larger {}", fc_.resolution_key(), fu_.key());
   refuse_endless_run(cfg_.real("run.end_time") / units_.dt(), shorten);
+  // A ramp that outlasts the run leaves nothing at full inflow to measure (and 1e300 s overflowed
+  // the step count into a negative sample index: a crash).
+  if (const double ramp = cfg_.real("run.inflow_ramp_time"); ramp > 0 && !(ramp < cfg_.real("run.end_time")))
+    cfg_.fail("run.inflow_ramp_time",
+              fmt::format("{:.4g} s does not end before run.end_time = {:.4g} s: nothing would be measured at the full "
+                          "inflow; give a shorter ramp, -1 (automatic) or 0 (none)",
+                          ramp, cfg_.real("run.end_time")));
   begin_output(opt_);  // the lattice is built and checked: from here on files go into out_dir
   const long steps_total = std::max(1L, std::lround(cfg_.real("run.end_time") / units_.dt()));
   const long samples = cfg_.integer("output.samples");

@@ -146,6 +146,11 @@ std::vector<Bad> bad_scenarios() {
       {"run_that_cannot_end", kUcs2d + "ucs.platen_velocity = 1e-12\n", {"ucs.platen_velocity", "time steps of"}},
       {"platen_jumping_grains", kUcs2d + "ucs.platen_velocity = 1e6\n", {"ucs.platen_velocity", "in one time step"}},
       {"lbm_end_time_overflowing", kCavity + "lbm.tau = 0.52\nrun.end_time = 1e300\n", {"run.end_time", "time steps"}},
+      // every pair bonded: memory past 6 GB on a 3D block
+      {"bond_gap_beyond_the_grains", kUcs2d + "sample.bond_gap = 1\n", {"sample.bond_gap", "largest particle radius"}},
+      // 1e300 s overflowed the ramp's step count into a negative sample index: a segmentation fault
+      {"inflow_ramp_outlasting_the_run", kCylinder + "run.inflow_ramp_time = 1e300\n",
+       {"run.inflow_ramp_time", "does not end before run.end_time"}},
   };
 }
 
