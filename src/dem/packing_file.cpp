@@ -172,7 +172,7 @@ SampleInfo place_packing(const PackingFile& p, const Config& cfg, DemSystem& sys
       for (const auto& [i, j] : bonds) sys.add_bond(i, j);
       info.bonds = bonds.size();
     } else {
-      info.bonds = sys.install_bonds(cfg.real("sample.bond_gap"));
+      info.bonds = install_sample_bonds(cfg, sys);
     }
   }
   std::vector<int> degree(n, 0);

@@ -387,6 +387,17 @@ int default_group(const Config& cfg, const Materials& mat) {
 
 }  // namespace
 
+std::size_t install_sample_bonds(const Config& cfg, DemSystem& sys) {
+  const Real gap = cfg.real("sample.bond_gap");
+  Real rmax = 0;
+  for (Real r : sys.particles.radius) rmax = std::max(rmax, r);
+  if (gap > rmax)
+    cfg.fail("sample.bond_gap", fmt::format("{:.6g} m is above the sample's largest particle radius ({:.6g} m): bonds "
+                                            "join neighbours across small gaps; give at most that",
+                                            gap, rmax));
+  return sys.install_bonds(gap);
+}
+
 void validate_dem_sample(const Config& cfg) {
   const DemSettings settings = build_settings(cfg);
   const Materials mat = build_materials(cfg);
@@ -566,7 +577,7 @@ SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
     }
     info.pore_particles = removed;
   }
-  if (sys.materials.has_bonds()) info.bonds = sys.install_bonds(cfg.real("sample.bond_gap"));
+  if (sys.materials.has_bonds()) info.bonds = install_sample_bonds(cfg, sys);
   {  // Floaters: particles held by fewer than 3 (2D: 2) bonds (PFC counts contacts; we report them).
     std::vector<int> degree(P.size(), 0);
     for (std::size_t b = 0; b < sys.bonds.i.size(); ++b) {

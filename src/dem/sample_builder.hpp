@@ -46,6 +46,10 @@ inline constexpr std::size_t kMaxRegions = 10000;
 // packing: groups and pair tables, laws, radii and sizes, porosity, regions (STL files read),
 // the voxel stack (read) and the default group. The `validate` of the DEM drivers.
 void validate_dem_sample(const Config& cfg);
+// Installs the bonds of sample.bond_gap on the built sample, after refusing a gap above its largest
+// particle radius (a bond is a cement bridge between neighbours; 1e300 m bonded every pair: memory
+// grew past 6 GB for a 3D block). Returns the bond count.
+std::size_t install_sample_bonds(const Config& cfg, DemSystem& sys);
 
 // Label of the grey-value window named "pore": particles whose centre lies in such a voxel are removed.
 inline constexpr int kPoreLabel = -1;
