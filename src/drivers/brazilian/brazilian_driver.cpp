@@ -29,7 +29,7 @@ void declare(ParamTable& t) {
   dem::declare_sample_params(t);
   t.real("brazilian.platen_velocity", 0.05, "m/s", "speed of each platen towards the sample (along y)").positive();
   t.real("brazilian.platen_friction", 0.1, "-", "friction between platens and particles").non_negative();
-  t.real("brazilian.stop_fraction", 0.6, "-", "stop when the load has fallen below this fraction of its peak").open_range(0, 1);
+  t.real("brazilian.stop_fraction", 0.6, "-", "stop when the load has fallen below this fraction of its quasi-static peak (the largest among rows with an unbalanced-force ratio below 0.1)").open_range(0, 1);
   t.real("brazilian.max_strain", 0.03, "-", "stop at this diametral strain (platen approach / diameter) in any case")
       .positive();
   t.real("brazilian.centre_gauge_radius", 0.25, "-",

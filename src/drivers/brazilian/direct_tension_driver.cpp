@@ -35,7 +35,7 @@ void declare(ParamTable& t) {
   t.real("direct_tension.grip_thickness", 2.0, "-",
          "particles whose centre lies within this many sample.radius_max of an end are glued to that end's grip")
       .positive();
-  t.real("direct_tension.stop_fraction", 0.5, "-", "stop when the load has fallen below this fraction of its peak")
+  t.real("direct_tension.stop_fraction", 0.5, "-", "stop when the load has fallen below this fraction of its quasi-static peak (the largest among rows with an unbalanced-force ratio below 0.1)")
       .open_range(0, 1);
   t.real("direct_tension.max_strain", 0.01, "-", "stop at this axial strain (extension / free length) in any case")
       .positive();

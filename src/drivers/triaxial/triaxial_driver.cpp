@@ -55,7 +55,7 @@ void declare(ParamTable& t) {
       .open_range(0, 1);
   t.real("triaxial.measurement_sphere_radius", 0.6, "-", "radius of the three measurement spheres on the axis, as a fraction of the sample radius")
       .open_range(0, 1);
-  t.real("triaxial.stop_fraction", 0.6, "-", "stop when the differential stress has fallen below this fraction of its peak").open_range(0, 1);
+  t.real("triaxial.stop_fraction", 0.6, "-", "stop when the differential stress has fallen below this fraction of its quasi-static peak (the largest among rows with an unbalanced-force ratio below 0.1)").open_range(0, 1);
   t.real("triaxial.max_strain", 0.06, "-", "stop at this axial strain (deviatoric stage) in any case").positive();
   t.integer("triaxial.series_interval", 100, "steps", "steps between rows of series.csv").positive();
   t.real("triaxial.vtk_strain_interval", 2e-3, "-", "axial strain between VTK snapshots").positive();

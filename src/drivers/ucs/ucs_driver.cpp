@@ -28,7 +28,7 @@ void declare_ucs_params(ParamTable& t) {
   dem::declare_sample_params(t);
   t.real("ucs.platen_velocity", 0.05, "m/s", "speed of each platen towards the sample").positive();
   t.real("ucs.platen_friction", 0.1, "-", "friction between platens and particles (seed 000: 0.1)").non_negative();
-  t.real("ucs.stop_fraction", 0.6, "-", "stop when the axial stress has fallen below this fraction of its peak").open_range(0, 1);
+  t.real("ucs.stop_fraction", 0.6, "-", "stop when the axial stress has fallen below this fraction of its quasi-static peak (the largest among rows with an unbalanced-force ratio below 0.1)").open_range(0, 1);
   t.real("ucs.max_strain", 0.05, "-", "stop at this axial strain in any case").positive();
   t.integer("ucs.series_interval", 100, "steps", "steps between rows of series.csv").positive();
   t.real("ucs.vtk_strain_interval", 1e-3, "-", "axial strain between VTK snapshots").positive();
