@@ -74,6 +74,24 @@ TEST(PorenetForces, GradientAndShear) {
   EXPECT_GT(total, 0);
 }
 
+// d(void of pore i per unit depth)/d(x_j, y_j) of the network's own pore_void, by central differences.
+template <class Packing>
+void void_central_difference(Network2D& net, Packing& s, Index j, Index i, Real fd[2]) {
+  for (int axis = 0; axis < 2; ++axis) {
+    auto& c = axis == 0 ? s.x : s.y;
+    const Real h = 1e-9, c0 = c[j];
+    c[j] = c0 + h;
+    update_network_2d(net, s.view(), {});
+    const Real vp = net.pore_void[i];
+    c[j] = c0 - h;
+    update_network_2d(net, s.view(), {});
+    const Real vm = net.pore_void[i];
+    c[j] = c0;
+    fd[axis] = (vp - vm) / (2 * h) / net.params.thickness;
+  }
+  update_network_2d(net, s.view(), {});
+}
+
 // The void-gradient force (coupling::PressureForce::VoidGradient) is P 2 r_j dV/dx_j: checked against
 // central differences of the network's own void (pore_geometry, floors off), relative 1e-6.
 TEST(PorenetForces, VoidGradientIsTheDerivativeOfTheNetworksVoid) {
@@ -90,19 +108,7 @@ TEST(PorenetForces, VoidGradientIsTheDerivativeOfTheNetworksVoid) {
       Real gx, gy;
       void_gradient_2d(net, s.view(), j, e, gx, gy);
       Real fd[2];
-      for (int axis = 0; axis < 2; ++axis) {
-        auto& c = axis == 0 ? s.x : s.y;
-        const Real h = 1e-9, c0 = c[j];
-        c[j] = c0 + h;
-        update_network_2d(net, s.view(), {});
-        const Real vp = net.pore_void[i];
-        c[j] = c0 - h;
-        update_network_2d(net, s.view(), {});
-        const Real vm = net.pore_void[i];
-        c[j] = c0;
-        fd[axis] = (vp - vm) / (2 * h) / prm.thickness;
-      }
-      update_network_2d(net, s.view(), {});
+      void_central_difference(net, s, j, i, fd);
       worst = std::max(worst, std::hypot(gx - fd[0], gy - fd[1]));
       scale = std::max(scale, std::hypot(fd[0], fd[1]));
     }
@@ -164,19 +170,7 @@ TEST(PorenetForces, VoidGradientFollowsTheVoidFloors) {
       Real gx, gy;
       void_gradient_2d(net, s.view(), j, e, gx, gy);
       Real fd[2];
-      for (int axis = 0; axis < 2; ++axis) {
-        auto& c = axis == 0 ? s.x : s.y;
-        const Real h = 1e-9, c0 = c[j];
-        c[j] = c0 + h;
-        update_network_2d(net, s.view(), {});
-        const Real vp = net.pore_void[i];
-        c[j] = c0 - h;
-        update_network_2d(net, s.view(), {});
-        const Real vm = net.pore_void[i];
-        c[j] = c0;
-        fd[axis] = (vp - vm) / (2 * h) / prm.thickness;
-      }
-      update_network_2d(net, s.view(), {});
+      void_central_difference(net, s, j, i, fd);
       (ratio > 1 ? free : floored) += 1;
       worst = std::max(worst, std::hypot(gx - fd[0], gy - fd[1]));
       scale = std::max(scale, std::hypot(fd[0], fd[1]));
