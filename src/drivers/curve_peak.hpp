@@ -4,8 +4,6 @@
 // not a strength, and that does not repeat from run to run (docs/saturated.md, "Peak stress").
 #pragma once
 #include <cstddef>
-#include <filesystem>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <span>
 #include <string_view>
@@ -33,12 +31,11 @@ struct QuasiStaticPeak {
   std::size_t row = 0;
   double stress = 0, strain = 0;
 };
-inline std::optional<QuasiStaticPeak> quasi_static_peak(const CsvTable& t, std::string_view stress_column,
-                                                         std::string_view strain_column = "axial_strain") {
+inline std::optional<QuasiStaticPeak> quasi_static_peak(const CsvTable& t, std::string_view stress_column) {
   const auto& s = t.column(stress_column);
   const auto k = quasi_static_peak(s, t.column("unbalanced_force_ratio"), kQuasiStaticUnbalance);
   if (!k) return std::nullopt;
-  return QuasiStaticPeak{*k, s[*k], t.column(strain_column)[*k]};
+  return QuasiStaticPeak{*k, s[*k], t.column("axial_strain")[*k]};
 }
 
 // The stop rule's peak of a loading curve, row by row: the largest stress among the rows that count
@@ -60,17 +57,5 @@ struct StopPeak {
     return stress > 0 && row >= min_row && e > strain && s < fraction * stress;
   }
 };
-
-// summary.json's peak.quasi_static of a loading driver, read back from its series.csv at the end
-// (nothing in the checkpoint): {stress_Pa, <strain column>, unbalanced_force_ratio_below}, or null
-// without such a row (the drivers also give null where the curve did not peak).
-inline nlohmann::json quasi_static_peak_json(const std::filesystem::path& series_csv, std::string_view stress_column,
-                                             std::string_view strain_column = "axial_strain") {
-  const auto q = quasi_static_peak(read_csv(series_csv), stress_column, strain_column);
-  if (!q) return nullptr;
-  return {{"stress_Pa", q->stress},
-          {std::string(strain_column), q->strain},
-          {"unbalanced_force_ratio_below", kQuasiStaticUnbalance}};
-}
 
 }  // namespace ff::drivers

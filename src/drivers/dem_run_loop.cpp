@@ -73,6 +73,13 @@ void DemRun::find_quasi_static_column() {
   ubf_column_ = it == columns.end() ? -1 : static_cast<long>(it - columns.begin());
 }
 
+nlohmann::json DemRun::quasi_static_peak_json(const std::string& strain_key) const {
+  if (ubf_column_ < 0 || stop_peak_.row < 0) return nullptr;
+  return {{"stress_Pa", stop_peak_.stress},
+          {strain_key, stop_peak_.strain},
+          {"unbalanced_force_ratio_below", kQuasiStaticUnbalance}};
+}
+
 void DemRun::begin_curve() {
   *c_.next_vtk_strain = vtk_every_;
   start_energy();
@@ -115,11 +122,10 @@ void DemRun::open_outputs() {
     e_hist_ = t.column(spec.strain_column);
     s_hist_ = t.column(spec.stress_column);
     l_hist_ = spec.lateral_column.empty() ? std::vector<Real>(e_hist_.size(), 0.0) : t.column(spec.lateral_column);
-    if (ubf_column_ >= 0) {  // the stop rule's peak, as the rows gave it
-      const auto& u = t.column("unbalanced_force_ratio");
-      for (std::size_t k = 0; k < u.size(); ++k)
-        stop_peak_.add(static_cast<long>(k), s_hist_[k], e_hist_[k], u[k] < kQuasiStaticUnbalance);
-    }
+    // The stop rule's peak, as the rows gave it.
+    const std::vector<Real>* u = ubf_column_ >= 0 ? &t.column("unbalanced_force_ratio") : nullptr;
+    for (std::size_t k = 0; k < s_hist_.size(); ++k)
+      stop_peak_.add(static_cast<long>(k), s_hist_[k], e_hist_[k], !u || (*u)[k] < kQuasiStaticUnbalance);
   }
 }
 
@@ -159,14 +165,9 @@ std::string DemRun::curve_row(const DemRowReport& r, double& fraction) {
   // quasi-static curve at 637 Pa and rising). And it must lie 10 rows into the loading: a slow
   // platen's first rows are start-up noise (a saturated specimen's first row at 2 mm/s held 3.7 Pa,
   // its tenth 2 Pa, and the run stopped there).
-  const bool qs = ubf_column_ >= 0;
-  if (qs) {
-    stop_peak_.add(*c_.rows - 1, r.stress, r.strain, row[static_cast<std::size_t>(ubf_column_)] < kQuasiStaticUnbalance);
-  } else {  // every row counts: the curve's own peak
-    stop_peak_.stress = peak;
-    stop_peak_.strain = *c_.strain_at_peak;
-    stop_peak_.row = *c_.peak_row;
-  }
+  const bool qs = ubf_column_ >= 0;  // without the column every row counts: the curve's own peak
+  stop_peak_.add(*c_.rows - 1, r.stress, r.strain,
+                 !qs || row[static_cast<std::size_t>(ubf_column_)] < kQuasiStaticUnbalance);
   if (stop_peak_.fallen(r.stress, r.strain, stop_fraction_))
     stop = fmt::format("{} fell below {} of the {}peak", spec.stress_name, stop_fraction_, qs ? "quasi-static " : "");
   stopped_at_strain_cap_ = r.strain >= max_strain_;

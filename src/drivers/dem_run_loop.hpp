@@ -113,6 +113,10 @@ class DemRun {
   // of a stage).
   void begin_curve();
   void checkpoint();
+  // summary.json's peak.quasi_static: the stop rule's peak (the largest stress among rows with an
+  // unbalanced-force ratio below kQuasiStaticUnbalance, as series.csv holds them) with its strain
+  // under `strain_key`; null without that column or such a row.
+  nlohmann::json quasi_static_peak_json(const std::string& strain_key) const;
 
   const Config& cfg;
   const RunOptions& opt;
@@ -142,8 +146,9 @@ class DemRun {
   bool vtk_ = false;
   Real extent_ = 0, vtk_every_ = 0, stop_fraction_ = 0, max_strain_ = 0;
   std::vector<Real> e_hist_, s_hist_, l_hist_;  // the curve, for the elastic fit
-  // The stop rule's peak: the largest stress among rows near equilibrium (drivers/curve_peak.hpp),
-  // derived from series.csv (recomputed on resume: nothing in the checkpoint). -1: no such column.
+  // The stop rule's peak: the largest stress among rows near equilibrium (drivers/curve_peak.hpp;
+  // every row without that column), derived from series.csv (recomputed on resume: nothing in the
+  // checkpoint). ubf_column_ -1: no unbalanced-force ratio column.
   long ubf_column_ = -1;
   StopPeak stop_peak_;
   void find_quasi_static_column();

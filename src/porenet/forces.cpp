@@ -76,12 +76,12 @@ void void_gradient_2d(const Network2D& net, const Particles2D& p, Index j, Index
   // inflow, did work it never stored (seed 004's study, S 0.5, packing 10: kinetic energy and the
   // largest pore pressure grew e-fold every ~8 us, whatever the time step, to 11 MPa at a platen
   // stress of 80 Pa). At the fraction floor (overlapping discs) V = phi x the triangle.
-  if (with_floors && !(net.pore_void[k] > net.void_floor)) {
+  const VoidFloor floor = with_floors ? void_floor_of(net, k) : VoidFloor::None;
+  if (floor == VoidFloor::Relative) {
     gx = gy = 0;
     return;
   }
-  // (1 + 1e-12): the floor's product rounds differently from phi x the cell.
-  if (with_floors && net.pore_void[k] <= net.params.min_void_fraction * net.pore_cell[k] * (1 + 1e-12)) {
+  if (floor == VoidFloor::Fraction) {
     gx *= net.params.min_void_fraction;
     gy *= net.params.min_void_fraction;
     return;

@@ -131,6 +131,16 @@ struct Network2D {
   Index n_channels() const { return static_cast<Index>(ch_length.size()); }
 };
 
+// Which floor holds pore k's void (pore_geometry): none, the overlap floor (V = min_void_fraction x the
+// cell: overlapping grains) or the relative floor (void_floor, a constant). (1 + 1e-12): the floor's
+// product rounds differently from the fraction x the cell.
+enum class VoidFloor : std::uint8_t { None, Fraction, Relative };
+inline VoidFloor void_floor_of(const Network2D& net, Index k) {
+  if (!(net.pore_void[k] > net.void_floor)) return VoidFloor::Relative;
+  if (net.pore_void[k] <= net.params.min_void_fraction * net.pore_cell[k] * (1 + 1e-12)) return VoidFloor::Fraction;
+  return VoidFloor::None;
+}
+
 // Triangulates and builds pores, channels and apertures. Throws InputError for mismatched
 // spans, non-positive radii, coincident centres, repeated pairs or fewer than 3 non-collinear points.
 Network2D build_network_2d(const Particles2D& particles, const PairList& pairs,

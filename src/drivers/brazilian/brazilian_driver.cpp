@@ -16,7 +16,6 @@
 #include "dem/diagnostics.hpp"
 #include "dem/sample_builder.hpp"
 #include "drivers/brazilian/tensile_plots.hpp"
-#include "drivers/curve_peak.hpp"
 #include "drivers/dem_results.hpp"
 #include "drivers/dem_run_loop.hpp"
 
@@ -198,7 +197,7 @@ class BrazilianRun final : public DemRun {
     }
     // The peak among rows near equilibrium (a crack burst's one-row spike is not a strength).
     j["peak"]["quasi_static"] =
-        peak ? quasi_static_peak_json(opt.out_dir / "series.csv", "tensile_stress_Pa", "diametral_strain") : nullptr;
+        peak ? quasi_static_peak_json("diametral_strain") : nullptr;
   }
   void plots() override {
     tensile_plots(opt.out_dir, cfg, "Brazilian test", "platen_displacement_m", "diametral_strain", "diametral strain",

@@ -18,7 +18,6 @@
 #include "dem/sample_builder.hpp"
 #include "drivers/brazilian/brazilian_driver.hpp"
 #include "drivers/brazilian/tensile_plots.hpp"
-#include "drivers/curve_peak.hpp"
 #include "drivers/dem_results.hpp"
 #include "drivers/dem_run_loop.hpp"
 #include "drivers/ucs/ucs_measure.hpp"
@@ -243,7 +242,7 @@ class DirectTensionRun final : public DemRun {
       log::warn("no tensile strength (null in summary.json): {}", out.no_peak);
     }
     // The peak among rows near equilibrium (a crack burst's one-row spike is not a strength).
-    j["peak"]["quasi_static"] = peak ? quasi_static_peak_json(opt.out_dir / "series.csv", "tensile_stress_Pa") : nullptr;
+    j["peak"]["quasi_static"] = peak ? quasi_static_peak_json("axial_strain") : nullptr;
     put_elastic_fit(j, out.fit,
                     "least squares on the pre-peak tension curve between 20% and 50% of the peak stress (tension "
                     "positive: Young's modulus in tension; Poisson's ratio from the mid-length lateral gauge)");

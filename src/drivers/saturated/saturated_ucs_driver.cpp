@@ -332,8 +332,9 @@ class SaturatedUcsRun final : public UcsRun {
       // Pores whose void is a floor push no grain (porenet/forces.cpp): say how many there are.
       Index at_relative = 0, at_fraction = 0;
       for (Index k = 0; k < net.n_pores(); ++k) {
-        if (!(net.pore_void[k] > net.void_floor)) ++at_relative;
-        else if (net.pore_void[k] <= net.params.min_void_fraction * net.pore_cell[k] * (1 + 1e-12)) ++at_fraction;
+        const porenet::VoidFloor f = porenet::void_floor_of(net, k);
+        at_relative += f == porenet::VoidFloor::Relative;
+        at_fraction += f == porenet::VoidFloor::Fraction;
       }
       log::info("pore network: {} pores, {} channels ({} pairs); DEM step {:.3g} s, flow stable step {:.3g} s; {} pores "
                 "at the void floor (fluid.min_void_relative x the mean cell), {} at {} of their triangle (overlapping "

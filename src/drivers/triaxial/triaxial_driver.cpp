@@ -12,7 +12,6 @@
 #include "core/log.hpp"
 #include "dem/dem_params.hpp"
 #include "dem/sample_builder.hpp"
-#include "drivers/curve_peak.hpp"
 #include "drivers/dem_results.hpp"
 #include "drivers/dem_run_loop.hpp"
 #include "drivers/triaxial/triaxial_boundary.hpp"
@@ -422,7 +421,7 @@ void TriaxialRun::summarize(nlohmann::json& j, const DemOutcome& out) {
   }
   // The peak among rows near equilibrium (a crack burst's one-row spike is not a strength).
   j["peak"]["quasi_static"] =
-      out.no_peak.empty() ? quasi_static_peak_json(opt.out_dir / "series.csv", "differential_stress_Pa") : nullptr;
+      out.no_peak.empty() ? quasi_static_peak_json("axial_strain") : nullptr;
   put_elastic_fit(j, out.fit, "least squares on the pre-peak differential stress between 20% and 50% of its peak");
   nlohmann::json spheres = nlohmann::json::array();
   for (int s = 0; s < 3; ++s)

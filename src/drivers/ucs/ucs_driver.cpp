@@ -9,7 +9,6 @@
 #include "core/log.hpp"
 #include "dem/dem_params.hpp"
 #include "dem/sample_builder.hpp"
-#include "drivers/curve_peak.hpp"
 #include "drivers/dem_results.hpp"
 #include "drivers/dem_run_loop.hpp"
 #include "drivers/ucs/ucs_measure.hpp"
@@ -133,7 +132,7 @@ void UcsRun::summarize(nlohmann::json& j, const DemOutcome& out) {
   // The peak among rows near equilibrium: a crack burst's one-row spike (grains thrown onto a
   // platen) is not a strength; in saturated specimens it reached 2.7 x this (drivers/curve_peak.hpp).
   j["peak"]["quasi_static"] =
-      out.no_peak.empty() ? quasi_static_peak_json(opt.out_dir / "series.csv", "axial_stress_Pa") : nullptr;
+      out.no_peak.empty() ? quasi_static_peak_json("axial_strain") : nullptr;
   put_elastic_fit(j, out.fit, "least squares on the pre-peak curve between 20% and 50% of the peak stress");
   extra_summary(j, out);
 }
