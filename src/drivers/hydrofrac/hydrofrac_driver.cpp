@@ -431,11 +431,11 @@ void HydrofracRun::begin_injection() {
   int nf = 0;
   for (const auto& c : insitu_)
     if (c.far) far_xx += c.xx, far_yy += c.yy, ++nf;
-  log::info("hydrofrac: in-situ stage {} after {} steps: walls {:.3f} / {:.3f}{} MPa (targets {:.3f} / {:.3f}{}), interior "
+  log::info("hydrofrac: in-situ stage {} after {} steps: walls {:.4g} / {:.4g}{} MPa (targets {:.4g} / {:.4g}{}), interior "
             "circles {:.3f} / {:.3f} MPa; hole: {} wall particles, effective radius {:.4g} m",
             st_.equilibrium ? "in equilibrium" : "NOT in equilibrium", st_.insitu_steps, 1e-6 * ws.x(), 1e-6 * ws.y(),
-            sys.settings.dim == 3 ? fmt::format(" / {:.3f}", 1e-6 * ws.z()) : std::string(), 1e-6 * targets_.x(),
-            1e-6 * targets_.y(), sys.settings.dim == 3 ? fmt::format(" / {:.3f}", 1e-6 * targets_.z()) : std::string(),
+            sys.settings.dim == 3 ? fmt::format(" / {:.4g}", 1e-6 * ws.z()) : std::string(), 1e-6 * targets_.x(),
+            1e-6 * targets_.y(), sys.settings.dim == 3 ? fmt::format(" / {:.4g}", 1e-6 * targets_.z()) : std::string(),
             1e-6 * far_xx / nf, 1e-6 * far_yy / nf, fluid_->wall_particles().size(), st_.effective_radius);
   vtk();
   checkpoint();
