@@ -20,6 +20,7 @@
 #include "io/plot.hpp"
 #include "lbm/analysis.hpp"
 #include "lbm/image_mask.hpp"
+#include "lbm/lattice_budget.hpp"
 
 namespace fs = std::filesystem;
 
@@ -152,9 +153,13 @@ class CylinderCase : public FlowCase {
     units_ = u;
     const double dx = u.dx();
     DomainSpec d;
-    d.nx = int(std::lround(len_ / dx));
-    d.ny = int(std::lround(H_ / dx));
-    d.nz = duct() ? std::max(1, int(std::lround(W_ / dx))) : 0;
+    const char* hint = "lower lbm.resolution or the channel's size";
+    d.nx = lbm::lattice_side(len_ / dx, "channel.length", hint);
+    d.ny = lbm::lattice_side(H_ / dx, "channel.height", hint);
+    d.nz = duct() ? lbm::lattice_side(std::max(1.0, W_ / dx), "channel.depth", hint) : 0;
+    // Before the masks below (a byte per cell): the least any lattice of this size needs (D2Q9 in
+    // single precision); the runner checks the lattice actually chosen.
+    lbm::check_lattice_memory(d.nx, d.ny, std::max(1, d.nz), 9, 4, hint);
     d.periodic = {false, periodic_, false};
     d.faces[0].kind = inlet_bb_ ? lbm::FaceCondition::Kind::Wall : lbm::FaceCondition::Kind::Velocity;
     // A plug profile is singular where it meets the no-slip walls: the Zou-He inflow nodes next

@@ -21,6 +21,7 @@
 #include "io/plot.hpp"
 #include "io/pvd.hpp"
 #include "io/vtk.hpp"
+#include "lbm/lattice_budget.hpp"
 
 namespace fs = std::filesystem;
 
@@ -30,7 +31,7 @@ void declare_lbm_params(ParamTable& t, const LbmDefaults& d) {
   t.string("lbm.lattice", "D2Q9", "velocity set; D3Q19 extrudes the 2D case along a periodic z axis").one_of({"D2Q9", "D3Q19"});
   // A fallback: flow/cylinder's duct takes its depth from channel.depth and refuses this key when
   // set, so the saved scenario of a duct run must not set it (resume reads that file).
-  t.integer("lbm.depth_cells", 1, "cells", "D3Q19 only: cells along the periodic z axis").at_least(1).fallback();
+  t.integer("lbm.depth_cells", 1, "cells", "D3Q19 only: cells along the periodic z axis").range(1, 1 << 20).fallback();
   t.string("lbm.precision", "double", "storage and arithmetic precision of the populations").one_of({"double", "float"});
   t.string("lbm.collision", "trt", "collision: two-relaxation-time (Ginzburg et al. 2008) or BGK").one_of({"trt", "bgk"});
   t.string("lbm.equilibrium", "incompressible",
@@ -56,7 +57,7 @@ void declare_lbm_params(ParamTable& t, const LbmDefaults& d) {
          fmt::format("expected relative compressibility error C Ma^2 (C as for lbm.mach) the run may make: the "
                      "driver picks Ma = sqrt(target / C), then dt and tau as for lbm.mach (0: not set)"))
       .range(0, 1);
-  t.integer("lbm.resolution", d.resolution, "cells", "cells across the characteristic length of the case").at_least(2);
+  t.integer("lbm.resolution", d.resolution, "cells", "cells across the characteristic length of the case").range(2, 1 << 20);
   t.real("fluid.density", d.density, "kg/m^3", "fluid density").positive();
   t.real("fluid.viscosity", d.viscosity, "m^2/s", "kinematic viscosity").positive();
   t.real("run.end_time", d.end_time, "s", "simulated time at which the run stops").positive();
@@ -215,6 +216,9 @@ void Runner<L, T>::build() {
                                  driver_, dom_.nx, dom_.ny, dom_.nz));
   nz_ = L::D == 3 ? (box ? dom_.nz : int(cfg_.integer("lbm.depth_cells"))) : 1;
   const bool pz = !box || dom_.periodic[2];
+  lbm::check_lattice_memory(dom_.nx, dom_.ny, nz_, L::Q, sizeof(T),
+                            L::D == 3 && !box ? "lower lbm.resolution, lbm.depth_cells or the domain's size"
+                                              : "lower lbm.resolution or the domain's size");
   lbm::Grid g(L::D, dom_.nx, dom_.ny, nz_, {dom_.periodic[0], dom_.periodic[1], pz});
   lbm::SolverSettings s;
   s.collision = cfg_.string("lbm.collision") == "bgk" ? lbm::CollisionModel::Bgk : lbm::CollisionModel::Trt;

@@ -9,6 +9,7 @@
 #include "drivers/flow/flow_runner.hpp"
 #include "io/csv.hpp"
 #include "io/plot.hpp"
+#include "lbm/lattice_budget.hpp"
 
 namespace fs = std::filesystem;
 
@@ -50,7 +51,7 @@ class PoiseuilleCase : public FlowCase {
   DomainSpec domain(const lbm::Units& u) override {
     units_ = u;
     DomainSpec d;
-    d.nx = std::max(1, int(std::lround(len_ / u.dx())));
+    d.nx = lbm::lattice_side(std::max(1.0, len_ / u.dx()), "channel.length", "lower lbm.resolution or channel.length");
     d.ny = n_;
     d.periodic = {drive_ == "body_force", false};
     const double dx = u.dx();

@@ -11,6 +11,7 @@
 #include "coupling/particle_set.hpp"
 #include "drivers/hydrofrac/borehole.hpp"
 #include "io/vtk.hpp"
+#include "lbm/lattice_budget.hpp"
 #include "lbm/solver.hpp"
 
 namespace ff::drivers::hydrofrac {
@@ -50,10 +51,12 @@ void size_lattice(const dem::ParticleStore& P, Real dx, int dim, LbmInfo& info) 
       hi[a] = std::max(hi[a], P.pos[i][a] + P.radius[i]);
     }
   info.n[0] = info.n[1] = info.n[2] = 1;
+  const char* hint = "a coarser fluid.dx or a smaller block (sample.width, sample.height, sample.depth)";
   for (int a = 0; a < dim; ++a) {
     lo[a] -= dx;
-    info.n[a] = int(std::ceil((hi[a] + dx - lo[a]) / dx));
+    info.n[a] = lbm::lattice_side(std::ceil((hi[a] + dx - lo[a]) / dx), "fluid.dx", hint);
   }
+  lbm::check_lattice_memory(info.n[0], info.n[1], info.n[2], dim == 3 ? 19 : 9, sizeof(double), hint);
   if (dim == 2) lo.z() = -0.5 * dx;
   info.origin = lo + Vec3::Constant(0.5 * dx);
 }

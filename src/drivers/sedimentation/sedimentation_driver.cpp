@@ -23,6 +23,7 @@
 #include "io/plot.hpp"
 #include "io/pvd.hpp"
 #include "io/vtk.hpp"
+#include "lbm/lattice_budget.hpp"
 
 namespace fs = std::filesystem;
 
@@ -127,12 +128,18 @@ Geometry validate_geometry(const Config& cfg) {
   const double dx = cfg.real("lbm.dx");
   for (int a = 0; a < g.dim; ++a) {
     const double c = L[std::size_t(a)] / dx;
+    if (!(c < 1073741824.0))
+      cfg.fail("box.size", fmt::format("box.size[{}] = {} m is {:.4g} cells of lbm.dx = {} m; a side needs fewer than 2^30 "
+                                       "cells: a smaller box or a coarser lbm.dx",
+                                       a, L[std::size_t(a)], c, dx));
     g.n[a] = int(std::lround(c));
     if (std::abs(c - g.n[a]) > 1e-6 * c || g.n[a] < 8)
       cfg.fail("lbm.dx", fmt::format("{} m does not divide box.size[{}] = {} m into a whole number (>= 8) of cells "
                                      "({:.6g})",
                                      dx, a, L[std::size_t(a)], c));
   }
+  lbm::check_lattice_memory(g.n[0], g.n[1], g.dim == 3 ? g.n[2] : 1, g.dim == 3 ? 19 : 9,
+                            cfg.string("lbm.precision") == "double" ? 8 : 4, "a smaller box.size or a coarser lbm.dx");
   const auto &x = cfg.real_list("particles.x"), &y = cfg.real_list("particles.y"), &z = cfg.real_list("particles.z");
   const auto& r = cfg.real_list("particles.radius");
   const std::size_t np = x.size();

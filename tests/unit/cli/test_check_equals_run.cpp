@@ -151,6 +151,10 @@ std::vector<Bad> bad_scenarios() {
       // 1e300 s overflowed the ramp's step count into a negative sample index: a segmentation fault
       {"inflow_ramp_outlasting_the_run", kCylinder + "run.inflow_ramp_time = 1e300\n",
        {"run.inflow_ramp_time", "does not end before run.end_time"}},
+      // a side past an int wrapped into a negative size: "cannot create std::vector larger than max_size()"
+      {"lattice_side_past_an_int", kCylinder + "channel.height = 1e9\n", {"channel.height", "2^30 cells"}},
+      // a lattice past the machine's memory: std::bad_alloc, or gigabytes of masks first
+      {"lattice_beyond_memory", "driver = \"flow/cavity\"\n" + kOutput + "lbm.resolution = 100000\n", {"lbm.resolution", "GiB"}},
   };
 }
 
