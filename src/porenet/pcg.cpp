@@ -219,8 +219,8 @@ int PressureSystem::solve(std::span<const Real> b, std::span<Real> x, Preconditi
 #pragma omp parallel for schedule(static) if (n_ > kDicBlock)
     for (Index i = 0; i < n_; ++i) d_[i] = z_[i] + beta * d_[i];
   }
-  throw NumericalError(fmt::format("porenet: conjugate gradients did not converge in {} iterations{}; raise "
-                                   "cg_max_iterations or use the LDLT solver", max_it,
+  throw NumericalError(fmt::format("porenet: conjugate gradients did not converge in {} iterations{} (the pressure "
+                                   "system is too ill-conditioned for the iterative solver)", max_it,
                                    state && state_unmet() ? " (a pore's pressure mismatch above its bound)" : ""));
 }
 

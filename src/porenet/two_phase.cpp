@@ -387,8 +387,9 @@ void TwoPhaseFlow::update_pore_states(Real dt, const char* scheme, bool net_outf
       rp_[i] = prm_.gas.density_near(p > 0 ? p : 1.0, false, rp_[i]);
   }
   if (bad >= 0)
-    throw NumericalError(fmt::format("porenet: pore {} phase masses ({}, {}) kg after an {} step of {} s; reduce dt "
-                                     "below stable_dt()", bad, mq_[bad], mp_[bad], scheme, dt));
+    throw NumericalError(fmt::format("porenet: pore {} phase masses ({}, {}) kg after an {} step of {} s (a step "
+                                     "above the flow's stable step, or non-finite conductances)", bad, mq_[bad], mp_[bad],
+                                     scheme, dt));
   for (Index i = 0; i < np_; ++i)
     if (bc_[i] == PoreBc::Flux) injected_ += dt * bc_value_[i];
 }

@@ -217,7 +217,12 @@ void DemPorenetCoupling::step(dem::DemSystem& sys) {
   long nsub = 0;
   Real left = dt, h = dt;
   while (left > 0) {
-    const long need = limit < left ? static_cast<long>(std::ceil(left / limit)) : 1;
+    // A zero or NaN stable step (infinite or NaN conductances) would make the sub-step count
+    // undefined (a negative step was taken before this guard).
+    if (!(limit > 0))
+      throw NumericalError(fmt::format("coupling.porenet: the flow's stable step is {} s (a channel's conductance is "
+                                       "infinite or not a number)", limit));
+    const long need = limit < left ? static_cast<long>(std::min(std::ceil(left / limit), 1e18)) : 1;
     if (prm_.implicit_above > 0 && need > prm_.implicit_above) {
       flow_->step_implicit(left);
       cavitate();

@@ -258,6 +258,18 @@ void NetworkLoad::advance(const dem::DemSystem& sys) {
 // One flow step over the last N DEM steps: the network to the current positions (new cracks'
 // openings, pore volumes), the hole's condition at t, backward Euler, the forces for the next N.
 void NetworkLoad::flow_step(const dem::DemSystem& sys) {
+  try {
+    network_flow_step(sys);
+  } catch (const NumericalError& e) {  // the pore network's own words name no keys: add them
+    throw NumericalError(fmt::format(
+        "{}. The network fluid's inputs to check: network.aperture_h0, network.aperture_hinf, network.throat_factor "
+        "and network.max_conductance_ratio (the channels' conductance), injection.fluid_bulk_modulus (the liquid's "
+        "stiffness), network.pore_pressure, injection.ramp_rate / injection.rate",
+        e.what()));
+  }
+}
+
+void NetworkLoad::network_flow_step(const dem::DemSystem& sys) {
   const Real h = static_cast<Real>(st_.flow_every) * sys.settings.dt;
   now_ = st_.t_last = sys.time;
   auto t0 = std::chrono::steady_clock::now();

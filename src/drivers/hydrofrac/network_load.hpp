@@ -141,7 +141,8 @@ class NetworkLoad final : public FluidLoad {
   void find_hole_pores(const porenet::Network2D& net);
   void drain_faces(porenet::TwoPhaseFlow& f, const porenet::Network2D& net) const;
   void set_hole_bc(porenet::TwoPhaseFlow& f, const porenet::Network2D& net, Real time);
-  void flow_step(const dem::DemSystem& sys);
+  void flow_step(const dem::DemSystem& sys);          // network_flow_step with the keys in its errors
+  void network_flow_step(const dem::DemSystem& sys);
   void gather_forces();
   void measure(const dem::DemSystem& sys);
   void cavitate();

@@ -252,8 +252,16 @@ class PoreFluid {
     }
   }
   void step(dem::DemSystem& sys) {
-    if (dim3_) c3_.step(sys);
-    else c2_.step(sys);
+    try {
+      if (dim3_) c3_.step(sys);
+      else c2_.step(sys);
+    } catch (const NumericalError& e) {  // the pore network's own words name no keys: add them
+      throw NumericalError(fmt::format(
+          "{}. The pore fluid's inputs to check: fluid.aperture_h0, fluid.aperture_hinf and fluid.aperture_gamma "
+          "(the channels' conductance), fluid.liquid_bulk_modulus (the liquid's stiffness), fluid.initial_pressure, "
+          "fluid.cavitation_pressure; for a stiff liquid fluid.implicit_above (2D) and fluid.cg_tolerance",
+          e.what()));
+    }
   }
   bool dim3() const { return dim3_; }
   const porenet::Network2D& network() const { return dim3_ ? c3_.network() : c2_.network(); }
@@ -530,6 +538,12 @@ void validate(const Config& cfg) {
                                   "fluid.implicit_above of them); use auto or explicit");
   if (!dim3 && cfg.string("fluid.flow_scheme") == "explicit" && cfg.has("fluid.implicit_above"))
     cfg.fail("fluid.implicit_above", "applies with fluid.flow_scheme = auto; explicit means sub-steps only");
+  // Every pore would start cavitated and be held at that pressure (1e300 Pa: NaN grains at step 1).
+  if (!dim3 && !(cfg.real("fluid.cavitation_pressure") < cfg.real("fluid.initial_pressure")))
+    cfg.fail("fluid.cavitation_pressure",
+             fmt::format("{} Pa is not below fluid.initial_pressure = {} Pa: every pore would start cavitated (water's "
+                         "vapour pressure at 20 C is 2.34e3 Pa; 0 lets the liquid take any tension)",
+                         cfg.real("fluid.cavitation_pressure"), cfg.real("fluid.initial_pressure")));
 }
 
 RunStatus run(const Config& cfg, const RunOptions& opt) {

@@ -151,6 +151,17 @@ std::vector<Bad> bad_scenarios() {
       // 1e300 s overflowed the ramp's step count into a negative sample index: a segmentation fault
       {"inflow_ramp_outlasting_the_run", kCylinder + "run.inflow_ramp_time = 1e300\n",
        {"run.inflow_ramp_time", "does not end before run.end_time"}},
+      // every pore cavitated from the start and held there: NaN grains at the first step
+      {"cavitation_above_the_initial_pressure",
+       "driver = \"saturated_ucs\"\n" + kOutput + "dem.dim = 2\n" + kRock +
+           "sample.shape = \"box\"\nsample.width = 6e-3\nsample.height = 12e-3\nsample.porosity = 0.25\n"
+           "fluid.cavitation_pressure = 1e300\n",
+       {"fluid.cavitation_pressure", "not below fluid.initial_pressure"}},
+      {"vapour_above_the_pore_pressure",
+       "driver = \"hydrofrac\"\n" + kOutput + "dem.dim = 2\n" + kRock +
+           "sample.shape = \"box\"\nsample.width = 6e-3\nsample.height = 6e-3\nsample.porosity = 0.25\n"
+           "injection.fluid = \"network\"\nnetwork.vapour_pressure = 1e6\n",
+       {"network.vapour_pressure", "not below network.pore_pressure"}},
       // a side past an int wrapped into a negative size: "cannot create std::vector larger than max_size()"
       {"lattice_side_past_an_int", kCylinder + "channel.height = 1e9\n", {"channel.height", "2^30 cells"}},
       // a lattice past the machine's memory: std::bad_alloc, or gigabytes of masks first
