@@ -482,6 +482,16 @@ void HydrofracRun::measure_row() {
           "the hydrofrac run became unstable by step {} (t = {:.6g} s): a series.csv value is {}. The last good checkpoint "
           "stays in {}/checkpoint. Lower dem.time_step_safety, injection.ramp_rate or injection.rate, or insitu.servo_velocity",
           sys.step_count, sys.time, v, opt.out_dir.string()));
+  // A connected crack far outside the block: a bonded pair was thrown out (an unstable coupling that
+  // has not produced NaN yet); its extent would be reported as the fracture's (seen at 1.7e21 x).
+  if (st_.stage == 1 && extent_ > 10 * face_gap())
+    throw NumericalError(fmt::format(
+        "the hydrofrac run became unstable by step {} (t = {:.6g} s): a connected crack lies {:.3g} m beyond the hole's "
+        "wall, {:.3g} times the distance to the block's faces (grains were thrown out of the block). The last good "
+        "checkpoint stays in {}/checkpoint. Lower dem.time_step_safety, injection.ramp_rate or injection.rate{}",
+        sys.step_count, sys.time, extent_, extent_ / face_gap(), opt.out_dir.string(),
+        cfg.string("injection.fluid") == "lbm" && cfg.boolean("fluid.moving_walls") ? ", or set fluid.moving_walls = false"
+                                                                                    : ""));
   series_.row(row_);
   ++st_.rows;
   status_.clear();

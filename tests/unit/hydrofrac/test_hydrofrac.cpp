@@ -242,6 +242,22 @@ TEST(Hydrofrac, ConstantRateGivesAPressurePeak) {
   EXPECT_LT(p[k], K * Q * (time[k] - t0) / v0);  // so the pressure stays below the rigid-hole value
 }
 
+// A blast (1e13 Pa reached within a few steps) throws bonded grains out of the block before any
+// value turns NaN; before the guard the run ended normally and reported the thrown pair's crack as
+// a fracture 55 times the distance to the faces (and 1.7e21 x in an unstable coupled run). Now it
+// stops as unstable (exit code 3), naming keys, with the last good checkpoint kept.
+TEST(Hydrofrac, GrainsThrownOutOfTheBlockStopTheRun) {
+  Scratch s;
+  const fs::path file = s.write("block.toml", kBlock);
+  const fs::path out = s / "blast";
+  const auto r = fracflow("run " + file.string() + " --out " + out.string() +
+                          " -q -j1 --set injection.ramp_rate=1e20 --set injection.max_pressure=1e13");
+  EXPECT_EQ(r.code, 3) << r.output;
+  EXPECT_NE(r.output.find("thrown out of the block"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("injection.ramp_rate"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(out / "checkpoint")) << r.output;
+}
+
 // Natural fractures from the generator and from a file cut bonds; a joint through the hole's
 // axis at y = centre cuts the bonds along x and the fracture follows it at sH = sh.
 TEST(Hydrofrac, NaturalFracturesCutBonds) {
