@@ -192,13 +192,13 @@ void validate_scenario(const Config& cfg) {
   dem::validate_dem_sample(cfg);
   if (cfg.string("sample.shape") != "box")
     cfg.fail("sample.shape", "the hydrofrac block is a box: shape = \"box\" (2D rectangle in x-y; 3D box with the borehole along z)");
-  // The fluid's own checks (tau, Mach, density variation; the DEM step rounds dt_lbm later).
   if (cfg.string("injection.fluid") == "network" &&
       !(cfg.real("network.vapour_pressure") < cfg.real("network.pore_pressure")))
     cfg.fail("network.vapour_pressure",
              fmt::format("{} Pa is not below network.pore_pressure = {} Pa: every pore would start cavitated (water at "
                          "20 C: 2.34e3 Pa; 0 lets the liquid take any tension)",
                          cfg.real("network.vapour_pressure"), cfg.real("network.pore_pressure")));
+  // The fluid's own checks (tau, Mach, density variation; the DEM step rounds dt_lbm later).
   if (cfg.string("injection.fluid") == "lbm") {
     (void)coupling::derive_scales(lbm_fluid_spec(cfg));
     // `fracflow check` prints the LBM and DEM steps from the set-up (HydrofracRun::run), which

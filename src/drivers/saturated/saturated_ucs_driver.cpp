@@ -257,10 +257,12 @@ class PoreFluid {
       else c2_.step(sys);
     } catch (const NumericalError& e) {  // the pore network's own words name no keys: add them
       throw NumericalError(fmt::format(
-          "{}. The pore fluid's inputs to check: fluid.aperture_h0, fluid.aperture_hinf and fluid.aperture_gamma "
-          "(the channels' conductance), fluid.liquid_bulk_modulus (the liquid's stiffness), fluid.initial_pressure, "
-          "fluid.cavitation_pressure; for a stiff liquid fluid.implicit_above (2D) and fluid.cg_tolerance",
-          e.what()));
+          "{}. The pore fluid's inputs to check: {}, fluid.liquid_bulk_modulus (the liquid's stiffness), "
+          "fluid.initial_pressure{}",
+          e.what(),
+          dim3_ ? "fluid.pfv_factor (the throats' conductance)"
+                : "fluid.aperture_h0, fluid.aperture_hinf and fluid.aperture_gamma (the channels' conductance)",
+          dim3_ ? ", fluid.cg_tolerance" : ", fluid.cavitation_pressure, fluid.implicit_above"));
     }
   }
   bool dim3() const { return dim3_; }
