@@ -11,7 +11,7 @@ namespace ff::lbm {
 
 int lattice_side(double cells, std::string_view key, std::string_view hint) {
   const double n = std::round(cells);
-  if (!(n >= 1) || !(n < 1073741824.0))
+  if (!(n >= 1) || !(n < kMaxLatticeSide))
     throw InputError(fmt::format("{}: gives {:.4g} lattice cells along one side; a side needs 1 to 2^30 cells ({})",
                                  key, cells, hint));
   return int(n);

@@ -7,6 +7,9 @@
 
 namespace ff::lbm {
 
+// The most cells along one side (2^30: an int, with room for the ghost layers and row padding).
+inline constexpr double kMaxLatticeSide = 1073741824.0;
+
 // Cells along one side for a side of `cells` (= length / dx, a real): rounded to the nearest
 // whole number; throws InputError naming `key` when that is not a positive int below 2^30.
 int lattice_side(double cells, std::string_view key, std::string_view hint);

@@ -128,7 +128,7 @@ Geometry validate_geometry(const Config& cfg) {
   const double dx = cfg.real("lbm.dx");
   for (int a = 0; a < g.dim; ++a) {
     const double c = L[std::size_t(a)] / dx;
-    if (!(c < 1073741824.0))
+    if (!(c < lbm::kMaxLatticeSide))
       cfg.fail("box.size", fmt::format("box.size[{}] = {} m is {:.4g} cells of lbm.dx = {} m; a side needs fewer than 2^30 "
                                        "cells: a smaller box or a coarser lbm.dx",
                                        a, L[std::size_t(a)], c, dx));
