@@ -70,6 +70,12 @@ void SinglePhaseFlow::load_masses(std::span<const Real> m) {
     v_[i] = void_at(i, p_[i]);
     rho_[i] = m_[i] / v_[i];
   }
+  for (Index i : bc_pressure_pores_) {  // a prescribed pressure stays prescribed (as TwoPhaseFlow::load_masses)
+    p_[i] = bc_value_[i];
+    rho_[i] = prm_.fluid.density(p_[i], true);
+    v_[i] = void_at(i, p_[i]);
+    m_[i] = rho_[i] * v_[i];
+  }
 }
 
 Real SinglePhaseFlow::void_at(Index i, Real p) const {

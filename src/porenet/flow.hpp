@@ -61,7 +61,8 @@ class SinglePhaseFlow {
   void set_bc(Index pore, PoreBc kind, Real value);
   void set_total_stress(Real sigma) { sigma_ = sigma; }
 
-  // Replaces the pore masses (after a remeshing) and recomputes pressures and densities.
+  // Replaces the pore masses (after a remeshing) and recomputes pressures and densities; pores at a
+  // prescribed pressure keep it.
   void load_masses(std::span<const Real> m);
 
   Real stable_dt() const;

@@ -129,6 +129,11 @@ void TwoPhaseFlow::load_masses(std::span<const Real> mq, std::span<const Real> m
     rq_[i] = a > 0 ? mq_[i] / (a * V) : prm_.liquid.density(p > 0 ? p : 1.0, true);
     rp_[i] = a < 1 ? mp_[i] / ((1 - a) * V) : prm_.gas.density(p > 0 ? p : 1.0, false);
   }
+  // A prescribed pressure stays prescribed: the implicit step holds such a pore at its state (it
+  // never writes p there) and the explicit rates read it, so a remapped state would stay for the run
+  // (after a retriangulation drained hull pores held the interior's pressure, pushing it into the sample).
+  for (Index i = 0; i < np_; ++i)
+    if (bc_[i] == PoreBc::Pressure) set_pore_state(i, bc_value_[i], bc_alpha_[i]);
 }
 
 Real TwoPhaseFlow::solve_shared_pressure(Real mq, Real mp, Real V, Real a0, Real& p, int* iterations) const {
@@ -226,6 +231,13 @@ void TwoPhaseFlow::channel_mobilities(Index c, Index u, Real& lq, Real& lp) cons
     lq = 12 * net_.ch_cond[c] * r.q_liquid;
     lp = 12 * net_.ch_cond[c] * r.q_gas;
   }
+}
+
+Real TwoPhaseFlow::channel_mobility(Index c) const {
+  const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
+  Real lq, lp;
+  channel_mobilities(c, p_[a] >= p_[b] ? a : b, lq, lp);
+  return lq + lp;
 }
 
 void TwoPhaseFlow::compute_rates() {

@@ -96,7 +96,8 @@ class TwoPhaseFlow {
 
   // Explicit limit: min over pores of the pressure-diffusion bound V (alpha/K_q + (1-alpha)/K_p) / sum_j lambda_ij
   // (lambda the channel's total volumetric mobility) and of the transport bound m / outflow per phase.
-  // Replaces the phase masses (after a remeshing); solves B23 for every pore.
+  // Replaces the phase masses (after a remeshing); solves B23 for every pore. Pores at a prescribed
+  // pressure keep their prescribed state (set_bc), whatever masses they were given.
   void load_masses(std::span<const Real> mq, std::span<const Real> mp);
 
   Real stable_dt();
@@ -140,6 +141,9 @@ class TwoPhaseFlow {
   // rho dp/drho of pore i's liquid-gas mixture at its state, 1/K = alpha/K_q + (1 - alpha)/K_p [Pa];
   // 0 where a present phase has a non-positive modulus (Peng-Robinson's unstable branch).
   Real mixture_bulk_modulus(Index pore) const;
+  // Total volumetric mobility lambda_q + lambda_p of channel c [m^3/(Pa s)], its upstream pore by the
+  // current pressures (as the rates take it).
+  Real channel_mobility(Index c) const;
   std::span<const Real> liquid_fraction() const { return alpha_; }
   std::span<const Real> liquid_mass() const { return mq_; }
   std::span<const Real> gas_mass() const { return mp_; }
