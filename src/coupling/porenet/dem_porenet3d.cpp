@@ -6,6 +6,8 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <string>
+#include <utility>
 
 #include "core/error.hpp"
 #include "porenet/forces.hpp"
@@ -183,32 +185,53 @@ bool DemPorenet3D::sync(const dem::DemSystem& sys) {
 void DemPorenet3D::step(dem::DemSystem& sys) {
   sys.update_neighbors();
   sys.compute_forces();
+  bool held = true;
   if (stats_.cycle_left <= 0) {  // a flow step for the next N DEM steps
     (void)sync(sys);
+    bool predict = false;
     if (prm_.flow_every > 0) {
       stats_.flow_every = prm_.flow_every;
+      predict = prm_.predict_pressures;
     } else {
       if (stats_.until_choice <= 0) {
         stats_.stiffness_every = choose_flow_every(sys);
         stats_.until_choice = prm_.choose_every;
       }
+      // Where the fluid's stiffness bounds N (liquid-full pores), the held steps predict the pressures
+      // and N may reach max_flow_every; elsewhere the forces are held as they are (soft gas pores).
+      const long cap = std::max<long>(prm_.max_flow_every, 1);
+      predict = prm_.predict_pressures && stats_.stiffness_every < cap;
+      const long bound = predict ? cap : stats_.stiffness_every;
       // The flow's own transport limit: a flow step that had to halve itself (s transport sub-steps)
-      // shrinks the next stride by s; one that did not lets it double, up to the stiffness bound.
+      // shrinks the next stride by s; one that did not lets it double, up to the bound.
       const long s = stats_.flow_steps > 0 ? std::max<long>(stats_.last_substeps, 1) : 1;
       stats_.flow_every = s > 1 ? std::max<long>(stats_.flow_every / s, 1)
-                                : std::min(stats_.stiffness_every, std::max<long>(2 * stats_.flow_every, 1));
+                                : std::min(bound, std::max<long>(2 * stats_.flow_every, 1));
       stats_.until_choice -= stats_.flow_every;
     }
     stats_.cycle_left = stats_.flow_every;
     advance_flow(static_cast<Real>(stats_.flow_every) * sys.settings.dt);
     const auto t1 = std::chrono::steady_clock::now();
     compute_fluid_forces(-std::numeric_limits<Real>::infinity());
+    if (predict && stats_.flow_every > 1) {
+      pred_dt_ = sys.settings.dt;
+      linearise_pressures();
+    } else {
+      pred_g_.clear();  // no prediction in this cycle (nor a stale size in a checkpoint)
+    }
     stats_.t_forces += seconds_since(t1);
     ++stats_.flow_steps;
+    held = false;
   }
   --stats_.cycle_left;
   sys.add_external_loads();
   add_forces(sys);
+  if (!pred_g_.empty()) ++pred_geom_age_;
+  if (held && !pred_g_.empty()) {  // at the flow step the increment is zero
+    const auto t1 = std::chrono::steady_clock::now();
+    add_predicted_forces(sys);
+    stats_.t_forces += seconds_since(t1);
+  }
   sys.integrate();
 }
 
@@ -234,6 +257,13 @@ void DemPorenet3D::save(CheckpointWriter& w) const {
   w.put("porenet3d.fx", fx_);  // the forces held until the next flow step
   w.put("porenet3d.fy", fy_);
   w.put("porenet3d.fz", fz_);
+  // The prediction of the current cycle (empty without held steps).
+  for (const auto& [tag, v] : {std::pair{"g", &pred_g_}, {"a", &pred_a_}, {"x0", &pred_x0_}, {"c", &pred_c_},
+                               {"w", &pred_w_}, {"ws", &pred_ws_}, {"q", &pred_q_}, {"b", &pred_b_}, {"dp", &pred_dp_}})
+    w.put(std::string("porenet3d.pred_") + tag, *v);
+  w.put("porenet3d.pred_dt", std::vector<Real>{pred_dt_, static_cast<Real>(pred_geom_tri_),
+                                                static_cast<Real>(pred_geom_age_)});
+  w.put("porenet3d.pred_setup_val", pred_g_.empty() ? std::vector<Real>{} : pred_setup_val_);
 }
 
 void DemPorenet3D::load(CheckpointReader& r, const dem::DemSystem& sys, const Porenet3DParams& params) {
@@ -276,6 +306,42 @@ void DemPorenet3D::load(CheckpointReader& r, const dem::DemSystem& sys, const Po
   r.get("porenet3d.fz", fz_);
   if (fx_.size() != n || fy_.size() != n || fz_.size() != n)
     throw InputError(fmt::format("checkpoint: porenet3d forces for {} spheres; the sample has {}", fx_.size(), n));
+  const auto np = static_cast<std::size_t>(net_->n_pores());
+  for (const auto& [tag, v] : {std::pair{"g", &pred_g_}, {"a", &pred_a_}, {"x0", &pred_x0_}, {"c", &pred_c_},
+                               {"w", &pred_w_}, {"ws", &pred_ws_}, {"q", &pred_q_}, {"b", &pred_b_}, {"dp", &pred_dp_}}) {
+    v->clear();  // checkpoints before 2026-11-29 have none: forces held as they are until the next flow step
+    const std::string key = std::string("porenet3d.pred_") + tag;
+    if (r.has(key)) r.get(key, *v);
+  }
+  if (!pred_g_.empty() &&
+      (pred_g_.size() != 12 * np || pred_a_.size() != 3 * static_cast<std::size_t>(net_->pp_start[net_->n_particles]) ||
+       pred_x0_.size() != 3 * n || pred_c_.size() != np || pred_ws_.size() != np || pred_q_.size() != np ||
+       pred_w_.size() != static_cast<std::size_t>(net_->n_channels()) || pred_b_.size() != np ||
+       pred_dp_.size() != np))
+    throw InputError("checkpoint: porenet3d pressure prediction does not match the rebuilt network");
+  pred_tmp_.assign(np, 0.0);
+  pred_rhs_.assign(np, 0.0);
+  pred_z_.assign(np, 0.0);
+  pred_sys_.reset();
+  if (!pred_g_.empty()) {
+    std::vector<Real> dt;
+    r.get("porenet3d.pred_dt", dt);
+    if (dt.size() != 3) throw InputError("checkpoint: porenet3d.pred_dt does not hold three values");
+    pred_dt_ = dt[0];
+    pred_geom_tri_ = static_cast<long>(dt[1]);
+    pred_geom_age_ = static_cast<long>(dt[2]);
+    // The system with the current values, its aggregates from the values they were built from.
+    build_prediction_system(true);
+    auto& A = pred_sys_->matrix();
+    const std::vector<Real> current(A.valuePtr(), A.valuePtr() + A.nonZeros());
+    r.get("porenet3d.pred_setup_val", pred_setup_val_);
+    if (pred_setup_val_.size() != current.size())
+      throw InputError("checkpoint: porenet3d.pred_setup_val does not match the rebuilt network");
+    std::copy(pred_setup_val_.begin(), pred_setup_val_.end(), A.valuePtr());
+    pred_amg_.setup(porenet::CsrView{net_->n_pores(), A.outerIndexPtr(), A.innerIndexPtr(), A.valuePtr()});
+    std::copy(current.begin(), current.end(), A.valuePtr());
+    pred_amg_.refresh(porenet::CsrView{net_->n_pores(), A.outerIndexPtr(), A.innerIndexPtr(), A.valuePtr()});
+  }
 }
 
 // dV_i/dx_j of tetrahedral pore i (corner entry e of sphere j) for V = V_tet - sum_k Omega_k R_k^3 / 3

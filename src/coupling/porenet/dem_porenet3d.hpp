@@ -13,6 +13,20 @@
 //     liquids need no sub-steps) or explicit with n = ceil(dt_dem / (safety dt_stable)) sub-steps;
 //   add_external_loads(); grain forces from the gauge pressure p - p_ambient (pressure integrated over
 //     each sphere's patches inside its tetrahedra, porenet::add_pressure_forces_3d); integrate().
+// Pressure prediction in the held steps (Porenet3DParams::predict_pressures; on where the fluid's
+// stiffness would bound N, i.e. liquid-full samples): each held step advances the pressure changes dp
+// since the flow step by the flow's own backward-Euler step over one DEM step, linearised at the flow
+// step: (C + dt L) dp_m = C dp_{m-1} - (V_m - V_{m-1}) - dt q, with V_m - V_0 = sum_k g_ik . (x_k - x_k0)
+// (g = void_gradient), C_i = V_i / K_i (K the mixture's modulus), L the channels' mobility Laplacian
+// and q the net outflow at the flow step's pressures; pores at a prescribed pressure keep dp = 0. The
+// system is solved approximately by multigrid V-cycles (porenet::Amg without over-interpolation: a
+// convergent stationary iteration) from dp_{m-1}; the grain forces grow by sum_i dp_i a_ij. One-level
+// (Jacobi) sweeps were tried and dropped: clusters of tiny, strongly connected pores (dt sum W / C ~
+// 400) kept 70 % of the change unresolved, and the force jumps at the flow steps excited the saturated
+// 3D example; undrained increments (dp = -dV / C) were as bad. The flow step (every scale of drainage,
+// the nonlinear equation of state) corrects the pressures every N steps. So a held force is no longer
+// an explicit spring and N may reach max_flow_every: the saturated 3D sample strides 20 steps instead
+// of 1 (docs/saturated.md gives accuracy and speed).
 // Channel shear (B25) is not applied in 3D. Results are bit-identical on any thread count.
 // Cracks in 3D: no separate crack channels; a broken bond's spheres move apart, and the facets
 // they share grow in fluid area and hydraulic radius (update_network_3d each step), so the
@@ -29,6 +43,7 @@
 #include "dem/dem_system.hpp"
 #include "io/checkpoint.hpp"
 #include "porenet/network.hpp"
+#include "porenet/pcg.hpp"
 #include "porenet/remap.hpp"
 #include "porenet/two_phase.hpp"
 
@@ -59,6 +74,11 @@ struct Porenet3DParams {
   // divides the next N by s (wide PFV throats: the phases' transport limit is below the DEM step
   // already, and a 20-fold implicit step exhausted the halvings: "phase masses (0, 0)").
   long flow_every = 1;
+  // Pressure prediction in the held steps (above), where the stiffness bound on N is below
+  // max_flow_every (auto N) or for any fixed N > 1: N then up to max_flow_every (still divided by the
+  // transport halvings). false: forces held as they are.
+  bool predict_pressures = true;
+  int predict_cycles = 2;  // V-cycles per held step (at least 1)
   Real flow_safety = 0.3;
   long max_flow_every = 20;
   long choose_every = 200;
@@ -141,6 +161,9 @@ class DemPorenet3D {
   void retriangulate();
   void flow_step(Real dt);
   void add_forces(dem::DemSystem& sys);
+  void linearise_pressures();                       // pred_* at the flow step (predict_pressures)
+  void build_prediction_system(bool setup);         // pred_sys_, pred_amg_ from pred_c_, pred_w_, pred_ws_
+  void add_predicted_forces(dem::DemSystem& sys);   // the held forces' increment, every held step
   long choose_flow_every(const dem::DemSystem& sys) const;  // the stiffness bound on N (flow_every = 0)
   porenet::Particles3D view() const { return {x_, y_, z_, r_, {}}; }
 
@@ -150,6 +173,26 @@ class DemPorenet3D {
   std::vector<Real> x_, y_, z_, r_, ref_x_, ref_y_, ref_z_, fx_, fy_, fz_, pg_;
   Real mean_radius_ = 0;
   Porenet3DStats stats_;
+  // Pressure prediction (predict_pressures), fixed from one flow step to the next, checkpointed:
+  std::vector<Real> pred_g_;   // 12 per pore (pore-major, by corner): dV_i/dx_k [m^2]
+  std::vector<Real> pred_a_;   // 3 per corner entry (network().pp_*): force on the sphere per unit pressure [m^2]
+  std::vector<Real> pred_x0_;  // 3 per sphere: positions at the flow step [m]
+  std::vector<Real> pred_c_;   // per pore: storage V / K [m^3/Pa]; < 0: no change (prescribed, no modulus)
+  std::vector<Real> pred_w_;   // per channel: mobility [m^3/(Pa s)]
+  std::vector<Real> pred_ws_;  // per pore: the sum of its channels' mobilities
+  std::vector<Real> pred_q_;   // per pore: its net outflow at the flow step's pressures [m^3/s]
+  std::vector<Real> pred_b_;   // per pore: -(V - V0) at the last held step [m^3]
+  std::vector<Real> pred_dp_;  // per pore: the predicted p - p(flow step) [Pa]
+  std::vector<Real> pred_tmp_, pred_rhs_, pred_z_;  // per pore, scratch
+  std::unique_ptr<porenet::PressureSystem> pred_sys_;  // C + dt L of the held steps (pattern, values)
+  // Its V-cycle, without over-interpolation: exact Galerkin coarse matrices and symmetric Gauss-Seidel
+  // make the stationary iteration an A-norm contraction (with the factor 1.5, meant for CG, it diverged).
+  porenet::Amg pred_amg_{porenet::AmgParams{.over_interp = 1.0}};
+  Index pred_sys_n_ = -1;
+  long pred_sys_tri_ = -1;
+  Real pred_dt_ = 0;  // the DEM step of the prediction [s]
+  std::vector<Real> pred_setup_val_;  // the matrix values pred_amg_'s aggregates were built from
+  long pred_geom_tri_ = -1, pred_geom_age_ = 0;  // pred_g_, pred_a_: network (retriangulations) and age [steps]
 };
 
 }  // namespace ff::coupling

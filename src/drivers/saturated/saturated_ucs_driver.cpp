@@ -79,10 +79,16 @@ void declare(ParamTable& t) {
       .fallback();
   t.integer("fluid.flow_every", 0, "-",
             "3D: one flow step (network update, flow, pressure forces) every this many DEM steps, the forces held in "
-            "between (1: every step); 0 = automatic: at most 0.3 of the stiffest grain-fluid period (re-evaluated "
-            "every 200 DEM steps) and 20, doubling from 2 while the flow needs no transport halving, divided by its "
-            "halvings otherwise (partly saturated samples stride far, saturated ones hardly)")
+            "between (1: every step); 0 = automatic: at most 20, doubling from 2 while the flow needs no transport "
+            "halving, divided by its halvings otherwise, and, without fluid.predict_pressures, at most 0.3 of the "
+            "stiffest grain-fluid period (re-evaluated every 200 DEM steps: saturated samples then hardly stride)")
       .non_negative()
+      .fallback();
+  t.boolean("fluid.predict_pressures", true,
+            "3D, between flow steps: advance the pore pressures every DEM step by the flow's implicit step linearised "
+            "at the last flow step (multigrid V-cycles), so that the held forces follow the grains; on where the "
+            "fluid's stiffness would bound fluid.flow_every (water-full samples) or when fluid.flow_every > 1 "
+            "(false: the forces held as they are)")
       .fallback();
   t.real("fluid.cg_tolerance", 1e-12, "-",
          "3D implicit flow: relative residual of the conjugate-gradient pressure solve (porenet; the phase masses stay "
@@ -133,7 +139,8 @@ void declare(ParamTable& t) {
 const std::vector<std::string> k2DOnly = {"fluid.aperture_h0", "fluid.aperture_hinf", "fluid.aperture_gamma",
                                           "fluid.shear_forces", "fluid.cavitation_pressure", "fluid.force_height",
                                           "fluid.remap", "fluid.implicit_above"};
-const std::vector<std::string> k3DOnly = {"fluid.pfv_factor", "fluid.cg_tolerance", "fluid.flow_every"};
+const std::vector<std::string> k3DOnly = {"fluid.pfv_factor", "fluid.cg_tolerance", "fluid.flow_every",
+                                          "fluid.predict_pressures"};
 
 porenet::TwoPhaseParams fluid_params(const Config& cfg) {
   porenet::TwoPhaseParams f;
@@ -195,6 +202,7 @@ coupling::Porenet3DParams params_3d(const Config& cfg) {
   p.retriangulation_tolerance = cfg.real("fluid.retriangulation_tolerance");
   p.implicit = cfg.string("fluid.flow_scheme") != "explicit";
   p.flow_every = cfg.integer("fluid.flow_every");
+  p.predict_pressures = cfg.boolean("fluid.predict_pressures");
   p.drained = false;  // the lateral hull pores only: set by SaturatedUcsRun's on_network
   p.pressure_force = pressure_force(cfg, true);
   return p;
@@ -271,6 +279,7 @@ class PoreFluid {
   Real max_pressure() const { return dim3_ ? c3_.max_pressure() : c2_.max_pressure(); }
   long retriangulations() const { return dim3_ ? c3_.stats().retriangulations : c2_.stats().retriangulations; }
   long substeps() const { return dim3_ ? c3_.stats().last_substeps : c2_.stats().last_substeps; }
+  long flow_every() const { return dim3_ ? c3_.stats().flow_every : 1; }  // DEM steps per flow step
   const coupling::DemPorenetCoupling& c2() const { return c2_; }
   const coupling::DemPorenet3D& c3() const { return c3_; }
   Index drained_pores() const { return drained_; }
@@ -378,14 +387,15 @@ class SaturatedUcsRun final : public UcsRun {
   }
   void extra_columns(std::vector<std::string>& c) const override {
     for (const char* k : {"max_pore_pressure_Pa", "mean_pore_pressure_Pa", "saturation", "retriangulations",
-                          "flow_substeps"})
+                          "flow_substeps", "flow_every"})
       c.emplace_back(k);
   }
   void extra_row(const CompressionState& m) override {
     Real pmean, v;
     fluid_.mean_pressure(pmean, v);
     for (const double x : {fluid_.max_pressure(), pmean, fluid_.flow().saturation(),
-                           static_cast<double>(fluid_.retriangulations()), static_cast<double>(fluid_.substeps())})
+                           static_cast<double>(fluid_.retriangulations()), static_cast<double>(fluid_.substeps()),
+                           static_cast<double>(fluid_.flow_every())})
       row.push_back(x);
     if (m.axial_stress >= ucs_state().peak_stress) write_pores("pores_at_peak.csv");
     fmt::format_to(std::back_inserter(status), "  p_max {:.4g} MPa", 1e-6 * fluid_.max_pressure());
