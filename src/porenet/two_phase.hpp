@@ -138,6 +138,8 @@ class TwoPhaseFlow {
 
   std::span<const Real> pressure() const { return p_; }
   PoreBc bc(Index pore) const { return bc_[static_cast<std::size_t>(pore)]; }
+  // The condition's value: Pressure [Pa], Flux: liquid mass inflow [kg/s].
+  Real bc_value(Index pore) const { return bc_value_[static_cast<std::size_t>(pore)]; }
   // rho dp/drho of pore i's liquid-gas mixture at its state, 1/K = alpha/K_q + (1 - alpha)/K_p [Pa];
   // 0 where a present phase has a non-positive modulus (Peng-Robinson's unstable branch).
   Real mixture_bulk_modulus(Index pore) const;

@@ -213,12 +213,10 @@ void DemPorenet3D::step(dem::DemSystem& sys) {
     advance_flow(static_cast<Real>(stats_.flow_every) * sys.settings.dt);
     const auto t1 = std::chrono::steady_clock::now();
     compute_fluid_forces(-std::numeric_limits<Real>::infinity());
-    if (predict && stats_.flow_every > 1) {
-      pred_dt_ = sys.settings.dt;
-      linearise_pressures();
-    } else {
-      pred_g_.clear();  // no prediction in this cycle (nor a stale size in a checkpoint)
-    }
+    if (predict && stats_.flow_every > 1)
+      start_prediction(sys.settings.dt);
+    else
+      stop_prediction();  // no prediction in this cycle (nor a stale size in a checkpoint)
     stats_.t_forces += seconds_since(t1);
     ++stats_.flow_steps;
     held = false;
@@ -226,7 +224,6 @@ void DemPorenet3D::step(dem::DemSystem& sys) {
   --stats_.cycle_left;
   sys.add_external_loads();
   add_forces(sys);
-  if (!pred_g_.empty()) ++pred_geom_age_;
   if (held && !pred_g_.empty()) {  // at the flow step the increment is zero
     const auto t1 = std::chrono::steady_clock::now();
     add_predicted_forces(sys);

@@ -36,6 +36,7 @@
 #pragma once
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -151,6 +152,18 @@ class DemPorenet3D {
   // cavitation bounds the suction), not added to the system.
   void compute_fluid_forces(Real p_floor);
 
+  // The held steps' pressure prediction (above) for staged use: start_prediction after a flow step's
+  // compute_fluid_forces (dt_dem: the DEM step the held steps take), add_predicted_forces in each held
+  // step (the forces that the predicted change of p, clamped below at p_floor as compute_fluid_forces
+  // clamps p, adds to the held ones), stop_prediction for cycles without it.
+  void start_prediction(Real dt_dem) {
+    pred_dt_ = dt_dem;
+    linearise_pressures();
+  }
+  void stop_prediction() { pred_g_.clear(); }
+  bool predicting() const { return !pred_g_.empty(); }
+  void add_predicted_forces(dem::DemSystem& sys, Real p_floor = -std::numeric_limits<Real>::infinity());
+
   // Called after every (re)build of the network, before the state is carried over: boundary conditions.
   std::function<void(porenet::TwoPhaseFlow&, const porenet::Network2D&)> on_network;
 
@@ -163,7 +176,6 @@ class DemPorenet3D {
   void add_forces(dem::DemSystem& sys);
   void linearise_pressures();                       // pred_* at the flow step (predict_pressures)
   void build_prediction_system(bool setup);         // pred_sys_, pred_amg_ from pred_c_, pred_w_, pred_ws_
-  void add_predicted_forces(dem::DemSystem& sys);   // the held forces' increment, every held step
   long choose_flow_every(const dem::DemSystem& sys) const;  // the stiffness bound on N (flow_every = 0)
   porenet::Particles3D view() const { return {x_, y_, z_, r_, {}}; }
 

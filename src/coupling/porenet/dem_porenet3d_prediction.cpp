@@ -2,6 +2,7 @@
 // equations in dem_porenet3d.hpp): the linearisation at a flow step, its multigrid system, and the
 // per-DEM-step advance with the grain forces it adds.
 #include <algorithm>
+#include <limits>
 #include <vector>
 
 #include "coupling/porenet/dem_porenet3d.hpp"
@@ -56,10 +57,13 @@ void DemPorenet3D::linearise_pressures() {
       w += pred_w_[static_cast<std::size_t>(c)];
       out += pred_w_[static_cast<std::size_t>(c)] * (p[i] - p[o]);
     }
+    if (flow_->bc(i) == porenet::PoreBc::Flux)  // an injection (liquid mass rate) flows in
+      out -= flow_->bc_value(i) / flow_->liquid_density()[u];
     pred_ws_[u] = w;
     pred_q_[u] = out;
   }
   build_prediction_system(geometry);
+  ++pred_geom_age_;  // this flow step's DEM step
   if (!geometry) return;
   // Each corner entry writes its own slots: no two threads share one.
 #pragma omp parallel for schedule(static) if (net.n_particles > porenet::kParallelMin)
@@ -121,7 +125,8 @@ void DemPorenet3D::build_prediction_system(bool setup) {
   }
 }
 
-void DemPorenet3D::add_predicted_forces(dem::DemSystem& sys) {
+void DemPorenet3D::add_predicted_forces(dem::DemSystem& sys, Real p_floor) {
+  ++pred_geom_age_;
   const auto& net = *net_;
   const auto& pos = sys.particles.pos;
   const Real dt = sys.settings.dt;
@@ -160,11 +165,22 @@ void DemPorenet3D::add_predicted_forces(dem::DemSystem& sys) {
       pred_dp_[u] = pred_c_[u] < 0 ? 0.0 : pred_dp_[u] + pred_z_[u];
     }
   }
+  // The force's pressure change, clamped below as compute_fluid_forces clamps p (cavitation).
+  const bool clamp = p_floor > -std::numeric_limits<Real>::infinity();
+  if (clamp) {
+    const auto p = flow_->pressure();
+#pragma omp parallel for schedule(static) if (parallel_pores)
+    for (Index i = 0; i < net.n_pores(); ++i) {
+      const auto u = static_cast<std::size_t>(i);
+      pred_z_[u] = std::max(p[u] + pred_dp_[u], p_floor) - std::max(p[u], p_floor);
+    }
+  }
+  const std::vector<Real>& dp_force = clamp ? pred_z_ : pred_dp_;
 #pragma omp parallel for schedule(static) if (net.n_particles > porenet::kParallelMin)
   for (Index j = 0; j < net.n_particles; ++j) {
     Vec3 f = Vec3::Zero();
     for (Index e = net.pp_start[j]; e < net.pp_start[j + 1]; ++e) {
-      const Real dp = pred_dp_[static_cast<std::size_t>(net.pp_pore[e])];
+      const Real dp = dp_force[static_cast<std::size_t>(net.pp_pore[e])];
       const Real* a = &pred_a_[3 * static_cast<std::size_t>(e)];
       f += dp * Vec3(a[0], a[1], a[2]);
     }

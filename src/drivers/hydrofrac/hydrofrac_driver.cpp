@@ -209,6 +209,7 @@ void HydrofracRun::make_fluid() {
     n.pressure_force = cfg.string("network.pressure_forces") == "void_gradient" ? coupling::PressureForce::VoidGradient
                                                                                 : coupling::PressureForce::Surface;
     n.flow_every = cfg.integer("network.flow_every");
+    n.predict_pressures = cfg.boolean("network.predict_pressures");
     const std::string faces = cfg.string("network.faces");
     n.drained_faces = faces == "drained" || (faces == "auto" && sys.settings.dim == 3);
     n.cell = s.cell;
@@ -820,6 +821,7 @@ void HydrofracRun::finish(const std::string& stop) {
                     {"dt_flow_s", in.dt_flow},
                     {"dt_dem_s", in.dt_dem},
                     {"flow_every", in.flow_every},
+                    {"predict_pressures", net_->predicting()},
                     {"dt_explicit_s", in.dt_explicit},
                     {"spring_period_s", in.t_spring},
                     {"flow_steps", b.flow_steps},

@@ -78,6 +78,10 @@ void declare_params(ParamTable& t) {
   t.integer("network.flow_every", 0, "steps",
             "network: DEM steps per implicit flow step (0: from the fluid-grain stiffness, see docs/hydrofrac.md)")
       .non_negative();
+  t.boolean("network.predict_pressures", true,
+            "network, 3D: between flow steps advance the pore pressures every DEM step by the flow's implicit step "
+            "linearised at the last flow step, so that the held forces follow the grains: where the fluid-grain "
+            "stiffness would allow fewer than 20 DEM steps per flow step, 20 (or network.flow_every when set)");
   t.string("network.faces", "auto",
            "network: the pores on the block's hull: drained (held at network.pore_pressure, the far field, with every "
            "pore within one largest radius of the outermost centres), closed "

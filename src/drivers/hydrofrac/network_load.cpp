@@ -217,10 +217,16 @@ void NetworkLoad::begin(const dem::DemSystem& sys, const BoreholeGeometry& hole,
   info_.dt_explicit = flow().stable_dt();
   info_.t_spring = spring_time(sys);
   long n = s_.flow_every;
+  bool predict = c3_ && s_.predict_pressures;
   if (n <= 0) {
     const Real f = std::floor(s_.flow_safety * info_.t_spring / sys.settings.dt);
     n = std::clamp<long>(std::isfinite(f) ? static_cast<long>(std::min<Real>(f, 1e9)) : 1, 1, s_.max_flow_every);
+    if (predict && n < s_.predict_every)
+      n = std::min(s_.predict_every, s_.max_flow_every);  // the stiffness no longer bounds it
+    else
+      predict = false;  // the held forces alone are stable at n
   }
+  predict_ = predict && n > 1;
   st_.flow_every = info_.flow_every = n;
   info_.dt_flow = static_cast<Real>(n) * sys.settings.dt;
   rho_vapour_liquid_ = fluid_params(s_).liquid.density(s_.vapour_pressure, true);
@@ -248,6 +254,12 @@ void NetworkLoad::gather_forces() {
 void NetworkLoad::add_forces(dem::DemSystem& sys) {
   auto& F = sys.particles.ext_force;
   for (std::size_t k = 0; k < force_.size(); ++k) F[k] += force_[k];
+  // Held steps (not the DEM step right after a flow step, whose positions the flow step saw).
+  if (c3_ && c3_->predicting() && st_.steps % st_.flow_every != 0) {
+    const auto t0 = std::chrono::steady_clock::now();
+    c3_->add_predicted_forces(sys, s_.vapour_pressure);
+    st_.t_forces += seconds_since(t0);
+  }
 }
 
 void NetworkLoad::advance(const dem::DemSystem& sys) {
@@ -294,6 +306,11 @@ void NetworkLoad::network_flow_step(const dem::DemSystem& sys) {
   if (s_.rate_mode) st_.injected_mass += s_.density * s_.flow_rate * h;
   ++st_.flow_steps;
   gather_forces();
+  if (c3_ && predict_) {
+    t0 = std::chrono::steady_clock::now();
+    c3_->start_prediction(sys.settings.dt);
+    st_.t_forces += seconds_since(t0);
+  }
   measure(sys);
 }
 
@@ -404,6 +421,7 @@ void NetworkLoad::save(CheckpointWriter& w) const {
   w.put_value("network.hole", to_record(hole_));
   w.put("network.wall", wall_);
   w.put("network.force", force_);
+  w.put("network.predict", std::vector<std::uint8_t>{static_cast<std::uint8_t>(predict_)});
   if (c2_) {
     c2_->save(w);
     const auto g = flow().implicit_guess();
@@ -419,6 +437,9 @@ void NetworkLoad::load(CheckpointReader& r, const dem::DemSystem& sys) {
   hole_ = from_record(r.get_value<BoreholeRecord>("network.hole"));
   r.get("network.wall", wall_);
   r.get("network.force", force_);
+  std::vector<std::uint8_t> predict;
+  if (r.has("network.predict")) r.get("network.predict", predict);  // absent before 2026-11-29: no prediction
+  predict_ = predict.size() == 1 && predict[0] != 0;
   is_wall_.assign(sys.particles.size(), 0);
   for (Index k : wall_) is_wall_[static_cast<std::size_t>(k)] = 1;
   id_index_ = index_of_ids(sys.particles);

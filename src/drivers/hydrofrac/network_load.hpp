@@ -23,7 +23,10 @@
 // flow step are held over the next N DEM steps. N is set by the fluid-grain stiffness: a grain
 // of mass m facing a pore of void V sees the spring k = K A^2 / V (A its face: 2 r t in 2D,
 // pi r^2 in 3D), and a spring sampled every N dt stays stable and accurate while N dt is a
-// fraction of sqrt(m / k) (the median over the rock's pores); network.flow_every overrides.
+// fraction of sqrt(m / k) (the median over the rock's pores); network.flow_every overrides. In 3D
+// the held steps may predict the pressures instead (network.predict_pressures: each DEM step advances
+// them by the flow's implicit step linearised at the flow step, coupling/porenet/dem_porenet3d.hpp),
+// so that a water-filled network strides 20 DEM steps where the stiffness allowed 1.
 // Units: SI; 2D per metre of thickness (network depth t = 1 m).
 #pragma once
 #include <filesystem>
@@ -73,6 +76,10 @@ struct NetworkSettings {
   long flow_every = 0;                    // DEM steps per flow step; 0: from the fluid-grain stiffness
   Real flow_safety = 0.3;                 // N dt <= safety x sqrt(m / k) (median)
   long max_flow_every = 100;
+  // 3D: the held steps predict the pore pressures (coupling::Porenet3DParams::predict_pressures) where
+  // the stiffness bound gives N < predict_every; N is then predict_every (or flow_every when set).
+  bool predict_pressures = true;
+  long predict_every = 20;
   Real cell = 0, inflate = 0, reach = 0;  // hole_surface (the wall particles)
 };
 
@@ -114,6 +121,7 @@ class NetworkLoad final : public FluidLoad {
 
   const NetworkInfo& info() const { return info_; }
   bool drained_faces() const { return s_.drained_faces; }
+  bool predicting() const { return predict_; }  // 3D: the held steps predict the pressures
   NetworkBudget budget() const;
   Real effective_radius() const { return st_.effective_radius; }
   const porenet::Network2D& network() const;
@@ -154,6 +162,7 @@ class NetworkLoad final : public FluidLoad {
   Real rho_vapour_liquid_ = 0;  // liquid density at the vapour pressure
   std::vector<Real> cp_, ca_, cmq_, cmp_, crq_, crp_;  // cavitation scratch
   Real now_ = 0;  // time of the flow step in progress (the 3D on_network hook's p(t))
+  bool predict_ = false;  // 3D: the held steps predict the pressures (NetworkSettings::predict_pressures)
   BoreholeGeometry hole_;
   State st_;
   NetworkInfo info_;
