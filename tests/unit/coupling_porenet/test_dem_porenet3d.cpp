@@ -162,6 +162,18 @@ std::vector<Real> state_of(const dem::DemSystem& sys, DemPorenet3D& c) {
   return v;
 }
 
+// Storage-weighted mean pore pressure above the initial 1e5 Pa [Pa].
+Real mean_rise(DemPorenet3D& c) {
+  const auto& net = c.network();
+  const auto p = c.flow().pressure();
+  Real pv = 0, v = 0;
+  for (Index i = 0; i < net.n_pores(); ++i) {
+    pv += p[i] * net.pore_void[i];
+    v += net.pore_void[i];
+  }
+  return pv / v - 1e5;
+}
+
 // Checkpoints (DEM + coupling) `sys` and `c`, loads both into a fresh specimen, runs it `steps` more
 // steps and returns its state.
 std::vector<Real> resumed_state(const dem::DemSystem& sys, const DemPorenet3D& c, const Porenet3DParams& prm,
@@ -193,16 +205,6 @@ std::vector<Real> resumed_state(const dem::DemSystem& sys, const DemPorenet3D& c
 // A checkpoint taken mid-cycle (after 215 steps; flow steps at 210, 230) resumes bit-for-bit (the held
 // forces are saved).
 TEST(CouplingPorenet3D, SubCyclingFromTheFluidStiffness) {
-  auto mean_rise = [](DemPorenet3D& c) {
-    const auto& net = c.network();
-    const auto p = c.flow().pressure();
-    Real pv = 0, v = 0;
-    for (Index i = 0; i < net.n_pores(); ++i) {
-      pv += p[i] * net.pore_void[i];
-      v += net.pore_void[i];
-    }
-    return pv / v - 1e5;
-  };
   for (const Real S : {0.5, 1.0}) {
     Real rise[2];
     std::vector<Real> st[2];
@@ -270,16 +272,6 @@ TEST(CouplingPorenet3D, SubCyclingFromTheFluidStiffness) {
 // bit-for-bit (the prediction's state is saved; its multigrid is set up again from it), and 1 and 2
 // threads give the same state.
 TEST(CouplingPorenet3D, PressurePredictionLetsSaturatedSamplesStride) {
-  auto mean_rise = [](DemPorenet3D& c) {
-    const auto& net = c.network();
-    const auto p = c.flow().pressure();
-    Real pv = 0, v = 0;
-    for (Index i = 0; i < net.n_pores(); ++i) {
-      pv += p[i] * net.pore_void[i];
-      v += net.pore_void[i];
-    }
-    return pv / v - 1e5;
-  };
   const long steps = 1000;
   std::vector<Real> ref;
   Real top = 0, worst[2] = {0, 0};
