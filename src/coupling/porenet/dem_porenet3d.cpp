@@ -7,7 +7,6 @@
 #include <cmath>
 #include <limits>
 #include <string>
-#include <utility>
 
 #include "core/error.hpp"
 #include "porenet/forces.hpp"
@@ -49,6 +48,8 @@ void DemPorenet3D::make_network_and_flow(std::unique_ptr<porenet::Network2D>& ne
   ref_y_ = y_;
   ref_z_ = z_;
   pg_.assign(static_cast<std::size_t>(net->n_pores()), 0);
+  pred_g_.clear();  // the prediction's geometry and matrix belong to the old network
+  pred_sys_.reset();
   stats_.t_triangulation += seconds_since(t0);
 }
 
@@ -255,11 +256,8 @@ void DemPorenet3D::save(CheckpointWriter& w) const {
   w.put("porenet3d.fy", fy_);
   w.put("porenet3d.fz", fz_);
   // The prediction of the current cycle (empty without held steps).
-  for (const auto& [tag, v] : {std::pair{"g", &pred_g_}, {"a", &pred_a_}, {"x0", &pred_x0_}, {"c", &pred_c_},
-                               {"w", &pred_w_}, {"ws", &pred_ws_}, {"q", &pred_q_}, {"b", &pred_b_}, {"dp", &pred_dp_}})
-    w.put(std::string("porenet3d.pred_") + tag, *v);
-  w.put("porenet3d.pred_dt", std::vector<Real>{pred_dt_, static_cast<Real>(pred_geom_tri_),
-                                                static_cast<Real>(pred_geom_age_)});
+  for (const auto& [tag, member] : kPredSections) w.put(std::string("porenet3d.pred_") + tag, this->*member);
+  w.put("porenet3d.pred_dt", std::vector<Real>{pred_dt_, static_cast<Real>(pred_geom_age_)});
   w.put("porenet3d.pred_setup_val", pred_g_.empty() ? std::vector<Real>{} : pred_setup_val_);
 }
 
@@ -304,40 +302,38 @@ void DemPorenet3D::load(CheckpointReader& r, const dem::DemSystem& sys, const Po
   if (fx_.size() != n || fy_.size() != n || fz_.size() != n)
     throw InputError(fmt::format("checkpoint: porenet3d forces for {} spheres; the sample has {}", fx_.size(), n));
   const auto np = static_cast<std::size_t>(net_->n_pores());
-  for (const auto& [tag, v] : {std::pair{"g", &pred_g_}, {"a", &pred_a_}, {"x0", &pred_x0_}, {"c", &pred_c_},
-                               {"w", &pred_w_}, {"ws", &pred_ws_}, {"q", &pred_q_}, {"b", &pred_b_}, {"dp", &pred_dp_}}) {
-    v->clear();  // checkpoints before 2026-11-29 have none: forces held as they are until the next flow step
+  for (const auto& [tag, member] : kPredSections) {
+    auto& v = this->*member;
+    v.clear();  // checkpoints before 2026-11-29 have none: forces held as they are until the next flow step
     const std::string key = std::string("porenet3d.pred_") + tag;
-    if (r.has(key)) r.get(key, *v);
+    if (r.has(key)) r.get(key, v);
   }
   if (!pred_g_.empty() &&
       (pred_g_.size() != 12 * np || pred_a_.size() != 3 * static_cast<std::size_t>(net_->pp_start[net_->n_particles]) ||
-       pred_x0_.size() != 3 * n || pred_c_.size() != np || pred_ws_.size() != np || pred_q_.size() != np ||
+       pred_x0_.size() != 3 * n || pred_c_.size() != np || pred_q_.size() != np ||
        pred_w_.size() != static_cast<std::size_t>(net_->n_channels()) || pred_b_.size() != np ||
        pred_dp_.size() != np))
     throw InputError("checkpoint: porenet3d pressure prediction does not match the rebuilt network");
   pred_tmp_.assign(np, 0.0);
   pred_rhs_.assign(np, 0.0);
   pred_z_.assign(np, 0.0);
-  pred_sys_.reset();
   if (!pred_g_.empty()) {
     std::vector<Real> dt;
     r.get("porenet3d.pred_dt", dt);
-    if (dt.size() != 3) throw InputError("checkpoint: porenet3d.pred_dt does not hold three values");
+    if (dt.size() != 2) throw InputError("checkpoint: porenet3d.pred_dt does not hold two values");
     pred_dt_ = dt[0];
-    pred_geom_tri_ = static_cast<long>(dt[1]);
-    pred_geom_age_ = static_cast<long>(dt[2]);
-    // The system with the current values, its aggregates from the values they were built from.
-    build_prediction_system(true);
-    auto& A = pred_sys_->matrix();
-    const std::vector<Real> current(A.valuePtr(), A.valuePtr() + A.nonZeros());
+    pred_geom_age_ = static_cast<long>(dt[1]);
+    // The multigrid's aggregates from the values they were built from, then the current values.
+    const porenet::CsrView v = fill_prediction_matrix();
+    Real* val = pred_sys_->matrix().valuePtr();
+    std::vector<Real> current(val, val + pred_sys_->matrix().nonZeros());
     r.get("porenet3d.pred_setup_val", pred_setup_val_);
     if (pred_setup_val_.size() != current.size())
       throw InputError("checkpoint: porenet3d.pred_setup_val does not match the rebuilt network");
-    std::copy(pred_setup_val_.begin(), pred_setup_val_.end(), A.valuePtr());
-    pred_amg_.setup(porenet::CsrView{net_->n_pores(), A.outerIndexPtr(), A.innerIndexPtr(), A.valuePtr()});
-    std::copy(current.begin(), current.end(), A.valuePtr());
-    pred_amg_.refresh(porenet::CsrView{net_->n_pores(), A.outerIndexPtr(), A.innerIndexPtr(), A.valuePtr()});
+    std::copy(pred_setup_val_.begin(), pred_setup_val_.end(), val);
+    pred_amg_.setup(v);
+    std::copy(current.begin(), current.end(), val);
+    pred_amg_.refresh(v);
   }
 }
 

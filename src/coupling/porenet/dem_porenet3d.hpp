@@ -38,6 +38,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "coupling/porenet/pressure_force.hpp"
@@ -175,7 +176,7 @@ class DemPorenet3D {
   void flow_step(Real dt);
   void add_forces(dem::DemSystem& sys);
   void linearise_pressures();                       // pred_* at the flow step (predict_pressures)
-  void build_prediction_system(bool setup);         // pred_sys_, pred_amg_ from pred_c_, pred_w_, pred_ws_
+  porenet::CsrView fill_prediction_matrix();        // pred_sys_'s values from pred_c_, pred_w_ (creates it)
   long choose_flow_every(const dem::DemSystem& sys) const;  // the stiffness bound on N (flow_every = 0)
   porenet::Particles3D view() const { return {x_, y_, z_, r_, {}}; }
 
@@ -191,7 +192,6 @@ class DemPorenet3D {
   std::vector<Real> pred_x0_;  // 3 per sphere: positions at the flow step [m]
   std::vector<Real> pred_c_;   // per pore: storage V / K [m^3/Pa]; < 0: no change (prescribed, no modulus)
   std::vector<Real> pred_w_;   // per channel: mobility [m^3/(Pa s)]
-  std::vector<Real> pred_ws_;  // per pore: the sum of its channels' mobilities
   std::vector<Real> pred_q_;   // per pore: its net outflow at the flow step's pressures [m^3/s]
   std::vector<Real> pred_b_;   // per pore: -(V - V0) at the last held step [m^3]
   std::vector<Real> pred_dp_;  // per pore: the predicted p - p(flow step) [Pa]
@@ -200,11 +200,14 @@ class DemPorenet3D {
   // Its V-cycle, without over-interpolation: exact Galerkin coarse matrices and symmetric Gauss-Seidel
   // make the stationary iteration an A-norm contraction (with the factor 1.5, meant for CG, it diverged).
   porenet::Amg pred_amg_{porenet::AmgParams{.over_interp = 1.0}};
-  Index pred_sys_n_ = -1;
-  long pred_sys_tri_ = -1;
   Real pred_dt_ = 0;  // the DEM step of the prediction [s]
   std::vector<Real> pred_setup_val_;  // the matrix values pred_amg_'s aggregates were built from
-  long pred_geom_tri_ = -1, pred_geom_age_ = 0;  // pred_g_, pred_a_: network (retriangulations) and age [steps]
+  long pred_geom_age_ = 0;  // DEM steps since pred_g_, pred_a_ were taken
+  // The checkpointed per-pore/channel/entry arrays of the prediction (save and load).
+  static constexpr std::pair<const char*, std::vector<Real> DemPorenet3D::*> kPredSections[] = {
+      {"g", &DemPorenet3D::pred_g_}, {"a", &DemPorenet3D::pred_a_}, {"x0", &DemPorenet3D::pred_x0_},
+      {"c", &DemPorenet3D::pred_c_}, {"w", &DemPorenet3D::pred_w_}, {"q", &DemPorenet3D::pred_q_},
+      {"b", &DemPorenet3D::pred_b_}, {"dp", &DemPorenet3D::pred_dp_}};
 };
 
 }  // namespace ff::coupling

@@ -18,19 +18,17 @@ void DemPorenet3D::linearise_pressures() {
   const auto nc = static_cast<std::size_t>(net.n_channels());
   const auto n = static_cast<std::size_t>(net.n_particles);
   // The void gradients and patch forces (a few atan2 per corner entry: as much as the pressure solve)
-  // change by ~(displacement / radius); taken again after choose_every DEM steps or a new network.
-  const bool geometry = pred_g_.size() != 12 * np || pred_geom_tri_ != stats_.retriangulations ||
-                        pred_geom_age_ >= prm_.choose_every;
+  // change by ~(displacement / radius); taken again after choose_every DEM steps or on a new network
+  // (which clears pred_g_).
+  const bool geometry = pred_g_.size() != 12 * np || pred_geom_age_ >= prm_.choose_every;
   if (geometry) {
     pred_g_.assign(12 * np, 0.0);
     pred_a_.assign(3 * static_cast<std::size_t>(net.pp_start[net.n_particles]), 0.0);
-    pred_geom_tri_ = stats_.retriangulations;
     pred_geom_age_ = 0;
   }
   pred_x0_.resize(3 * n);
   pred_c_.resize(np);
   pred_w_.resize(nc);
-  pred_ws_.resize(np);
   pred_q_.resize(np);
   pred_b_.assign(np, 0.0);
   pred_dp_.assign(np, 0.0);
@@ -44,25 +42,32 @@ void DemPorenet3D::linearise_pressures() {
   }
 #pragma omp parallel for schedule(static) if (net.n_channels() > porenet::kParallelMin)
   for (Index c = 0; c < net.n_channels(); ++c) pred_w_[static_cast<std::size_t>(c)] = flow_->channel_mobility(c);
+  const auto p = flow_->pressure();
 #pragma omp parallel for schedule(static) if (net.n_pores() > porenet::kParallelMin)
   for (Index i = 0; i < net.n_pores(); ++i) {
     const auto u = static_cast<std::size_t>(i);
     const Real K = flow_->bc(i) == porenet::PoreBc::Pressure ? 0.0 : flow_->mixture_bulk_modulus(i);
     pred_c_[u] = K > 0 && net.pore_void[i] > 0 ? net.pore_void[i] / K : -1.0;
-    Real w = 0, out = 0;
-    const auto p = flow_->pressure();
+    Real out = 0;
     for (Index q = net.pc_start[i]; q < net.pc_start[i + 1]; ++q) {
       const Index c = net.pc_ch[q];
       const Index o = net.ch_pore[2 * c] == i ? net.ch_pore[2 * c + 1] : net.ch_pore[2 * c];
-      w += pred_w_[static_cast<std::size_t>(c)];
       out += pred_w_[static_cast<std::size_t>(c)] * (p[i] - p[o]);
     }
     if (flow_->bc(i) == porenet::PoreBc::Flux)  // an injection (liquid mass rate) flows in
       out -= flow_->bc_value(i) / flow_->liquid_density()[u];
-    pred_ws_[u] = w;
     pred_q_[u] = out;
   }
-  build_prediction_system(geometry);
+  // The multigrid: new aggregates with the geometry (the values they were built from are kept in
+  // pred_setup_val_ and checkpointed, so that a resume builds the same), refreshed coarse matrices at
+  // the other flow steps.
+  const porenet::CsrView v = fill_prediction_matrix();
+  if (geometry) {
+    pred_setup_val_.assign(v.val, v.val + pred_sys_->matrix().nonZeros());
+    pred_amg_.setup(v);
+  } else {
+    pred_amg_.refresh(v);
+  }
   ++pred_geom_age_;  // this flow step's DEM step
   if (!geometry) return;
   // Each corner entry writes its own slots: no two threads share one.
@@ -84,17 +89,10 @@ void DemPorenet3D::linearise_pressures() {
 }
 
 // The held steps' matrix C + dt L (volume form of the flow's implicit step over one DEM step), its
-// rows at a prescribed pressure (or without a modulus) identity rows: dp = 0 there, and its multigrid
-// V-cycle: new aggregates with the geometry (setup; the values they were built from are kept in
-// pred_setup_val_ and checkpointed, so that a resume builds the same), refreshed coarse matrices at the
-// other flow steps.
-void DemPorenet3D::build_prediction_system(bool setup) {
+// rows at a prescribed pressure (or without a modulus) identity rows: dp = 0 there.
+porenet::CsrView DemPorenet3D::fill_prediction_matrix() {
   const auto& net = *net_;
-  if (!pred_sys_ || pred_sys_n_ != net.n_pores() || pred_sys_tri_ != stats_.retriangulations) {
-    pred_sys_ = std::make_unique<porenet::PressureSystem>(net);
-    pred_sys_n_ = net.n_pores();
-    pred_sys_tri_ = stats_.retriangulations;
-  }
+  if (!pred_sys_) pred_sys_ = std::make_unique<porenet::PressureSystem>(net);  // the network's pattern
   auto& A = pred_sys_->matrix();
   const auto& ch = pred_sys_->entry_channel();
   const Index* outer = A.outerIndexPtr();
@@ -105,10 +103,12 @@ void DemPorenet3D::build_prediction_system(bool setup) {
   for (Index col = 0; col < net.n_pores(); ++col) {
     const auto u = static_cast<std::size_t>(col);
     const bool fixed_col = pred_c_[u] < 0;
+    Real ws = 0;  // the pore's channels' mobilities
+    for (Index q = net.pc_start[col]; q < net.pc_start[col + 1]; ++q) ws += pred_w_[static_cast<std::size_t>(net.pc_ch[q])];
     for (Index k = outer[col]; k < outer[col + 1]; ++k) {
       const Index row = inner[k];
       if (row == col) {
-        const Real d = (fixed_col ? 0.0 : pred_c_[u]) + dt * pred_ws_[u];
+        const Real d = (fixed_col ? 0.0 : pred_c_[u]) + dt * ws;
         val[k] = d > 0 ? d : 1.0;
       } else {
         const bool fixed = fixed_col || pred_c_[static_cast<std::size_t>(row)] < 0;
@@ -116,13 +116,7 @@ void DemPorenet3D::build_prediction_system(bool setup) {
       }
     }
   }
-  const porenet::CsrView v{net.n_pores(), outer, inner, val};
-  if (setup) {
-    pred_setup_val_.assign(val, val + A.nonZeros());
-    pred_amg_.setup(v);
-  } else {
-    pred_amg_.refresh(v);
-  }
+  return {net.n_pores(), outer, inner, val};
 }
 
 void DemPorenet3D::add_predicted_forces(dem::DemSystem& sys, Real p_floor) {
