@@ -61,6 +61,26 @@ coupling::Porenet3DParams params_3d(const NetworkSettings& s) {
   p.drained = s.drained_faces;
   return p;
 }
+// DEM steps per flow step and whether the held steps predict the pressures (3D): from the fluid-grain
+// spring period (t_spring, median) unless network.flow_every is set. begin() chooses it, load() derives
+// the same from the checkpointed info.
+struct Stride {
+  long n = 1;
+  bool predict = false;
+};
+Stride flow_stride(const NetworkSettings& s, int dim, Real t_spring, Real dt) {
+  Stride st{s.flow_every, dim == 3 && s.predict_pressures};
+  if (st.n <= 0) {
+    const Real f = std::floor(s.flow_safety * t_spring / dt);
+    st.n = std::clamp<long>(std::isfinite(f) ? static_cast<long>(std::min<Real>(f, 1e9)) : 1, 1, s.max_flow_every);
+    if (st.predict && st.n < s.predict_every)
+      st.n = std::min(s.predict_every, s.max_flow_every);  // the stiffness no longer bounds it
+    else
+      st.predict = false;  // the held forces alone are stable at n
+  }
+  st.predict = st.predict && st.n > 1;
+  return st;
+}
 }  // namespace
 
 std::string NetworkInfo::describe() const {
@@ -216,17 +236,9 @@ void NetworkLoad::begin(const dem::DemSystem& sys, const BoreholeGeometry& hole,
   for (Index i : hole_pores_) info_.hole_volume += net.pore_void[i];
   info_.dt_explicit = flow().stable_dt();
   info_.t_spring = spring_time(sys);
-  long n = s_.flow_every;
-  bool predict = c3_ && s_.predict_pressures;
-  if (n <= 0) {
-    const Real f = std::floor(s_.flow_safety * info_.t_spring / sys.settings.dt);
-    n = std::clamp<long>(std::isfinite(f) ? static_cast<long>(std::min<Real>(f, 1e9)) : 1, 1, s_.max_flow_every);
-    if (predict && n < s_.predict_every)
-      n = std::min(s_.predict_every, s_.max_flow_every);  // the stiffness no longer bounds it
-    else
-      predict = false;  // the held forces alone are stable at n
-  }
-  predict_ = predict && n > 1;
+  const Stride stride = flow_stride(s_, dim_, info_.t_spring, sys.settings.dt);
+  const long n = stride.n;
+  predict_ = stride.predict;
   st_.flow_every = info_.flow_every = n;
   info_.dt_flow = static_cast<Real>(n) * sys.settings.dt;
   rho_vapour_liquid_ = fluid_params(s_).liquid.density(s_.vapour_pressure, true);
@@ -421,7 +433,6 @@ void NetworkLoad::save(CheckpointWriter& w) const {
   w.put_value("network.hole", to_record(hole_));
   w.put("network.wall", wall_);
   w.put("network.force", force_);
-  w.put("network.predict", std::vector<std::uint8_t>{static_cast<std::uint8_t>(predict_)});
   if (c2_) {
     c2_->save(w);
     const auto g = flow().implicit_guess();
@@ -437,9 +448,9 @@ void NetworkLoad::load(CheckpointReader& r, const dem::DemSystem& sys) {
   hole_ = from_record(r.get_value<BoreholeRecord>("network.hole"));
   r.get("network.wall", wall_);
   r.get("network.force", force_);
-  std::vector<std::uint8_t> predict;
-  if (r.has("network.predict")) r.get("network.predict", predict);  // absent before 2026-11-29: no prediction
-  predict_ = predict.size() == 1 && predict[0] != 0;
+  // The stride's rule again; a run checkpointed before the prediction existed kept its N (no prediction).
+  const Stride stride = flow_stride(s_, dim_, info_.t_spring, info_.dt_dem);
+  predict_ = stride.predict && stride.n == st_.flow_every;
   is_wall_.assign(sys.particles.size(), 0);
   for (Index k : wall_) is_wall_[static_cast<std::size_t>(k)] = 1;
   id_index_ = index_of_ids(sys.particles);
