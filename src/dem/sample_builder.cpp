@@ -398,6 +398,26 @@ std::size_t install_sample_bonds(const Config& cfg, DemSystem& sys) {
   return sys.install_bonds(gap);
 }
 
+Real crushing_stress(const Config& cfg) {
+  const int dim = static_cast<int>(cfg.integer("dem.dim"));
+  const Materials mat = build_materials(cfg);
+  const Real r = 0.5 * (cfg.real("sample.radius_min") + cfg.real("sample.radius_max"));
+  Real force = 0;
+  mat.with_contact_law([&]<class Law>(std::type_identity<Law>) {
+    for (const auto& p : mat.contact_params<Law>()) force = std::max(force, Law::normal_force(p, r, r, 0.5 * r, dim));
+  });
+  return force / (dim == 3 ? 4 * r * r : 2 * r);
+}
+
+void refuse_crushing_stress(const Config& cfg, const std::string& key) {
+  const Real limit = crushing_stress(cfg);
+  if (cfg.real(key) >= limit)
+    cfg.fail(key, fmt::format("{:.4g} Pa would crush the sample: at {:.4g} Pa the contacts between particles of the mean "
+                              "radius already overlap by half a radius (dem.contact_law = \"{}\", its stiffest pair in "
+                              "[dem.contact.*]); give a stress below that (rock: up to a few hundred MPa)",
+                              cfg.real(key), limit, cfg.string("dem.contact_law")));
+}
+
 void validate_dem_sample(const Config& cfg) {
   const DemSettings settings = build_settings(cfg);
   const Materials mat = build_materials(cfg);
@@ -406,6 +426,7 @@ void validate_dem_sample(const Config& cfg) {
   std::vector<int> region_group;
   read_regions(cfg, mat, region_group);
   default_group(cfg, mat);
+  refuse_crushing_stress(cfg, "sample.locked_in_stress");
 }
 
 SampleInfo build_sample(const Config& cfg, DemSystem& sys) {

@@ -6,6 +6,7 @@
 // segmented voxel image (CT-like PGM stack, grey-value windows as in seed 000 s. 2.2), whose
 // "pore" window removes particles before bonding.
 #pragma once
+#include <string>
 #include <vector>
 
 #include "dem/dem_system.hpp"
@@ -46,6 +47,14 @@ inline constexpr std::size_t kMaxRegions = 10000;
 // packing: groups and pair tables, laws, radii and sizes, porosity, regions (STL files read),
 // the voxel stack (read) and the default group. The `validate` of the DEM drivers.
 void validate_dem_sample(const Config& cfg);
+// The isotropic stress at which the contacts of a packing of mean-size particles (radii midway
+// between sample.radius_min and radius_max, the stiffest contact pair) overlap by half a radius:
+// 3D force / (2r)^2, 2D force / (2r x 1 m). A confining, in-situ or locked-in stress above it
+// crushes the sample instead of loading it (contact laws hold for overlaps of a few per cent).
+Real crushing_stress(const Config& cfg);
+// Refuses `key` (a stress in Pa) when it is at or above crushing_stress(cfg), naming the contact
+// keys that set the bound.
+void refuse_crushing_stress(const Config& cfg, const std::string& key);
 // Installs the bonds of sample.bond_gap on the built sample, after refusing a gap above its largest
 // particle radius (a bond is a cement bridge between neighbours; 1e300 m bonded every pair: memory
 // grew past 6 GB for a 3D block). Returns the bond count.

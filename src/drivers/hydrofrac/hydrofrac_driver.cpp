@@ -594,6 +594,10 @@ RunStatus HydrofracRun::run() {
   const Real max_p = cfg.real("injection.max_pressure"), max_t = cfg.real("injection.max_time");
   const Real stop_extent = cfg.real("injection.stop_extent"), stop_fraction = cfg.real("injection.stop_fraction");
   const Real peak_drop = cfg.real("injection.peak_drop");
+  auto wall_list = [&](const Vec3& v) {
+    return sys.settings.dim == 3 ? fmt::format("{:.4g} / {:.4g} / {:.4g}", 1e-6 * v.x(), 1e-6 * v.y(), 1e-6 * v.z())
+                                 : fmt::format("{:.4g} / {:.4g}", 1e-6 * v.x(), 1e-6 * v.y());
+  };
   Progress progress("hydrofrac", opt.progress_interval_s);
   LongRunNotice long_run(planned_steps() - static_cast<double>(sys.step_count), kShortenKeys, sys.step_count);
   std::string stop;
@@ -611,6 +615,14 @@ RunStatus HydrofracRun::run() {
         fraction = 0.5 * static_cast<double>(sys.step_count) / static_cast<double>(insitu_max);
         if (eq || sys.step_count >= insitu_max) {
           st_.equilibrium = eq;
+          // Walls still far from their targets: breakdown pressures of such a block mean nothing.
+          if (!eq && err > 0.5)
+            throw NumericalError(fmt::format(
+                "hydrofrac: the in-situ stage reached insitu.max_steps = {} with the walls at {} MPa, up to {:.0f}% away "
+                "from their targets ({} MPa; insitu.sigma_H, insitu.sigma_h{}). Raise insitu.max_steps (or "
+                "insitu.servo_velocity) if the walls were still closing in (the progress lines show their stresses), or "
+                "lower the in-situ stresses if the block cannot carry them",
+                insitu_max, wall_list(ws), 100 * err, wall_list(targets_), sys.settings.dim == 3 ? ", insitu.sigma_v" : ""));
           if (!eq)
             log::warn("hydrofrac: the in-situ stage reached insitu.max_steps = {} without equilibrium (largest wall-stress "
                       "error {:.3g}, unbalanced-force ratio {:.3g}, tolerance {}); injecting anyway",

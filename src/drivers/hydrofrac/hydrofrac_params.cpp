@@ -100,7 +100,12 @@ void declare_params(ParamTable& t) {
   t.real("fluid.sound_speed", 0.0, "m/s", "lbm: lattice sound speed c_s = dx / (sqrt(3) dt) (0: not set)").non_negative();
   t.real("fluid.time_step", 0.0, "s", "lbm: LBM step (0: not set)").non_negative();
   t.real("fluid.tau", 0.0, "-", "lbm: relaxation time, dt = (tau - 1/2) dx^2 / (3 nu) (0: not set)").non_negative();
-  t.real("fluid.background_pressure", 0.0, "Pa", "lbm: pore pressure p0 outside the populations: p = p0 + K_eff (rho_lb - 1)");
+  t.real("fluid.background_pressure", 0.0, "Pa",
+         "lbm: pore pressure p0 outside the populations: p = p0 + K_eff (rho_lb - 1); at most 1 GPa (five times the "
+         "highest reservoir pore pressures: beyond, p0 + K_eff (rho_lb - 1) loses the injection's pressure changes to "
+         "round-off)")
+      .non_negative()
+      .at_most(1e9);
   t.real("fluid.dx", 0.0, "m", "lbm: lattice spacing (0: sample.radius_min / fluid.cells_per_radius)").non_negative();
   t.real("fluid.cells_per_radius", 1.5, "-", "lbm: cells per smallest particle radius when fluid.dx = 0 (seed 002: >= 1)")
       .positive();
@@ -194,6 +199,8 @@ coupling::FluidSpec lbm_fluid_spec(const Config& cfg) {
 
 void validate_scenario(const Config& cfg) {
   dem::validate_dem_sample(cfg);
+  for (const char* key : {"insitu.sigma_H", "insitu.sigma_h", "insitu.sigma_v"})
+    if (cfg.integer("dem.dim") == 3 || std::string(key) != "insitu.sigma_v") dem::refuse_crushing_stress(cfg, key);
   if (cfg.string("sample.shape") != "box")
     cfg.fail("sample.shape", "the hydrofrac block is a box: shape = \"box\" (2D rectangle in x-y; 3D box with the borehole along z)");
   if (cfg.string("injection.fluid") == "network" &&

@@ -59,7 +59,10 @@ void declare(ParamTable& t) {
   t.real("fluid.bulk_modulus", 0.0, "Pa", "effective bulk modulus K_eff = rho c_s^2: fixes the step (0: not set)")
       .non_negative();
   t.real("fluid.background_pressure", 0.0, "Pa",
-         "pressure p0 carried outside the populations: p = p0 + K_eff (rho_lb - 1) (docs/coupling.md)");
+         "pressure p0 carried outside the populations: p = p0 + K_eff (rho_lb - 1) (docs/coupling.md); at most 1 GPa "
+         "(beyond, p0 + K_eff (rho_lb - 1) loses the flow's pressure differences to round-off)")
+      .non_negative()
+      .at_most(1e9);
   t.real("fluid.reference_velocity", 0.0, "m/s",
          "expected largest speed, for the Mach-number check U / c_s (0: the Stokes settling speed of the largest "
          "particle, capped by its free-fall speed sqrt(2 g d))")

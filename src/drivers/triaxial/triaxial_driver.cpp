@@ -172,6 +172,7 @@ void check_triaxial_keys(const Config& cfg) {
 void validate(const Config& cfg) {
   check_triaxial_keys(cfg);
   dem::validate_dem_sample(cfg);
+  dem::refuse_crushing_stress(cfg, "triaxial.confining_pressure");
 }
 
 // The triaxial test on the shared loop: an isotropic stage (platens and lateral boundary

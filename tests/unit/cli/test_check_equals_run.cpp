@@ -123,6 +123,9 @@ std::vector<Bad> bad_scenarios() {
        {"dem.bond.rock-rock.friction_angle", "> 0"}},
       // triaxial
       {"triaxial_2d", kTriaxial + "dem.dim = 2\n", {"dem.dim", "3D"}},
+      {"triaxial_crushing_confinement", kTriaxial + "triaxial.confining_pressure = 1e12\n",
+       {"triaxial.confining_pressure", "half a radius"}},
+      {"crushing_locked_in_stress", kUcs2d + "sample.locked_in_stress = 1e300\n", {"sample.locked_in_stress", "half a radius"}},
       {"triaxial_reserved_group",
        kTriaxial + "triaxial.lateral = \"particle_membrane\"\ndem.group.membrane.density = 1000\n"
                    "dem.contact.membrane-membrane.friction = 0.1\ndem.contact.membrane-rock.friction = 0.1\n"

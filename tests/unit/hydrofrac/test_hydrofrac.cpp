@@ -293,12 +293,25 @@ TEST(Hydrofrac, CheckRefusesBadInputNamingTheKey) {
                         Case{"dfn.file=\"missing.csv\"", "dfn.file"},
                         Case{"dfn.count=3 --set dfn.length_max=1e-3", "dfn.length_max"},
                         Case{"network.remap=\"volume\"", "network.remap"},
-                        Case{"network.pressure_forces=\"arc\"", "network.pressure_forces"}}) {
+                        Case{"network.pressure_forces=\"arc\"", "network.pressure_forces"},
+                        // Stresses that crush the block (its contacts overlapping half a radius) and a pore
+                        // pressure beyond round-off: NaN forces or a crushed block injected "anyway" before.
+                        Case{"insitu.sigma_H=1e300", "insitu.sigma_H"}, Case{"sample.locked_in_stress=1e300", "sample.locked_in_stress"},
+                        Case{"fluid.background_pressure=1e300", "fluid.background_pressure"},
+                        Case{"fluid.background_pressure=-1", "fluid.background_pressure"}}) {
     const auto r = fracflow("check " + file.string() + " --set " + c.set);
     EXPECT_EQ(r.code, 2) << c.set << "\n" << r.output;
     EXPECT_NE(r.output.find(c.key), std::string::npos) << c.set << "\n" << r.output;
   }
   EXPECT_EQ(fracflow("check " + file.string()).code, 0);
+  // Walls that end the in-situ stage far from their targets stop the run (after a checkpoint)
+  // instead of injecting into a block at a fraction of its stress.
+  const fs::path out = s / "short";
+  const auto r = fracflow("run " + file.string() + " --out " + out.string() + " -q -j1 --set insitu.max_steps=300 --set insitu.sigma_H=40e6");
+  EXPECT_EQ(r.code, 3) << r.output;
+  EXPECT_NE(r.output.find("insitu.max_steps = 300"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(out / "checkpoint_failed"));
+  EXPECT_FALSE(fs::exists(out / "summary.json"));
 }
 
 // A run stopped by --max-steps during the injection and resumed gives the same files, bit for
