@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <span>
@@ -159,6 +160,7 @@ void DemPorenetCoupling::set_uniform_state(Real p, Real s) {
 }
 
 void DemPorenetCoupling::retriangulate(const dem::DemSystem& sys) {
+  const auto t0 = std::chrono::steady_clock::now();
   // Old network at the current positions (centroids for the nearest-pore map), then a new one.
   porenet::update_network_2d(*net_, porenet::Particles2D{x_, y_, r_, {}}, pairs_);
   auto old_net = std::move(net_);
@@ -176,6 +178,7 @@ void DemPorenetCoupling::retriangulate(const dem::DemSystem& sys) {
   const std::vector<Real> old_vap = vap_;
   carry_vapour(*old_net, old_vap, old_flow->gas_mass());
   ++stats_.retriangulations;
+  t_triangulation_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 // Each new pore's gas takes the vapour fraction of the old pore nearest to it (the composition is

@@ -116,6 +116,8 @@ class DemPorenetCoupling {
   const porenet::TwoPhaseFlow& flow() const { return *flow_; }
   const porenet::PairList& pairs() const { return pairs_; }
   const CouplingStats& stats() const { return stats_; }
+  // Wall seconds spent in retriangulations (network, pairs and remap) by this process (not checkpointed).
+  double triangulation_seconds() const { return t_triangulation_; }
   const PorenetCouplingParams& params() const { return prm_; }
   Real max_pressure() const;
   // Vapour mass (cavitation's part of the gas) per pore [kg per m of depth]; sum = vapour in the sample.
@@ -178,6 +180,7 @@ class DemPorenetCoupling {
   std::vector<Real> vap_, mp_prev_;
   std::vector<std::uint8_t> bc_pore_;
   Real mean_radius_ = 0;
+  double t_triangulation_ = 0;
   CouplingStats stats_;
 };
 

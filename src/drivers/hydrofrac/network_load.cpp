@@ -307,7 +307,9 @@ void NetworkLoad::network_flow_step(const dem::DemSystem& sys) {
     }
   }
   set_hole_bc(flow(), network(), sys.time);
-  st_.t_sync += seconds_since(t0);
+  const double sync_s = seconds_since(t0);
+  st_.t_sync += sync_s;
+  if (rebuilt) t_retriangulation_ += sync_s;
   t0 = std::chrono::steady_clock::now();
   if (c2_) flow().step_implicit(h);
   else c3_->advance_flow(h);
@@ -423,6 +425,7 @@ NetworkBudget NetworkLoad::budget() const {
   b.vapour_volume = st_.vapour_volume;
   b.t_sync = st_.t_sync;
   b.t_flow = st_.t_flow;
+  b.t_triangulation = t_retriangulation_;
   b.t_forces = st_.t_forces;
   return b;
 }

@@ -105,6 +105,7 @@ struct NetworkBudget {
   long cavitations = 0;      // pore-steps that cavitated
   Real vapour_volume = 0;    // void not filled by liquid in cavitated pores, last flow step [m^3]
   double t_sync = 0, t_flow = 0, t_forces = 0;  // wall seconds of the network update, flow and forces
+  double t_triangulation = 0;  // wall seconds of the updates that retriangulated, this process only
 };
 
 class NetworkLoad final : public FluidLoad {
@@ -133,6 +134,7 @@ class NetworkLoad final : public FluidLoad {
   void write_vtu(const std::filesystem::path& file, const dem::DemSystem& sys) const;
 
  private:
+  double t_retriangulation_ = 0;  // this process's (not checkpointed)
   struct State {  // (trivially copyable: a checkpoint section)
     Real t0 = 0, t_last = 0, pressure = 0, volume = 0, injected_mass = 0, mass0 = 0, mass = 0, effective_radius = 0;
     long steps = 0, flow_steps = 0, wetted = 0, flow_every = 1;

@@ -204,6 +204,8 @@ TEST(HydrofracNetwork, VoidGradientForceWithDrainedFacesBreaksFromTheHole) {
   const double a = j["borehole"]["effective_radius_m"].get<double>();
   for (double x : d) EXPECT_LT(x, a + 4 * 0.6e-3) << "a first crack away from the hole";
   EXPECT_LT(j["network"]["retriangulations"].get<long>(), 200);
+  const double share = j["network"]["retriangulation_wall_share"].get<double>();  // timed and reported
+  EXPECT_TRUE(share > 0 && share < 1) << share;
 }
 
 // 3. Mass budget (rate mode, the block closed): what was pumped (rho Q t) equals what the pores

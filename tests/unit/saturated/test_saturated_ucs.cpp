@@ -209,6 +209,9 @@ TEST(SaturatedUcs3D, ResumeAndThreadsBitIdentical) {
   ASSERT_EQ(test::run_scenario(text, sets, one, 1), RunStatus::Finished);
   const auto j = nlohmann::json::parse(test::slurp(whole / "summary.json"));
   EXPECT_GE(j["fluid"]["retriangulations"].get<long>(), 1);
+  EXPECT_GT(j["fluid"]["triangulation_seconds"].get<double>(), 0.0);  // timed, and its share of the run reported
+  const double share = j["fluid"]["triangulation_wall_share"].get<double>();
+  EXPECT_TRUE(share > 0 && share < 1) << share;
   EXPECT_GT(j["steps"].get<long>(), 150);
   test::expect_same_results(whole, parts, "3D saturated UCS, resumed at step 150");
   EXPECT_TRUE(test::read_bytes(whole / "series.csv") == test::read_bytes(one / "series.csv")) << "1 vs 2 threads";
