@@ -803,7 +803,8 @@ void HydrofracRun::finish(const std::string& stop) {
                 {"dt_dem_s", in.dem_dt},
                 {"sub_steps", in.stride},
                 {"tau", in.scales.units.tau()},
-                {"mach", in.scales.mach},
+                {"mach_reference", in.scales.mach},
+                {"max_mach", b.max_mach},
                 {"bulk_modulus_eff_Pa", in.scales.bulk_modulus},
                 {"dx_m", in.scales.units.dx()},
                 {"lattice", {in.n[0], in.n[1], in.n[2]}},
@@ -820,8 +821,8 @@ void HydrofracRun::finish(const std::string& stop) {
                                  "the residual what the bounce-back walls created or destroyed"}}},
                 {"faces", cfg.string("fluid.faces")}};
     log::info("hydrofrac: LBM mass budget over {} LBM steps ({} new particle sets; m^3 at rho_f): injected {:.4g}, lattice "
-              "change {:.4g}, drained {:.4g}, covering and refill {:.4g}, residual (walls) {:.4g}",
-              b.lbm_steps, b.set_changes, b.injected, b.lattice_change, b.drained, b.covering_refill, b.residual);
+              "change {:.4g}, drained {:.4g}, covering and refill {:.4g}, residual (walls) {:.4g}; largest Mach number {:.3g}",
+              b.lbm_steps, b.set_changes, b.injected, b.lattice_change, b.drained, b.covering_refill, b.residual, b.max_mach);
   }
   if (net_) {
     const auto& in = net_->info();

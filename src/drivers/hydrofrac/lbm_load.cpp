@@ -139,6 +139,7 @@ class LbmLoad final : public LbmLoadBase {
     b.residual = b.lattice_change - b.injected - b.drained - b.covering_refill;
     b.lbm_steps = st_.lbm_steps;
     b.set_changes = st_.set_changes;
+    b.max_mach = st_.max_mach;
     return b;
   }
 
@@ -260,7 +261,9 @@ class LbmLoad final : public LbmLoadBase {
     Real drained = 0;  // mass the drained faces added (negative: outflow) [m^3 at rho_f]
     long dem_steps = 0, lbm_steps = 0;
     long set_changes = 0;  // LBM steps that handed the solver a new particle set
+    double max_mach = 0;   // largest |u| / c_s over the fluid cells, sampled every kMachEvery LBM steps
   };
+  static constexpr long kMachEvery = 20;
 
   double cell_volume() const { return std::pow(s_.fluid.dx, L::D); }  // 2D: per metre
 
@@ -354,6 +357,21 @@ class LbmLoad final : public LbmLoadBase {
     for (std::size_t i = 0; i < set_.size(); ++i) loaded_[i] = touches_wet(set_.position[i], sys.particles.radius[i] / dx);
   }
 
+  // The fluid's Mach number (a pass over the moments the last step stored): the largest so far for summary.json,
+  // and a stop with advice past coupling::kMaxMach or at NaN (the populations' expansion no longer
+  // holds; the run would only blow up later).
+  void check_mach(const dem::DemSystem& sys) {
+    const double mach = fluid_->max_speed() * std::sqrt(3.0);
+    if (!(mach <= coupling::kMaxMach))
+      throw NumericalError(fmt::format(
+          "hydrofrac: the LBM fluid became unstable at t = {:.6g} s (LBM step {}): Mach number {:.3g} (limit {}). A "
+          "stiffer lattice fluid (raise fluid.bulk_modulus or fluid.sound_speed: a shorter LBM step), a slower "
+          "injection (lower injection.ramp_rate or injection.rate) or a more viscous fluid (fluid.viscosity) keeps "
+          "the fluid's speed below the lattice's sound speed",
+          sys.time, st_.lbm_steps, mach, coupling::kMaxMach));
+    st_.max_mach = std::max(st_.max_mach, mach);
+  }
+
   void lbm_step(const dem::DemSystem& sys) {
     if (set_stale(sys)) {
       fill_set(sys);
@@ -363,8 +381,11 @@ class LbmLoad final : public LbmLoadBase {
       find_loaded(sys);
       ++st_.set_changes;
     }
-    fluid_->step(false);
+    // Every kMachEvery-th step stores the moments (the fields are not read otherwise) for the Mach check.
+    const bool sample = (st_.lbm_steps + 1) % kMachEvery == 0;
+    fluid_->step(sample);
     ++st_.lbm_steps;
+    if (sample) check_mach(sys);
     const double dt = info_.scales.dt();
     const Real t_end = st_.t0 + double(st_.lbm_steps) * dt;
     // Injection: the hole's fluid cells get the borehole density.

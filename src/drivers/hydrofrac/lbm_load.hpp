@@ -66,6 +66,7 @@ struct LbmBudget {
   Real drained = 0;  // mass the drained faces removed (negative: outflow); 0 with closed faces
   long lbm_steps = 0;
   long set_changes = 0;  // LBM steps that rebuilt the particles' solid cells (quasi-static walls: after 0.02 dx of motion)
+  double max_mach = 0;   // largest Mach number of the fluid seen (sampled every 20 LBM steps)
 };
 
 // The fluid load; dim 2 or 3. `dem_dt` is the DEM step the driver uses.
