@@ -1,8 +1,8 @@
 // `fracflow validate-hydrofrac`: the breakdown pressure of the hydrofrac driver over a sweep of
 // sigma_h against Hubbert & Willis (1957) and Haimson & Fairhurst (1967), as one command. It
 // measures the rock's tensile strength with the direct-tension driver on the same material,
-// runs the borehole block at each sigma_h with the sleeve (non-penetrating) and with
-// penetration, and writes docs/validation/hydrofrac.md (src/drivers/hydrofrac/breakdown_theory.hpp)
+// runs the borehole block at each sigma_h with the sleeve (non-penetrating), with penetration and
+// with the lattice Boltzmann fluid (unless --no-lbm), and writes docs/validation/hydrofrac.md (src/drivers/hydrofrac/breakdown_theory.hpp)
 // with a figure. Every run is an ordinary results folder under --out.
 #include <fmt/chrono.h>
 #include <fmt/format.h>
@@ -38,7 +38,21 @@ struct Args {
   double width = 30e-3, radius_min = 0.3e-3, radius_max = 0.45e-3, hole = 3.5e-3, ramp = 2e10;
   int seed = 1, threads = 1, packings = 3;
   bool overwrite = false;
+  bool lbm = true;  // also the lattice Boltzmann fluid on every block
+  // The LBM fluid (as examples/hydrofrac_2d_lbm.toml: a viscous lab oil, the smallest grain two cells
+  // across); K_eff so that the pressures up to lbm_max_pressure stay within 10 % of density variation.
+  double lbm_viscosity = 1e-2, lbm_bulk_modulus = 6.5e8, lbm_max_pressure = 60e6;
 };
+
+std::vector<std::string> lbm_sets(const Args& a) {
+  return {"injection.fluid=\"lbm\"",
+          "fluid.density=1000",
+          fmt::format("fluid.viscosity={}", a.lbm_viscosity),
+          fmt::format("fluid.bulk_modulus={}", a.lbm_bulk_modulus),
+          "fluid.cells_per_radius=1.0",
+          "fluid.scheme=\"interpolated\"",
+          fmt::format("injection.max_pressure={}", a.lbm_max_pressure)};
+}
 
 // The coal-matrix material of the UCS/Brazilian examples (examples/ucs_2d.toml), 2D.
 const char* kMaterial = R"(
@@ -143,12 +157,13 @@ int run_validate(const Args& a) {
   ctx.tensile_strength = jt["tensile_strength_Pa"];
   ctx.tension_run = fmt::format("`{}`, {} disks", (out / "tension").generic_string(), jt["sample"]["particles"].dump());
   std::vector<drivers::hydrofrac::BreakdownPoint> pts;
+  std::string lbm_words;
   for (double sh : a.sigma_h) {
     drivers::hydrofrac::BreakdownPoint p;
     p.sigma_H = a.sigma_H;
     p.sigma_h = sh;
     p.packings = a.packings;
-    std::vector<double> init, bd, pen;
+    std::vector<double> init, bd, pen, lbm_init, lbm_bd;
     for (int k = 0; k < a.packings; ++k) {
       const std::vector<std::string> sets = {fmt::format("insitu.sigma_h={}", sh), fmt::format("sample.seed={}", a.seed + k)};
       const auto js = run_one(block, sets, out / fmt::format("sleeve_sh{:g}MPa_seed{}", 1e-6 * sh, a.seed + k), a.threads);
@@ -165,6 +180,20 @@ int run_validate(const Args& a) {
       const auto jp = run_one(block, sets_p, out / fmt::format("penetration_sh{:g}MPa_seed{}", 1e-6 * sh, a.seed + k), a.threads);
       pen.push_back(number_or_nan(jp["breakdown"]["pressure_Pa"]));
       if (k == 0) p.wall_time_s += number_or_nan(jp["wall_time_s"]);
+      if (a.lbm) {
+        auto sets_l = sets;
+        for (const auto& x : lbm_sets(a)) sets_l.push_back(x);
+        const auto jl = run_one(block, sets_l, out / fmt::format("lbm_sh{:g}MPa_seed{}", 1e-6 * sh, a.seed + k), a.threads);
+        lbm_bd.push_back(number_or_nan(jl["breakdown"]["pressure_Pa"]));
+        lbm_init.push_back(number_or_nan(jl["breakdown"]["initiation_pressure_Pa"]));
+        if (k == 0) p.wall_time_s += number_or_nan(jl["wall_time_s"]);
+        if (k == 0 && lbm_words.empty())
+          lbm_words = fmt::format("nu = {:g} m^2/s, K_eff = {:.3g} Pa, dx = {:.3g} mm ({} x {} cells), tau = {:.3f}, {} DEM "
+                                  "sub-steps per LBM step, interpolated bounce-back, closed faces",
+                                  a.lbm_viscosity, number_or_nan(jl["lbm"]["bulk_modulus_eff_Pa"]),
+                                  1e3 * number_or_nan(jl["lbm"]["dx_m"]), jl["lbm"]["lattice"][0].dump(),
+                                  jl["lbm"]["lattice"][1].dump(), number_or_nan(jl["lbm"]["tau"]), jl["lbm"]["sub_steps"].dump());
+      }
     }
     // Means (NaN when a packing found no breakdown: the point is then not fitted) and ranges.
     auto mean = [](const std::vector<double>& v) {
@@ -179,6 +208,11 @@ int run_validate(const Args& a) {
     p.initiation_range = range(init);
     p.breakdown_range = range(bd);
     p.penetrating_range = range(pen);
+    if (a.lbm) {
+      p.lbm_breakdown = mean(lbm_bd);
+      p.lbm_initiation = mean(lbm_init);
+      p.lbm_range = range(lbm_bd);
+    }
     pts.push_back(p);
   }
   // The figure: DEM points and both theories against sigma_h.
@@ -188,11 +222,14 @@ int run_validate(const Args& a) {
   {
     std::ofstream c(out / "breakdown.csv");
     c << "sigma_h_Pa,initiation_sleeve_Pa,breakdown_sleeve_Pa,breakdown_penetration_Pa,hubbert_willis_Pa,"
-         "haimson_fairhurst_eta0_Pa\n";
-    for (const auto& p : pts)
+         "haimson_fairhurst_eta0_Pa" << (a.lbm ? ",breakdown_lbm_Pa" : "") << "\n";
+    for (const auto& p : pts) {
       c << p.sigma_h << "," << p.sleeve_initiation << "," << p.sleeve_breakdown << "," << p.penetrating_breakdown << ","
         << drivers::hydrofrac::hubbert_willis(p.sigma_H, p.sigma_h, ctx.tensile_strength) << ","
-        << drivers::hydrofrac::haimson_fairhurst(p.sigma_H, p.sigma_h, ctx.tensile_strength, 0) << "\n";
+        << drivers::hydrofrac::haimson_fairhurst(p.sigma_H, p.sigma_h, ctx.tensile_strength, 0);
+      if (a.lbm) c << "," << p.lbm_breakdown;
+      c << "\n";
+    }
   }
   PlotSpec spec;
   spec.title = fmt::format("Breakdown pressure, sigma_H = {:g} MPa, T = {:.2f} MPa (measured)", 1e-6 * a.sigma_H,
@@ -202,6 +239,7 @@ int run_validate(const Args& a) {
   spec.xlabel = "sigma_h [MPa]";
   spec.y = {"initiation_sleeve_Pa", "breakdown_sleeve_Pa", "breakdown_penetration_Pa", "hubbert_willis_Pa",
             "haimson_fairhurst_eta0_Pa"};
+  if (a.lbm) spec.y.push_back("breakdown_lbm_Pa");
   spec.y_scale = 1e-6;
   spec.ylabel = "borehole pressure [MPa]";
   const bool figure = plot_series(out / "breakdown.csv", images / "hydrofrac_breakdown.png", spec);
@@ -210,11 +248,12 @@ int run_validate(const Args& a) {
   utsname u{};
   uname(&u);
   ctx.machine = fmt::format("{} {}, {} thread(s)", u.sysname, u.machine, a.threads);
-  ctx.command = fmt::format("fracflow validate-hydrofrac --packings {} --sigma-H {:g} --sigma-h {}", a.packings, a.sigma_H, [&] {
+  ctx.command = fmt::format("fracflow validate-hydrofrac --packings {} --sigma-H {:g} --sigma-h {}{}", a.packings, a.sigma_H, [&] {
     std::string s;
     for (double v : a.sigma_h) s += (s.empty() ? "" : ",") + fmt::format("{:g}", v);
     return s;
-  }());
+  }(), a.lbm ? "" : " --no-lbm");
+  ctx.lbm_fluid = lbm_words;
   ctx.block = fmt::format("A {:.0f} mm square 2D block of about {} bonded disks (radii {:.2f}-{:.2f} mm), the coal-matrix "
                           "micro-parameters of examples/ucs_2d.toml.",
                           1e3 * a.width, pts.empty() ? 0L : pts.front().particles, 1e3 * a.radius_min, 1e3 * a.radius_max);
@@ -249,6 +288,8 @@ const bool registered = ff::cli::register_command({"validate-hydrofrac", [](CLI:
       ->capture_default_str();
   sub->add_option("--threads,-t", a->threads, "OpenMP threads per run")->check(CLI::PositiveNumber)->capture_default_str();
   sub->add_flag("--overwrite", a->overwrite, "replace an existing --out folder");
+  sub->add_flag("!--no-lbm", a->lbm, "skip the lattice Boltzmann fluid's runs (by default every block is also fractured by "
+                                     "the LBM fluid of examples/hydrofrac_2d_lbm.toml)");
   return ff::cli::Command::Run([a] { return run_validate(*a); });
 }});
 

@@ -56,21 +56,32 @@ std::string breakdown_report(const std::vector<BreakdownPoint>& pts, const Sweep
                  "Fairhurst (1967), penetrating: P_b = (3 sigma_h - sigma_H + T - 2 eta p0) / (2 - 2 eta); with p0 = 0 "
                  "it lies between (3 sigma_h - sigma_H + T)/2 (eta = 0) and Hubbert-Willis (eta = 0.5). Both give a "
                  "slope of 3 (H&W) or 3/(2 - 2 eta) against sigma_h at fixed sigma_H.\n\n");
+  const bool lbm = !c.lbm_fluid.empty();
+  if (lbm)
+    fmt::format_to(out,
+                   "**LBM fluid.** The same blocks (same packings) fractured by a resolved fluid instead of the sleeve "
+                   "(`injection.fluid = \"lbm\"`, docs/hydrofrac.md): {}. The fluid enters a crack only where the "
+                   "opening uncovers lattice cells, and as fast as viscous flow through them allows.\n\n",
+                   c.lbm_fluid);
   fmt::format_to(out, "| sigma_H [MPa] | sigma_h [MPa] | initiation (sleeve) | breakdown (sleeve) | breakdown (penetration) | "
                       "H&W | H&F, eta = 0 | fracture azimuth (sleeve) [deg] | particles | wall time [s] | packings | range: initiation / "
-                      "breakdown / penetration |\n");
-  fmt::format_to(out, "|---|---|---|---|---|---|---|---|---|---|---|---|\n");
-  std::vector<Real> x, yi, yb, yp;
+                      "breakdown / penetration |{}\n",
+                 lbm ? " initiation (LBM) | breakdown (LBM) | range (LBM) |" : "");
+  fmt::format_to(out, "|---|---|---|---|---|---|---|---|---|---|---|---|{}\n", lbm ? "---|---|---|" : "");
+  std::vector<Real> x, yi, yb, yp, yl;
   for (const auto& p : pts) {
-    fmt::format_to(out, "| {} | {} | {} | {} | {} | {} | {} | {:.1f} | {} | {:.1f} | {} | {} / {} / {} |\n", mpa(p.sigma_H),
+    fmt::format_to(out, "| {} | {} | {} | {} | {} | {} | {} | {:.1f} | {} | {:.1f} | {} | {} / {} / {} |", mpa(p.sigma_H),
                    mpa(p.sigma_h), mpa(p.sleeve_initiation), mpa(p.sleeve_breakdown), mpa(p.penetrating_breakdown),
                    mpa(hubbert_willis(p.sigma_H, p.sigma_h, T)), mpa(haimson_fairhurst(p.sigma_H, p.sigma_h, T, 0)),
                    p.sleeve_azimuth_deg, p.particles, p.wall_time_s, p.packings, mpa(p.initiation_range),
                    mpa(p.breakdown_range), mpa(p.penetrating_range));
+    if (lbm) fmt::format_to(out, " {} | {} | {} |", mpa(p.lbm_initiation), mpa(p.lbm_breakdown), mpa(p.lbm_range));
+    fmt::format_to(out, "\n");
     x.push_back(p.sigma_h);
     yi.push_back(p.sleeve_initiation);
     yb.push_back(p.sleeve_breakdown);
     yp.push_back(p.penetrating_breakdown);
+    yl.push_back(p.lbm_breakdown);
   }
   const Real sH = pts.empty() ? 0 : pts.front().sigma_H;
   fmt::format_to(out, "\nPressures in MPa (means over the packings; azimuth and wall time: the first packing's). Straight lines P = slope x sigma_h + offset through the points:\n\n");
@@ -86,6 +97,7 @@ std::string breakdown_report(const std::vector<BreakdownPoint>& pts, const Sweep
   line("initiation, sleeve (vs H&W)", yi, 3, T - sH);
   line("breakdown, sleeve (vs H&W)", yb, 3, T - sH);
   line("breakdown, penetration (vs H&F, eta = 0)", yp, 1.5, 0.5 * (T - sH));
+  if (lbm) line("breakdown, LBM fluid (vs H&F, eta = 0)", yl, 1.5, 0.5 * (T - sH));
   fmt::format_to(out,
                  "\n**Why the DEM differs.** (1) *Sample and grain size*: the hole is only a few grains across. The "
                  "wall's hoop tension is carried by a ring of grains, so it fails when the tension on a grain-sized zone, "
@@ -102,7 +114,13 @@ std::string breakdown_report(const std::vector<BreakdownPoint>& pts, const Sweep
                  "change), the eta = 0 end of their formula (slope 1.5). (5) *Rate and boundaries*: the ramp is "
                  "quasi-static (a 4 times slower ramp changed one breakdown pressure by 5%, docs/hydrofrac.md); the "
                  "block is about 4 borehole radii from the hole's axis to its faces, held by servo walls, which raises "
-                 "the hoop stresses near the wall by a few per cent over Kirsch's infinite plate.\n");
+                 "the hoop stresses near the wall by a few per cent over Kirsch's infinite plate.{}\n",
+                 lbm ? " (6) *The LBM fluid* loads the wall as the sleeve does, but the crack faces only where the fluid "
+                       "has reached them through cell-wide openings: it is a penetrating fluid with a lag, so its "
+                       "breakdown belongs between the two sleeve columns, nearer the penetrating one the slower the "
+                       "ramp against the viscous filling of the cracks (docs/hydrofrac.md, the LBM against both sleeves "
+                       "at three ramps)."
+                     : "");
   return s;
 }
 

@@ -1,6 +1,7 @@
 // Classical borehole breakdown pressures and the comparison of a sweep over sigma_h with them
 // (`fracflow validate-hydrofrac` writes docs/validation/hydrofrac.md from these).
 #pragma once
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -34,10 +35,13 @@ struct BreakdownPoint {
   // Over the packings of the point (the pressures above are their means): max - min [Pa].
   int packings = 1;
   Real initiation_range = 0, breakdown_range = 0, penetrating_range = 0;
+  // The same blocks with the lattice Boltzmann fluid (injection.fluid = "lbm"; NaN: not run).
+  Real lbm_breakdown = NAN, lbm_initiation = NAN, lbm_range = NAN;
 };
 struct SweepContext {
   Real tensile_strength = 0;      // measured by the direct-tension driver [Pa]
   std::string tension_run, block, command, date, machine;
+  std::string lbm_fluid;          // the LBM runs' fluid in words (empty: none run)
   Real ramp_rate = 0, hole_radius = 0, grain_radius = 0;
 };
 // The report (markdown): the table, the fits against both theories, the differences explained.

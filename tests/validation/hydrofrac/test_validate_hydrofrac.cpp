@@ -1,6 +1,6 @@
 // `fracflow validate-hydrofrac` end to end on a small sweep (2 values of sigma_h, one packing,
-// the unit tests' 560-disk block): it measures T by direct tension, runs the four blocks and
-// writes the report with the table, both fits and the figure's CSV.
+// the unit tests' 560-disk block): it measures T by direct tension, runs the six blocks (sleeve,
+// penetration, LBM fluid) and writes the report with the table, the fits and the figure's CSV.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -24,7 +24,8 @@ TEST(ValidateHydrofrac, SmallSweepWritesTheReport) {
   ss << f.rdbuf();
   const std::string text = ss.str();
   for (const char* part : {"T = ", "| 4.00 | 1.00 |", "| 4.00 | 4.00 |", "initiation, sleeve (vs H&W)",
-                           "breakdown, penetration (vs H&F, eta = 0)", "Why the DEM differs"})
+                           "breakdown, penetration (vs H&F, eta = 0)", "breakdown, LBM fluid (vs H&F, eta = 0)",
+                           "**LBM fluid.**", "Why the DEM differs"})
     EXPECT_NE(text.find(part), std::string::npos) << part << "\n" << text;
   EXPECT_TRUE(fs::exists(out / "tension" / "summary.json"));
   EXPECT_TRUE(fs::exists(out / "breakdown.csv"));
