@@ -211,7 +211,6 @@ INSTANTIATE_TEST_SUITE_P(Seed003Validation, Seed003Table2, ::testing::ValuesIn(t
 // tau 1.5 -> 19.32, TRT tau 3.5 (U = 0.1) -> 19.35, BGK tau 3.5 -> 17.32 (+4.3% from the IBM column,
 // +2.8% from the seed's): the seed's Re = 1 value carries BGK's tau-dependent wall error, so this row
 // is not a target for the (tau-independent) TRT result.
-#ifdef FRACFLOW_LONG_TESTS
 namespace {
 
 struct Table3Row {
@@ -265,12 +264,19 @@ TEST_P(Seed003Table3, Drag) {
   }
 }
 
+// make test: Re = 20 at D = 10 for each scheme (15,000 steps, ~7 s each; measured 2026-11-29: C_d
+// 2.4107 / 2.4480 / 2.4290, +2.00 / +3.58 / +2.77 % from the IBM column for PSM / stair-wise /
+// interpolated). The long label: every row at D = 20 (the seed's) and 10.
 std::vector<Table3Param> table3_params() {
   std::vector<Table3Param> v;
+#ifdef FRACFLOW_LONG_TESTS
   for (ParticleScheme s : kAll)
     for (int i = 0; i < 5; ++i) v.push_back({s, i, 400});
   for (ParticleScheme s : kAll)
     for (int i = 0; i < 5; ++i) v.push_back({s, i, 200});
+#else
+  for (ParticleScheme s : kAll) v.push_back({s, 2, 200});
+#endif
   return v;
 }
 
@@ -281,4 +287,3 @@ INSTANTIATE_TEST_SUITE_P(Seed003Validation, Seed003Table3, ::testing::ValuesIn(t
                          });
 
 }  // namespace
-#endif  // FRACFLOW_LONG_TESTS
