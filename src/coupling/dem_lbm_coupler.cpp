@@ -272,23 +272,29 @@ void DemLbmCoupler<L, T>::step(bool sample_fluid) {
 
 template <class L, class T>
 Vec3 DemLbmCoupler<L, T>::fluid_momentum() const {
-  // From the populations of the state before the next step (AA pattern: even t: g_q(x) in f[q][x];
-  // odd t: in f[opp q][x - c_q], so the box sum is -sum c_p f[p]); exact in a periodic box.
+  // From the populations of the state before the next step, over the fluid cells (not the static
+  // solids nor the particles' solid cells of the bounce-back schemes, whose populations are the
+  // particles' own): AA pattern, even t: g_q(x) in f[q][x]; odd t: in f[opp q][x - c_q].
   const auto& g = fluid_.grid();
   const auto& f = fluid_.populations();
+  const auto* mb = fluid_.moving_boundary();
   const lbm::CellIndex N = g.padded_size();
+  const bool odd = fluid_.time_step() % 2 != 0;
   long double P[3] = {0, 0, 0};
   for (int z = 0; z < g.nz; ++z)
     for (int y = 0; y < g.ny; ++y)
       for (int x = 0; x < g.nx; ++x) {
-        if (fluid_.is_solid(x, y, z)) continue;
-        for (int q = 1; q < L::Q; ++q)
-          for (int a = 0; a < L::D; ++a) P[a] += (long double)(L::c[q][a]) * f[std::size_t(q * N + g.index(x, y, z))];
+        const lbm::CellIndex i = g.index(x, y, z);
+        if (fluid_.is_solid(x, y, z) || (mb && mb->solid(i))) continue;
+        for (int q = 1; q < L::Q; ++q) {
+          const T v = odd ? f[std::size_t(L::opp[q] * N + g.neighbour(x, y, z, -L::c[q][0], -L::c[q][1], -L::c[q][2]))]
+                          : f[std::size_t(q * N + i)];
+          for (int a = 0; a < L::D; ++a) P[a] += (long double)(L::c[q][a]) * v;
+        }
       }
-  const double sign = fluid_.time_step() % 2 == 0 ? 1.0 : -1.0;
   const auto& u = scales_.units;
   const double scale = u.rho() * std::pow(dx_, L::D) * u.velocity_factor();
-  return sign * scale * Vec3(double(P[0]), double(P[1]), double(P[2]));
+  return scale * Vec3(double(P[0]), double(P[1]), double(P[2]));
 }
 
 template class DemLbmCoupler<lbm::D2Q9, double>;

@@ -39,11 +39,13 @@ inline void add_particle(dem::DemSystem& s, const Vec3& x, double r, const Vec3&
 
 template <class L>
 lbm::Solver<L, double> make_fluid(const FluidScales& sc, int nx, int ny, int nz, std::array<bool, 3> periodic,
-                                  lbm::PsmWeighting w = lbm::PsmWeighting::TauDependent) {
+                                  lbm::PsmWeighting w = lbm::PsmWeighting::TauDependent,
+                                  lbm::ParticleScheme scheme = lbm::ParticleScheme::Psm) {
   lbm::Grid g(L::D, nx, ny, nz, periodic);
   lbm::SolverSettings st;
   st.tau = sc.units.tau();
   st.psm_weighting = w;
+  st.particle_scheme = scheme;
   return lbm::Solver<L, double>(g, st);
 }
 
