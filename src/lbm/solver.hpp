@@ -173,6 +173,10 @@ class Solver {
   // f = f^eq(rho, u) on each listed interior cell that is not covered(); returns the mass added,
   // sum (rho - rho_before) over those cells (lattice units).
   double impose_equilibrium(const std::vector<std::array<int, 3>>& cells, double rho, const Vec3& u);
+  // The same with a velocity per cell, u_scale * u_dir[k] on cells[k] (a velocity source such as the
+  // hydrofrac's injection box).
+  double impose_equilibrium(const std::vector<std::array<int, 3>>& cells, double rho, const std::vector<Vec3>& u_dir,
+                            double u_scale);
 
   // Convective outflow: the speed U of the face's last step (set or the mean outflow speed).
   double outflow_velocity(int face) const { return double(convective_u_[face]); }

@@ -115,11 +115,14 @@ std::string breakdown_report(const std::vector<BreakdownPoint>& pts, const Sweep
                  "quasi-static (a 4 times slower ramp changed one breakdown pressure by 5%, docs/hydrofrac.md); the "
                  "block is about 4 borehole radii from the hole's axis to its faces, held by servo walls, which raises "
                  "the hoop stresses near the wall by a few per cent over Kirsch's infinite plate.{}\n",
-                 lbm ? " (6) *The LBM fluid* loads the wall as the sleeve does, but the crack faces only where the fluid "
-                       "has reached them through cell-wide openings: it is a penetrating fluid with a lag, so its "
+                 lbm ? " (6) *The LBM fluid* pushes on every grain surface it wets: besides the wall it fills the "
+                       "gaps between wall grains that are a lattice cell wide and pushes their flanks apart, so its "
+                       "initiation can come before the sleeve's; it reaches the faces of a new crack only through "
+                       "cell-wide openings and as fast as viscous flow allows, a penetrating fluid with a lag, so its "
                        "breakdown belongs between the two sleeve columns, nearer the penetrating one the slower the "
-                       "ramp against the viscous filling of the cracks (docs/hydrofrac.md, the LBM against both sleeves "
-                       "at three ramps)."
+                       "ramp against the filling of the cracks (docs/hydrofrac.md, the LBM against both sleeves at "
+                       "three ramps). With only the lattice's pore space in the rock (no matrix permeability) there "
+                       "is no poroelastic term."
                      : "");
   return s;
 }

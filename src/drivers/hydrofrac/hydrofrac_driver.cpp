@@ -238,6 +238,7 @@ void HydrofracRun::make_fluid() {
   l.ramp_rate = s.ramp_rate;
   l.initial_pressure = s.initial_pressure;
   l.flow_rate = s.flow_rate;
+  l.velocity_box = cfg.string("injection.lbm_source") == "velocity_box";
   l.cell = s.cell;
   l.inflate = s.inflate;
   l.reach = s.reach;

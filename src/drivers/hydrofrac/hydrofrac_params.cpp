@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -136,6 +137,11 @@ void declare_params(ParamTable& t) {
   t.real("injection.ramp_rate", 1e10, "Pa/s", "pressure rise rate (ramp mode)").positive();
   t.real("injection.initial_pressure", 0, "Pa", "borehole pressure when injection starts").non_negative();
   t.real("injection.rate", 1e-3, "m^3/s", "pumped volume rate (rate mode; 2D: per metre of thickness)").positive();
+  t.string("injection.lbm_source", "mass",
+           "rate mode with the LBM fluid: how the pumped fluid enters: mass (a source spread over the hole's cells, "
+           "the rate exact) or velocity_box (seed 003 Sec. 4.1: a square box of half the hole's radius on its axis "
+           "whose cells carry the outward velocity that pumps the rate; docs/hydrofrac.md)")
+      .one_of({"mass", "velocity_box"});
   t.real("injection.fluid_bulk_modulus", 2.2e9, "Pa", "fluid bulk modulus K_f (water 2.2e9): dp/dt = K_f/V (Q - dV/dt)").positive();
   t.boolean("injection.penetration", false,
             "fluid enters cracks connected to the hole (pressure on their faces); false: sleeve test, the wall only");
@@ -209,9 +215,26 @@ void validate_scenario(const Config& cfg) {
              fmt::format("{} Pa is not below network.pore_pressure = {} Pa: every pore would start cavitated (water at "
                          "20 C: 2.34e3 Pa; 0 lets the liquid take any tension)",
                          cfg.real("network.vapour_pressure"), cfg.real("network.pore_pressure")));
+  if (cfg.string("injection.lbm_source") == "velocity_box" &&
+      (cfg.string("injection.fluid") != "lbm" || cfg.string("injection.mode") != "rate"))
+    cfg.fail("injection.lbm_source", "velocity_box is the LBM fluid's rate-mode source: it needs injection.fluid = \"lbm\" "
+                                     "and injection.mode = \"rate\"");
   // The fluid's own checks (tau, Mach, density variation; the DEM step rounds dt_lbm later).
   if (cfg.string("injection.fluid") == "lbm") {
-    (void)coupling::derive_scales(lbm_fluid_spec(cfg));
+    const coupling::FluidScales sc = coupling::derive_scales(lbm_fluid_spec(cfg));
+    if (cfg.string("injection.lbm_source") == "velocity_box") {
+      // The box's side speed U: the rate over its perimeter (2D: per metre; 3D: the block's height);
+      // its corners move at sqrt(2) U.
+      const Real b = 0.5 * cfg.real("borehole.radius");
+      const Real depth = cfg.integer("dem.dim") == 3 ? cfg.real("sample.height") : 1.0;
+      const Real U = cfg.real("injection.rate") / (8 * b * depth);
+      const Real mach = std::sqrt(2.0) * U / sc.sound_speed;
+      if (mach > coupling::kWarnMach)
+        cfg.fail("injection.rate", fmt::format("{} m^3/s through the injection box (half-side {} m) moves its corners at "
+                                               "Mach {:.3g} (limit {}): lower the rate, raise fluid.bulk_modulus, or use "
+                                               "injection.lbm_source = \"mass\"",
+                                               cfg.real("injection.rate"), b, mach, coupling::kWarnMach));
+    }
     // `fracflow check` prints the LBM and DEM steps from the set-up (HydrofracRun::run), which
     // builds the sample once; here only the fluid's own keys.
   }

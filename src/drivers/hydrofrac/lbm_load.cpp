@@ -95,6 +95,7 @@ class LbmLoad final : public LbmLoadBase {
     st_.mass0 = lattice_mass();
     const double rho_b = info_.scales.lattice_density(s_.initial_pressure);
     st_.injected += fluid_->impose_equilibrium(hole_cells_, rho_b, Vec3::Zero()) * cell_volume();
+    st_.injected0 = st_.injected;
     measure_face_pressures();
     if (s_.moving_walls)
       log::warn("fluid.moving_walls = true: the particles' velocities enter the bounce-back walls; with explicit coupling "
@@ -262,8 +263,10 @@ class LbmLoad final : public LbmLoadBase {
     long dem_steps = 0, lbm_steps = 0;
     long set_changes = 0;  // LBM steps that handed the solver a new particle set
     double max_mach = 0;   // largest |u| / c_s over the fluid cells, sampled every kMachEvery LBM steps
+    Real injected0 = 0;    // injected volume once the hole stood at the initial pressure [m^3]
   };
   static constexpr long kMachEvery = 20;
+  static constexpr double kBoxRelax = 20;  // LBM steps over which the velocity box makes up a volume owed
 
   double cell_volume() const { return std::pow(s_.fluid.dx, L::D); }  // 2D: per metre
 
@@ -309,6 +312,33 @@ class LbmLoad final : public LbmLoadBase {
         }
     if (hole_cells_.empty())
       throw InputError(fmt::format("fluid.dx: {} m is too coarse: no lattice cell centre lies in the borehole", dx));
+    // The velocity box: hole cells within half-side b of the axis, velocity direction (x - c) / b per
+    // axis (div = 2 / b: the outflow U x perimeter leaves through the box's sides); the rest of the
+    // hole gives the box's density.
+    box_cells_.clear();
+    box_dir_.clear();
+    box_rest_.clear();
+    if (s_.rate_mode && s_.velocity_box) {
+      const double b = s_.box_fraction * hole_.radius;
+      for (const auto& c : hole_cells_) {
+        const Vec3 xs = info_.origin + dx * Vec3(c[0], c[1], L::D == 3 ? c[2] : 0);
+        const double ex = (xs.x() - hole_.centre.x()) / b, ey = (xs.y() - hole_.centre.y()) / b;
+        if (std::abs(ex) <= 1 && std::abs(ey) <= 1) {
+          box_cells_.push_back(c);
+          box_dir_.push_back(Vec3(ex, ey, 0));
+        } else {
+          box_rest_.push_back(c);
+        }
+      }
+      const double per_side = 2 * b / dx;
+      if (per_side < 4)
+        throw InputError(fmt::format("fluid.dx: {} m leaves the injection box (half-side {} m, half the hole's radius) "
+                                     "{:.2g} cells wide; it needs at least 4 (refine fluid.dx or use "
+                                     "injection.lbm_source = \"mass\")",
+                                     dx, b, per_side));
+      // The box's outflow per unit U (lattice units: volume per step over the box's cells' divergence).
+      box_outflow_ = double(box_cells_.size()) * 2.0 / (b / dx);
+    }
     face_cells_.clear();
     if (s_.drained_faces)
       for (int z = 0; z < g.nz; ++z)
@@ -393,6 +423,27 @@ class LbmLoad final : public LbmLoadBase {
       st_.pressure = pressure_now(t_end);
       st_.injected += fluid_->impose_equilibrium(hole_cells_, info_.scales.lattice_density(st_.pressure), Vec3::Zero()) *
                       cell_volume();
+    } else if (s_.velocity_box) {
+      // Seed 003 Sec. 4.1: the box's cells at the density of the hole around it and an outward velocity
+      // whose flux U x (box's divergence) carries the pumped volume (at reference density) per step;
+      // the mass the imposition adds is what left the box since the last step.
+      double mass = 0;
+      long nf = 0;
+      for (const auto& c : box_rest_.empty() ? box_cells_ : box_rest_)
+        if (!fluid_->covered(c[0], c[1], c[2])) {
+          mass += fluid_->cell_density(c[0], c[1], c[2]);
+          ++nf;
+        }
+      const double rho_b = nf > 0 ? mass / double(nf) : 1.0;
+      // The box at the nominal U pumps more than U x its divergence (its edge cells also meet the slower
+      // fluid outside: +25 % on the Fig. 9 block), so U follows the volume still owed against Q t,
+      // relaxed over kBoxRelax steps: the pumped volume tracks Q t within a few steps' worth.
+      const double step_volume = s_.flow_rate * dt;
+      const double owed = st_.injected0 + s_.flow_rate * (t_end - st_.t0) - st_.injected;
+      const double U = std::max(0.0, 1.0 + owed / (kBoxRelax * step_volume)) * step_volume / cell_volume() /
+                       (rho_b * box_outflow_);
+      st_.injected += fluid_->impose_equilibrium(box_cells_, rho_b, box_dir_, U) * cell_volume();
+      st_.pressure = info_.scales.pressure(rho_b);
     } else {
       double mass = 0;
       long nf = 0;
@@ -517,6 +568,9 @@ class LbmLoad final : public LbmLoadBase {
   std::vector<Index> wall_, id_index_;
   std::unique_ptr<Solver> fluid_;
   std::vector<std::array<int, 3>> hole_cells_;
+  std::vector<std::array<int, 3>> box_cells_, box_rest_;  // the velocity box's cells; the hole's others
+  std::vector<Vec3> box_dir_;                             // per box cell: its velocity / U
+  double box_outflow_ = 0;                                // lattice volume per step per unit U
   std::vector<std::array<int, 3>> face_cells_;  // the lattice's outer layer (drained faces only)
   lbm::ParticleSet set_;
   std::vector<Vec3> force_, torque_;

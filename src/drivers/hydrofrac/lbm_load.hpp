@@ -42,6 +42,11 @@ struct LbmSettings {
   lbm::PsmWeighting psm_weighting = lbm::PsmWeighting::TauDependent;
   bool rate_mode = false;
   Real ramp_rate = 0, initial_pressure = 0, flow_rate = 0;  // [Pa/s], [Pa], [m^3/s] (2D: per metre)
+  // Rate mode: the pumped fluid enters as a mass source spread over the hole's cells (false) or
+  // through a velocity box in the hole (seed 003 Sec. 4.1: a square of half-side box_fraction x the
+  // hole's radius about its axis whose cells carry f^eq at the outward velocity that gives the rate).
+  bool velocity_box = false;
+  Real box_fraction = 0.5;
   Real cell = 0, inflate = 0, reach = 0;                    // wall particles (hole_surface)
   bool moving_walls = false;  // particle velocities enter bounce-back (false: quasi-static walls)
   bool drained_faces = false;  // fluid.faces = "drained": the lattice's outer layer held at p0
