@@ -146,6 +146,41 @@ TEST(HydrofracLbm, VelocityBoxPumpsTheRateAsTheMassSource) {
   EXPECT_NE(r.output.find("injection.lbm_source"), std::string::npos) << r.output;
 }
 
+// The hydrofrac driver with the other bond law, seed 002's 6-DOF rotational bond (its lattice solid;
+// tensile strength c / tan(phi) = 17.3 MPa here), on the same block: a breakdown found and the first
+// cracks at the hole's wall, with the sleeve and with the LBM fluid. Measured 2026-11-29: sleeve
+// breakdown 25.4 MPa, LBM 14.1 MPa (initiation 13.2), the first cracks 3.1 mm from the axis (wall at
+// 2.49 mm); the rotational bonds fail in shear here (cohesion 10 MPa below their tension).
+TEST(HydrofracLbm, RotationalBondsBreakFromTheHole) {
+  Scratch s;
+  std::string text = kBlock;
+  auto replace = [&](const std::string& a, const std::string& b) {
+    const auto at = text.find(a);
+    ASSERT_NE(at, std::string::npos) << a;
+    text.replace(at, a.size(), b);
+  };
+  replace("bond_law = \"parallel\"", "bond_law = \"rotational\"");
+  {  // the parallel bond's table -> the rotational bond's
+    const auto from = text.find("[dem.bond.matrix-matrix]"), to = text.find("friction_angle = 4.0", from);
+    ASSERT_TRUE(from != std::string::npos && to != std::string::npos);
+    text.replace(from, to + std::string("friction_angle = 4.0").size() - from,
+                 "[dem.bond.matrix-matrix]\nyoungs_modulus = 2.09e9\npoisson_ratio = 0.25\ncohesion = 10e6\nfriction_angle = 30.0");
+  }
+  const fs::path file = s.write("rotational.toml", text);
+  for (const char* fluid : {"sleeve", "lbm"}) {
+    // (the LBM block's 25 MPa cap is its fluid's density limit; the sleeve has none)
+    const auto j = run_scenario(file, s / fluid, fmt::format(" --set injection.fluid=\"{}\"{}", fluid,
+                                                              std::string(fluid) == "sleeve" ? " --set injection.max_pressure=40e6" : ""));
+    ASSERT_TRUE(j["breakdown"]["pressure_Pa"].is_number()) << fluid << j["breakdown"].dump();
+    const double a = j["borehole"]["effective_radius_m"].get<double>();
+    const auto d = ff::test::first_crack_distances(s / fluid / "cracks.csv", 12e-3, 12e-3, 3);
+    ASSERT_EQ(d.size(), 3u) << fluid;
+    std::printf("rotational bonds, %s: breakdown %.2f MPa, first cracks at %.2f / %.2f / %.2f mm (wall %.2f mm)\n", fluid,
+                1e-6 * j["breakdown"]["pressure_Pa"].get<double>(), 1e3 * d[0], 1e3 * d[1], 1e3 * d[2], 1e3 * a);
+    for (double x : d) EXPECT_LT(x, a + 4 * 0.6e-3) << fluid << ": a first crack away from the hole";
+  }
+}
+
 // The same block with the partially saturated cells (fluid.scheme = "psm"), stopped at step 3000 and
 // resumed: the solid fractions of the last particle set handed to the solver come back with the
 // checkpoint, so the resumed run's series and cracks are the whole run's, byte for byte.
