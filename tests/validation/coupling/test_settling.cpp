@@ -1,4 +1,5 @@
-// A sphere settling under gravity through the coupled DEM-LBM path (src/coupling, PSM):
+// A sphere settling under gravity through the coupled DEM-LBM path (src/coupling; PSM, and the
+// moving bounce-back schemes in the periodic box):
 //  - fast: a sphere in a periodic box at low Reynolds number against Stokes drag with the
 //    finite-box (periodic array) correction of Hasimoto (1959), J. Fluid Mech. 5:317, with the
 //    coefficients of Sangani & Acrivos (1982), Int. J. Multiphase Flow 8:343;
@@ -28,7 +29,8 @@ using namespace ff::coupling::test;
 // Tolerance 8%: PSM's drag at a = 6 cells, tau = 0.7 is low by about 4% (docs/lbm.md: -7.1%,
 // -2.8% at a = 5.0, 7.4; Zick & Homsy), which raises the settling speed by as much, plus the
 // Reynolds number 0.1 (Oseen: +2% drag unbounded, less in an array).
-TEST(Settling, PeriodicBoxAgainstHasimoto) {
+// Returns the relative error of the settling speed; `scheme` the particles' coupling.
+double hasimoto_error(lbm::ParticleScheme scheme) {
   const int n = 36;
   const double a_cells = 6, dx = 1e-3;
   FluidSpec fs;
@@ -42,7 +44,7 @@ TEST(Settling, PeriodicBoxAgainstHasimoto) {
   const double K = 1.0 / (1 - 1.7601 * std::cbrt(phi) + phi - 1.5593 * phi * phi);
   const double U_lb = 0.0005, U_ref = U_lb * sc.units.velocity_factor();
   const double g = U_ref * 6 * M_PI * mu * a * K / ((rho_s - fs.density) * V);
-  auto fluid = make_fluid<lbm::D3Q19>(sc, n, n, n, {true, true, true});
+  auto fluid = make_fluid<lbm::D3Q19>(sc, n, n, n, {true, true, true}, lbm::PsmWeighting::TauDependent, scheme);
   // Body force density balancing the net weight (rho_s - rho_f) V g over the box.
   fluid.set_body_force(Vec3(0, 0, sc.units.to_lattice_force_density((rho_s - fs.density) * V * g / Vbox)));
   fluid.finalize();
@@ -64,17 +66,29 @@ TEST(Settling, PeriodicBoxAgainstHasimoto) {
     c.step();
     if (t % 500 == 0) {
       U_prev = U;
-      U = -(dem.particles.vel[0].z() - c.fluid_momentum().z() / (fs.density * Vbox));
+      // (the bounce-back schemes' fluid momentum leaves out the sphere's cells, which move with it)
+      const double inside = scheme == lbm::ParticleScheme::Psm ? 0.0 : V * dem.particles.vel[0].z();
+      U = -(dem.particles.vel[0].z() - (c.fluid_momentum().z() / fs.density + inside) / Vbox);
     }
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double Re = U * 2 * a / fs.viscosity, err = U / U_ref - 1;
-  std::printf("settling in a periodic box: phi = %.4f, K = %.4f, U = %.5g m/s, reference %.5g m/s, error %+.2f%%, "
+  std::printf("%s, settling in a periodic box: phi = %.4f, K = %.4f, U = %.5g m/s, reference %.5g m/s, error %+.2f%%, "
               "last change %.1e, Re = %.3f, %.1f s\n",
-              phi, K, U, U_ref, 100 * err, std::abs(U - U_prev) / U, Re, wall);
-  EXPECT_LT(std::abs(U - U_prev), 0.005 * U);  // settled
-  EXPECT_LT(std::abs(err), 0.08);
+              lbm::particle_scheme_name(scheme), phi, K, U, U_ref, 100 * err, std::abs(U - U_prev) / U, Re, wall);
+  // settled (the bounce-back spheres' speed flickers by ~0.5 % as cells are covered and refilled)
+  EXPECT_LT(std::abs(U - U_prev), (scheme == lbm::ParticleScheme::Psm ? 0.005 : 0.01) * U);
   EXPECT_LT(Re, 0.12);
+  return err;
+}
+TEST(Settling, PeriodicBoxAgainstHasimoto) { EXPECT_LT(std::abs(hasimoto_error(lbm::ParticleScheme::Psm)), 0.08); }
+// The same sphere with the moving bounce-back schemes (solid cells, links, covering and refill as it
+// moves). Tolerance 8 % as for the PSM (the stair-wise sphere's effective radius differs from a by a
+// fraction of a cell: Zick & Homsy in docs/lbm.md, +2..+4 % at a = 5). Measured 2026-11-29: +0.27 %
+// (stair-wise), +2.48 % (interpolated); PSM +4.72 %.
+TEST(Settling, PeriodicBoxAgainstHasimotoWithBounceBack) {
+  for (lbm::ParticleScheme s : {lbm::ParticleScheme::StairwiseBounceBack, lbm::ParticleScheme::InterpolatedBounceBack})
+    EXPECT_LT(std::abs(hasimoto_error(s)), 0.08) << lbm::particle_scheme_name(s);
 }
 #else
 // ten Cate et al. (2002) Table 1 (rho_f [kg/m^3], mu [Pa s], u_inf [m/s], Re): E1 970, 0.373, 0.038,
