@@ -120,6 +120,32 @@ TEST(HydrofracNetwork, PressurePredictionKeepsTheBreakdownPressure) {
   EXPECT_NEAR(c2, c1, 0.2 * c1);
 }
 
+// Natural fractures in 3D (vertical discs, seed 003 Sec. 4.3's joints as zero-strength bonds): from the
+// generator and from a file they cut bonds, a disc cuts more the larger it is, and one outside the
+// block cuts none. The sleeve to 5 MPa (no breakdown needed). Measured 2026-11-29: 35 bonds by 4
+// generated discs; a disc at y = 8.5 mm: 68 bonds (10 mm), 5 (3 mm), 0 (outside).
+TEST(HydrofracNetwork, NaturalFractureDiscsCutBonds3D) {
+  Scratch s;
+  const fs::path file = small_block(s);
+  const std::string sets = kSmallBlock + " --set injection.max_pressure=5e6";
+  auto cut = [&](const std::string& name, const std::string& more) {
+    const auto j = run_scenario(file, s / name, sets + more);
+    return j["borehole"]["natural_fracture_bonds"].get<long>();
+  };
+  const long generated = cut("gen", " --set dfn.count=4 --set dfn.buffer=1e-3");
+  s.write("big.csv", "x_m,y_m,z_m,angle_deg,length_m\n0.006,0.0085,0.002,0,0.010\n");
+  s.write("small.csv", "x_m,y_m,z_m,angle_deg,length_m\n0.006,0.0085,0.002,0,0.003\n");
+  s.write("outside.csv", "x_m,y_m,z_m,angle_deg,length_m\n0.006,0.0085,0.020,0,0.003\n");
+  const long big = cut("big", " --set dfn.file=\"big.csv\""), small = cut("small", " --set dfn.file=\"small.csv\""),
+             outside = cut("outside", " --set dfn.file=\"outside.csv\"");
+  std::printf("3D natural fractures: %ld bonds cut by 4 generated discs; one disc at y = 8.5 mm: %ld (10 mm), %ld (3 mm), "
+              "%ld (outside the block)\n", generated, big, small, outside);
+  EXPECT_GT(generated, 0);
+  EXPECT_GT(small, 0);
+  EXPECT_GT(big, 2 * small);
+  EXPECT_EQ(outside, 0);
+}
+
 // One and two threads give the same files, bit for bit, through the breakdown: a 16 x 16 x 4 mm block
 // (~1,040 spheres, 6,145 pores: above porenet::kParallelMin, so the network's loops, the multigrid
 // smoother's blocks and the prediction run on both threads; every DEM loop over 200 items too), with
