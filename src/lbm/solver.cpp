@@ -544,41 +544,37 @@ double Solver<L, T>::cell_density(int x, int y, int z) const {
 }
 
 template <class L, class T>
-double Solver<L, T>::impose_equilibrium(const std::vector<std::array<int, 3>>& cells, double rho, const Vec3& u) {
+double Solver<L, T>::put_equilibrium(const std::array<int, 3>& x, const T* geq, double rho) {
+  const double added = rho - cell_density(x[0], x[1], x[2]);
   const bool odd = (time_ & 1) != 0;
-  const CellIndex N = n_();
+  const CellIndex N = n_(), c = grid_.index(x[0], x[1], x[2]);
+  f_[c] = geq[0];
+  for (int q = 1; q < Q; ++q)
+    f_[odd ? L::opp[q] * N + grid_.neighbour(x[0], x[1], x[2], -L::c[q][0], -L::c[q][1], -L::c[q][2]) : q * N + c] = geq[q];
+  return added;
+}
+
+template <class L, class T>
+double Solver<L, T>::impose_equilibrium(const std::vector<std::array<int, 3>>& cells, double rho, const Vec3& u) {
   T geq[Q];
   const T uu[3] = {T(u.x()), T(u.y()), T(u.z())};
   equilibrium<L, T>(T(rho), uu, geq, settings_.incompressible);
   double added = 0;
-  for (const auto& x : cells) {
-    if (covered(x[0], x[1], x[2])) continue;
-    added += rho - cell_density(x[0], x[1], x[2]);
-    const CellIndex c = grid_.index(x[0], x[1], x[2]);
-    f_[c] = geq[0];
-    for (int q = 1; q < Q; ++q)
-      f_[odd ? L::opp[q] * N + grid_.neighbour(x[0], x[1], x[2], -L::c[q][0], -L::c[q][1], -L::c[q][2]) : q * N + c] = geq[q];
-  }
+  for (const auto& x : cells)
+    if (!covered(x[0], x[1], x[2])) added += put_equilibrium(x, geq, rho);
   return added;
 }
 
 template <class L, class T>
 double Solver<L, T>::impose_equilibrium(const std::vector<std::array<int, 3>>& cells, double rho,
                                         const std::vector<Vec3>& u_dir, double u_scale) {
-  const bool odd = (time_ & 1) != 0;
-  const CellIndex N = n_();
   T geq[Q];
   double added = 0;
   for (std::size_t k = 0; k < cells.size(); ++k) {
-    const auto& x = cells[k];
-    if (covered(x[0], x[1], x[2])) continue;
+    if (covered(cells[k][0], cells[k][1], cells[k][2])) continue;
     const T uu[3] = {T(u_scale * u_dir[k].x()), T(u_scale * u_dir[k].y()), T(u_scale * u_dir[k].z())};
     equilibrium<L, T>(T(rho), uu, geq, settings_.incompressible);
-    added += rho - cell_density(x[0], x[1], x[2]);
-    const CellIndex c = grid_.index(x[0], x[1], x[2]);
-    f_[c] = geq[0];
-    for (int q = 1; q < Q; ++q)
-      f_[odd ? L::opp[q] * N + grid_.neighbour(x[0], x[1], x[2], -L::c[q][0], -L::c[q][1], -L::c[q][2]) : q * N + c] = geq[q];
+    added += put_equilibrium(cells[k], geq, rho);
   }
   return added;
 }

@@ -189,6 +189,9 @@ class Solver {
   void restore(const std::vector<T>& f, long time_step);
 
  private:
+  // geq into the slots of interior cell x that the next step reads (AA pattern); returns rho minus the
+  // cell's density before (impose_equilibrium's mass).
+  double put_equilibrium(const std::array<int, 3>& x, const T* geq, double rho);
   struct Span {
     int x0, y, z, n;
   };

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -264,6 +265,24 @@ TEST(Psm, ComovingParticleAtAMovingWall) {
   std::printf("comoving at a wall: |F| / (6 pi mu a U) = %.2e\n", worst);
 }
 
+namespace {
+// A channel periodic along x between walls at y = -1/2 and ny - 1/2, tau 0.8, driven by the body force
+// fx along x, the fluid at rest.
+std::unique_ptr<Solver<D2Q9, double>> channel(int nx, int ny, double fx, ParticleScheme scheme = ParticleScheme::Psm) {
+  SolverSettings st;
+  st.tau = 0.8;
+  st.body_force = Vec3(fx, 0, 0);
+  st.particle_scheme = scheme;
+  auto sol = std::make_unique<Solver<D2Q9, double>>(Grid(2, nx, ny, 1, {true, false, true}), st);
+  sol->finalize();
+  sol->initialize([&](int, int, int, double& rho, Vec3& u) {
+    rho = 1;
+    u = Vec3::Zero();
+  });
+  return sol;
+}
+}  // namespace
+
 // The boundary-cell path with a disk fixed on a resting wall in a channel driven by a body force:
 // (1) the fluid in fully covered cells next to the wall follows the disk (u = 0 to 1e-3 of the
 // channel's peak speed, as in covered bulk cells), (2) momentum balance of every step,
@@ -272,17 +291,10 @@ TEST(Psm, ComovingParticleAtAMovingWall) {
 // (the walls' and the disk's booked share), (3) the disk takes the tangential share of the wall
 // links of its cells (x, along the flow), never a normal one.
 TEST(Psm, BoundaryCellsAtARestingWall) {
-  Grid g(2, 48, 24, 1, {true, false, true});
-  SolverSettings st;
-  st.tau = 0.8;
   const double fx = 1e-5;
-  st.body_force = Vec3(fx, 0, 0);
-  Solver<D2Q9, double> sol(g, st);
-  sol.finalize();
-  sol.initialize([&](int, int, int, double& rho, Vec3& u) {
-    rho = 1;
-    u = Vec3::Zero();
-  });
+  const auto owner = channel(48, 24, fx);
+  Solver<D2Q9, double>& sol = *owner;
+  const Grid& g = sol.grid();
   ParticleSet p;
   p.resize(1);
   p.radius[0] = 4.3;
@@ -338,17 +350,9 @@ namespace {
 // for a gap `gap` (cells) between them (each sinks 6 cells into its wall: no path past it there), driven by a body force along the periodic x: sum rho u_x
 // over the cross-section x = 2 (away from the disks).
 double throat_flux(ParticleScheme scheme, double gap) {
-  Grid g(2, 40, 60, 1, {true, false, true});
-  SolverSettings st;
-  st.tau = 0.8;
-  st.body_force = Vec3(1e-6, 0, 0);
-  st.particle_scheme = scheme;
-  Solver<D2Q9, double> sol(g, st);
-  sol.finalize();
-  sol.initialize([&](int, int, int, double& rho, Vec3& u) {
-    rho = 1;
-    u = Vec3::Zero();
-  });
+  const auto owner = channel(40, 60, 1e-6, scheme);
+  Solver<D2Q9, double>& sol = *owner;
+  const Grid& g = sol.grid();
   ParticleSet p;
   p.resize(2);
   p.radius[0] = p.radius[1] = 18;
