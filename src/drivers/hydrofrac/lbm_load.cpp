@@ -281,6 +281,18 @@ class LbmLoad final : public LbmLoadBase {
     return m;
   }
 
+  // Sum of rho over the listed cells that are fluid now; `nf` gets their count.
+  double uncovered_mass(const std::vector<std::array<int, 3>>& cells, long& nf) const {
+    double m = 0;
+    nf = 0;
+    for (const auto& c : cells)
+      if (!fluid_->covered(c[0], c[1], c[2])) {
+        m += fluid_->cell_density(c[0], c[1], c[2]);
+        ++nf;
+      }
+    return m;
+  }
+
   bool cell_of(const Vec3& x, int* c) const {
     const Vec3 xl = (x - info_.origin) / s_.fluid.dx;
     c[2] = 0;
@@ -427,13 +439,8 @@ class LbmLoad final : public LbmLoadBase {
       // Seed 003 Sec. 4.1: the box's cells at the density of the hole around it and an outward velocity
       // whose flux U x (box's divergence) carries the pumped volume (at reference density) per step;
       // the mass the imposition adds is what left the box since the last step.
-      double mass = 0;
       long nf = 0;
-      for (const auto& c : box_rest_.empty() ? box_cells_ : box_rest_)
-        if (!fluid_->covered(c[0], c[1], c[2])) {
-          mass += fluid_->cell_density(c[0], c[1], c[2]);
-          ++nf;
-        }
+      const double mass = uncovered_mass(box_rest_.empty() ? box_cells_ : box_rest_, nf);
       const double rho_b = nf > 0 ? mass / double(nf) : 1.0;
       // The box at the nominal U pumps more than U x its divergence (its edge cells also meet the slower
       // fluid outside: +25 % on the Fig. 9 block), so U follows the volume still owed against Q t,
@@ -445,13 +452,8 @@ class LbmLoad final : public LbmLoadBase {
       st_.injected += fluid_->impose_equilibrium(box_cells_, rho_b, box_dir_, U) * cell_volume();
       st_.pressure = info_.scales.pressure(rho_b);
     } else {
-      double mass = 0;
       long nf = 0;
-      for (const auto& c : hole_cells_)
-        if (!fluid_->covered(c[0], c[1], c[2])) {
-          mass += fluid_->cell_density(c[0], c[1], c[2]);
-          ++nf;
-        }
+      const double mass = uncovered_mass(hole_cells_, nf);
       if (nf > 0) {
         const double rho_b = (mass + s_.flow_rate * dt / cell_volume()) / double(nf);
         st_.injected += fluid_->impose_equilibrium(hole_cells_, rho_b, Vec3::Zero()) * cell_volume();

@@ -243,14 +243,16 @@ class PoreFluid {
     if (dim3_) band_ = drain_band(sys, info.axis);
     setup(cfg, info);
     if (dim3_) c3_.init(sys, params_3d(cfg));
-    else c2_.init(sys, coupling_params(cfg));    start_session();
+    else c2_.init(sys, coupling_params(cfg));
+    start_session();
   }
   void load(CheckpointReader& r, dem::DemSystem& sys, const Config& cfg, const dem::SampleInfo& info) {
     dim3_ = info.dim == 3;
     if (dim3_) band_ = r.get_value<DrainBand>("saturated.drain_band");
     setup(cfg, info);
     if (dim3_) c3_.load(r, sys, params_3d(cfg));
-    else c2_.load(r, sys, coupling_params(cfg));    start_session();
+    else c2_.load(r, sys, coupling_params(cfg));
+    start_session();
   }
   void save(CheckpointWriter& w) const {
     if (dim3_) {
