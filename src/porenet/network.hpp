@@ -96,12 +96,13 @@ struct Network2D {
   std::vector<Real> pore_cell;    // cell volume = area * t [m^3]
   std::vector<Real> pore_void;    // void volume V_i [m^3] (area minus disc sectors, times t)
   std::vector<Real> pore_cx, pore_cy, pore_cz;  // centroid [m] (pore_cz: 3D only)
+  std::vector<Real> pore_px, pore_py, pore_pz;  // 3D only: power centre [m] (the throats' length)
   std::vector<std::uint8_t> pore_hull;  // 1 if one of its edges is on the convex hull
   // channels
   std::vector<Index> ch_pore, ch_part;
   std::vector<ChannelKind> ch_kind;
   std::vector<Index> ch_pair;        // index into the PairList, -1 for T2T
-  std::vector<Real> ch_length;       // L: centroid-to-centroid distance [m]
+  std::vector<Real> ch_length;       // L: centroid-to-centroid distance (3D: power centres) [m]
   std::vector<Real> ch_edge;         // centre-to-centre edge length [m]
   std::vector<Real> ch_sin_omega;    // sin of the angle between edge and centre line
   std::vector<Real> ch_aperture;     // h [m]

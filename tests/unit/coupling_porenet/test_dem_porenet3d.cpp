@@ -265,17 +265,22 @@ TEST(CouplingPorenet3D, SubCyclingFromTheFluidStiffness) {
 // Pressure prediction between flow steps (Porenet3DParams::predict_pressures): a closed sample saturated
 // with water (K 2.2 GPa) at the DEM step that includes the fluid's stiffness (as saturated_ucs chooses
 // it), compacted at 0.05 m/s for 1000 DEM steps. The stiffness bound allows no stride, so the automatic
-// N would be 1; with the prediction it reaches the cap (20) and the storage-weighted mean pressure rise
-// at each flow step stays within 1 % (of the largest rise) of a flow step every DEM step at the same
-// step (measured 2026-11-29 over 2000 steps: 0.34 %, 8.8 kPa of 2.57 MPa). Held forces without the prediction at
-// N = 20 lag by far more (measured 29 %; asserted > 5 %). A checkpoint taken mid-cycle resumes
-// bit-for-bit (the prediction's state is saved; its multigrid is set up again from it), and 1 and 2
-// threads give the same state.
+// N would be 1; with the prediction it reaches the cap (20). The storage-weighted mean pressure rise is
+// compared at each flow step from step 200 on with a flow step every DEM step at the same step. The
+// reference itself oscillates about its trend (the stiff water and the grains ring under the platens:
+// rms 25 kPa = 2.7 % of the largest rise, measured 2026-11-29 with PFV's throat length), so the test
+// compares (1) the trends, straight lines fitted over those steps: slopes within 5 % (measured 2.4 %),
+// and (2) the scatter: the rms difference from the reference at most 1.5 x the reference's own rms
+// about its line (measured 1.06 x). Held forces without the prediction at N = 20 fail both by far
+// (asserted: rms difference above 5 x). A checkpoint taken mid-cycle resumes bit-for-bit (the
+// prediction's state is saved; its multigrid is set up again from it), and 1 and 2 threads give the
+// same state.
 TEST(CouplingPorenet3D, PressurePredictionLetsSaturatedSamplesStride) {
   const long steps = 1000;
   std::vector<Real> ref;
-  Real top = 0, worst[2] = {0, 0};
+  Real top = 0;
   long n_used[2] = {0, 0};
+  std::vector<Real> at[2], got[2], want[2];  // per variant: the flow steps >= 200, the rise there, the reference's
   for (int variant = 0; variant < 3; ++variant) {  // N = 1; auto with the prediction; N = 20 held
     auto s = specimen(0.05, 1);
     DemPorenet3D c;
@@ -292,17 +297,46 @@ TEST(CouplingPorenet3D, PressurePredictionLetsSaturatedSamplesStride) {
         ref.push_back(m);
         top = std::max(top, std::abs(m));
       } else if (c.stats().flow_steps > before && k >= 200) {
-        worst[variant - 1] = std::max(worst[variant - 1], std::abs(m - ref[static_cast<std::size_t>(k)]));
+        at[variant - 1].push_back(static_cast<Real>(k));
+        got[variant - 1].push_back(m);
+        want[variant - 1].push_back(ref[static_cast<std::size_t>(k)]);
       }
     }
     if (variant > 0) n_used[variant - 1] = c.stats().flow_every;
   }
-  std::printf("saturated, dt with the fluid's stiffness: largest mean rise %.6g Pa; predicted N %ld: worst |dp| %.4g Pa "
-              "(%.3g %%); held N %ld: %.4g Pa (%.3g %%)\n", top, n_used[0], worst[0], 100 * worst[0] / top, n_used[1],
-              worst[1], 100 * worst[1] / top);
+  // Least-squares line through (t, y): slope and the rms of the residuals.
+  auto line = [](const std::vector<Real>& t, const std::vector<Real>& y) {
+    const Real n = static_cast<Real>(t.size());
+    Real st = 0, sy = 0, stt = 0, sty = 0;
+    for (std::size_t i = 0; i < t.size(); ++i) {
+      st += t[i];
+      sy += y[i];
+      stt += t[i] * t[i];
+      sty += t[i] * y[i];
+    }
+    const Real slope = (n * sty - st * sy) / (n * stt - st * st), icpt = (sy - slope * st) / n;
+    Real r2 = 0;
+    for (std::size_t i = 0; i < t.size(); ++i) r2 += std::pow(y[i] - (icpt + slope * t[i]), 2);
+    return std::pair{slope, std::sqrt(r2 / n)};
+  };
+  Real slope_err[2], rms_ratio[2];
+  for (int v = 0; v < 2; ++v) {
+    ASSERT_GT(at[v].size(), 20u);
+    const auto [s_got, scatter_got] = line(at[v], got[v]);
+    const auto [s_want, scatter_want] = line(at[v], want[v]);
+    Real d2 = 0;
+    for (std::size_t i = 0; i < at[v].size(); ++i) d2 += std::pow(got[v][i] - want[v][i], 2);
+    slope_err[v] = std::abs(s_got / s_want - 1);
+    rms_ratio[v] = std::sqrt(d2 / static_cast<Real>(at[v].size())) / scatter_want;
+    std::printf("saturated, %s N %ld: slope %.5g Pa/step (reference %.5g, %.3g %%), rms difference %.4g x the "
+                "reference's scatter (%.4g Pa; largest rise %.6g Pa)\n", v == 0 ? "predicted" : "held", n_used[v],
+                s_got, s_want, 100 * slope_err[v], rms_ratio[v], scatter_want, top);
+    (void)scatter_got;
+  }
   EXPECT_EQ(n_used[0], 20);
-  EXPECT_LT(worst[0], 0.01 * top);
-  EXPECT_GT(worst[1], 0.05 * top);
+  EXPECT_LT(slope_err[0], 0.05);
+  EXPECT_LT(rms_ratio[0], 1.5);
+  EXPECT_GT(rms_ratio[1], 5.0);
 
   // Resume mid-cycle, and threads.
   auto prm = fluid(1.0, 2.2e9);

@@ -1,7 +1,10 @@
 // 3D PFV-style network (regular triangulation): void volumes, steady-flow mass balance and the
 // permeability of a random sphere packing against Kozeny–Carman, k_KC = phi^3 d^2 / (180 (1 - phi)^2)
 // (Carman 1937; c = 5, S0 = 6/d). Chareyre et al. (2012, Transp. Porous Media 94:595) report their
-// PFV permeabilities close to Kozeny–Carman for such packings; the ratio here is printed and bounded.
+// PFV permeabilities close to Kozeny–Carman for such packings (PFV's throat length: the distance between
+// the pores' power centres); the ratio here is printed and bounded to [0.5, 3] (measured 2026-11-29:
+// 1.51 / 2.11 / 1.38 at porosity 0.40 / 0.44 / 0.48; with the centroids' distance, as before that day,
+// 4.8 / 7.1 / 8.7, which the bound rejects).
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -115,9 +118,9 @@ TEST(PorenetNetwork3D, FourTouchingSpheresAndBoxFlow) {
   }
   const auto [lo, hi] = std::minmax_element(ratios.begin(), ratios.end());
   std::printf("3D k / k_KC from %.3f to %.3f\n", *lo, *hi);
-  EXPECT_LT(*hi / *lo, 3.0);
-  EXPECT_GT(*lo, 0.1);
-  EXPECT_LT(*hi, 10.0);
+  EXPECT_LT(*hi / *lo, 2.0);
+  EXPECT_GT(*lo, 0.5);
+  EXPECT_LT(*hi, 3.0);
 }
 
 // The patch force per unit pressure (forces.cpp) reads the vector the last geometry update stored for
