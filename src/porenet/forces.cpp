@@ -131,6 +131,40 @@ void unit_patch_force_3d(const Network2D& net, Index e, Real out[3]) {
   out[2] = a[2];
 }
 
+void add_shear_forces_3d(const Network2D& net, const Particles3D& p, std::span<const Real> P, std::span<Real> fx,
+                         std::span<Real> fy, std::span<Real> fz) {
+  const auto n = static_cast<std::size_t>(net.n_particles);
+  if (net.dim != 3) throw InputError("porenet: add_shear_forces_3d needs a 3D network");
+  if (p.x.size() != n || fx.size() != n || fy.size() != n || fz.size() != n ||
+      P.size() != static_cast<std::size_t>(net.n_pores()) ||
+      net.ch_shear.size() != 3 * static_cast<std::size_t>(net.n_channels()))
+    throw InputError(fmt::format("porenet: add_shear_forces_3d: {} particles, {} pores, {} throats; arrays of sizes "
+                                 "{}/{}/{}, {}, {}", n, net.n_pores(), net.n_channels(), p.x.size(), fx.size(),
+                                 fy.size(), P.size(), net.ch_shear.size()));
+  for (Index c = 0; c < net.n_channels(); ++c) {
+    const Index a = net.ch_pore[2 * c], b = net.ch_pore[2 * c + 1];
+    const Real dp = P[static_cast<std::size_t>(a)] - P[static_cast<std::size_t>(b)];
+    if (dp == 0) continue;
+    const Index* v = &net.ch_part[3 * static_cast<std::size_t>(c)];
+    const Real ux = p.x[v[1]] - p.x[v[0]], uy = p.y[v[1]] - p.y[v[0]], uz = p.z[v[1]] - p.z[v[0]];
+    const Real wx = p.x[v[2]] - p.x[v[0]], wy = p.y[v[2]] - p.y[v[0]], wz = p.z[v[2]] - p.z[v[0]];
+    Real nx = uy * wz - uz * wy, ny = uz * wx - ux * wz, nz = ux * wy - uy * wx;
+    const Real len = std::sqrt(nx * nx + ny * ny + nz * nz);
+    if (!(len > 0)) continue;
+    // Oriented from pore a to pore b (their centroids lie on either side of the shared facet).
+    const Real side = nx * (net.pore_cx[b] - net.pore_cx[a]) + ny * (net.pore_cy[b] - net.pore_cy[a]) +
+                      nz * (net.pore_cz[b] - net.pore_cz[a]);
+    const Real s = (side < 0 ? -dp : dp) / len;
+    for (int k = 0; k < 3; ++k) {
+      const Real w = s * net.ch_shear[3 * static_cast<std::size_t>(c) + k];
+      const auto j = static_cast<std::size_t>(v[k]);
+      fx[j] += w * nx;
+      fy[j] += w * ny;
+      fz[j] += w * nz;
+    }
+  }
+}
+
 void add_pressure_forces_3d(const Network2D& net, const Particles3D& p, std::span<const Real> P, std::span<Real> fx,
                             std::span<Real> fy, std::span<Real> fz) {
   const auto n = static_cast<std::size_t>(net.n_particles);

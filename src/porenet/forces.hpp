@@ -56,6 +56,15 @@ void add_shear_forces(const Network2D& net, const Particles2D& particles, std::s
 // pressure of the network's last geometry (build_network_3d or update_network_3d at these positions).
 void add_pressure_forces_3d(const Network2D& net, const Particles3D& particles, std::span<const Real> pore_pressure,
                             std::span<Real> fx, std::span<Real> fy, std::span<Real> fz);
+// 3D channel shear (the analogue of B25 and B28 for a throat of fluid area A_f and wetted perimeter
+// sum_k theta_k R_k): Poiseuille flow through the throat pulls its wall with tau = R_h (P_a - P_b) / L,
+// R_h = A_f / sum theta R, over the wall area sum theta R x L, i.e. A_f (P_a - P_b) in all; sphere k takes
+// its wetted arc's share, along the facet's normal from pore a to pore b (net.ch_shear). With the patch
+// pressure forces, which carry (P_a - P_b) times the facet's solid part, the grains of a fixed packing in
+// steady flow take the whole pressure drop times the cross-section (test_forces). Added to fx, fy, fz [N];
+// one pass over the throats in order (the same sums on any thread count).
+void add_shear_forces_3d(const Network2D& net, const Particles3D& particles, std::span<const Real> pore_pressure,
+                         std::span<Real> fx, std::span<Real> fy, std::span<Real> fz);
 // The force per unit pressure [m^2] on the sphere of pore-corner entry e (pore net.pp_pore[e]):
 // sum_f n_f theta_f R^2 / 2 (forces.cpp); add_pressure_forces_3d sums P_k times it.
 void unit_patch_force_3d(const Network2D& net, Index e, Real out[3]);

@@ -107,6 +107,8 @@ struct Network2D {
   std::vector<Real> ch_sin_omega;    // sin of the angle between edge and centre line
   std::vector<Real> ch_aperture;     // h [m]
   std::vector<Real> ch_cond;         // h^3 t / (12 L) [m^3]; conductance = ch_cond / mu
+  std::vector<Real> ch_shear;        // 3D: 3 per throat, A_f theta_k R_k / sum theta R [m^2]: the channel shear
+                                     // on its k-th sphere per unit pressure drop (forces.cpp)
   // CSR: channels of pore k are pc_ch[pc_start[k] .. pc_start[k+1]), sorted by channel id.
   std::vector<Index> pc_start, pc_ch;
   // CSR: pore corners of particle n: (pp_pore, pp_corner) in [pp_start[n], pp_start[n+1]).

@@ -123,6 +123,7 @@ void DemPorenet3D::compute_fluid_forces(Real p_floor) {
   std::fill(fx_.begin(), fx_.end(), 0.0);
   std::fill(fy_.begin(), fy_.end(), 0.0);
   std::fill(fz_.begin(), fz_.end(), 0.0);
+  if (prm_.channel_shear) porenet::add_shear_forces_3d(*net_, view(), pg_, fx_, fy_, fz_);
   if (prm_.pressure_force == PressureForce::Surface) {
     porenet::add_pressure_forces_3d(*net_, view(), pg_, fx_, fy_, fz_);
     return;
@@ -138,9 +139,9 @@ void DemPorenet3D::compute_fluid_forces(Real p_floor) {
       porenet::unit_patch_force_3d(net, e, a);
       f += pg_[static_cast<std::size_t>(net.pp_pore[e])] * void_gradient(j, e, Vec3(a[0], a[1], a[2]), true);
     }
-    fx_[static_cast<std::size_t>(j)] = f.x();
-    fy_[static_cast<std::size_t>(j)] = f.y();
-    fz_[static_cast<std::size_t>(j)] = f.z();
+    fx_[static_cast<std::size_t>(j)] += f.x();
+    fy_[static_cast<std::size_t>(j)] += f.y();
+    fz_[static_cast<std::size_t>(j)] += f.z();
   }
 }
 

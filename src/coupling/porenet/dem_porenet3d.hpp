@@ -27,7 +27,8 @@
 // the nonlinear equation of state) corrects the pressures every N steps. So a held force is no longer
 // an explicit spring and N may reach max_flow_every: the saturated 3D sample strides 20 steps instead
 // of 1 (docs/saturated.md gives accuracy and speed).
-// Channel shear (B25) is not applied in 3D. Results are bit-identical on any thread count.
+// Channel shear (Porenet3DParams::channel_shear): A_f (P_a - P_b) per throat on its three spheres.
+// Results are bit-identical on any thread count.
 // Cracks in 3D: no separate crack channels; a broken bond's spheres move apart, and the facets
 // they share grow in fluid area and hydraulic radius (update_network_3d each step), so the
 // throats across an opening crack conduct more (up to NetworkParams::max_cond_ratio x the
@@ -86,6 +87,12 @@ struct Porenet3DParams {
   long choose_every = 200;
   // Surface (the patches, PFV style; as before 2026-11-28) or the void's gradient (pressure_force.hpp).
   PressureForce pressure_force = PressureForce::Surface;
+  // Channel shear on the grains (porenet::add_shear_forces_3d; 2D: B25, B28), added at each flow step
+  // and held in between (the pressure prediction does not predict it). Off by default and not yet used
+  // by the drivers: held, it is an explicit spring the DEM step does not include (the saturated 3D
+  // example at S 0.5 went past the spinodal with it), and it halved the 3D hydrofrac block's breakdown
+  // pressure (docs/porenet.md section 6).
+  bool channel_shear = false;
 };
 
 struct Porenet3DStats {
