@@ -26,6 +26,7 @@
 #include "io/scenario.hpp"
 #include "porenet/eos.hpp"
 #include "porenet/flow.hpp"
+#include "../porenet/terzaghi.hpp"
 
 namespace ff::coupling {
 namespace {
@@ -93,15 +94,6 @@ void servo(Column& c, Real force) {
 }
 
 Real platen_position(const Column& c) { return c.sys.walls[c.top].point[c.info.axis]; }
-
-Real terzaghi_mean_excess(Real Tv) {
-  Real s = 0;
-  for (int m = 0; m < 200; ++m) {
-    const Real M = (2 * m + 1) * kPi / 2;
-    s += 2 / (M * M) * std::exp(-M * M * Tv);
-  }
-  return s;
-}
 
 }  // namespace
 
@@ -245,7 +237,7 @@ TEST(CouplingPorenet3D, TerzaghiConsolidationOfADemColumn) {
     const auto it = std::lower_bound(t.begin(), t.end(), t[k0] + Tv * H * H / cv);
     if (it == t.end()) break;
     std::printf("  T_v %.2f: pbar / peak %.4f, Terzaghi %.4f\n", Tv, pbar[static_cast<std::size_t>(it - t.begin())] / pu,
-                terzaghi_mean_excess(Tv));
+                test::terzaghi_mean_excess(Tv));
   }
   // Measured 2026-11-29: rate -13.8 %, S_A -13 % of the dry estimate. The network's flat tetrahedra along
   // the side walls carry throats at the conductance cap (100 x the median) that run the column's length:

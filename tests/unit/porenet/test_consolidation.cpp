@@ -12,21 +12,13 @@
 #include <cmath>
 
 #include "packings.hpp"
+#include "terzaghi.hpp"
 #include "porenet/flow.hpp"
 
 using namespace ff;
 using namespace ff::porenet;
 
-namespace {
-Real terzaghi_mean_excess(Real Tv) {
-  Real s = 0;
-  for (int m = 0; m < 200; ++m) {
-    const Real M = (2 * m + 1) * kPi / 2;
-    s += 2 / (M * M) * std::exp(-M * M * Tv);
-  }
-  return s;
-}
-}  // namespace
+using ff::test::terzaghi_mean_excess;
 
 TEST(PorenetConsolidation, UndrainedJumpAndTerzaghi) {
   const Real d = 1e-3;
