@@ -72,7 +72,11 @@ void pore_geometry_3d(Network2D& net, const Particles3D& p, Index k0, Index k1) 
       normal[12 * (k - k0) + 3 * i + 1] = N.y * inv;
       normal[12 * (k - k0) + 3 * i + 2] = N.z * inv;
     }
-    const Real six_vol = std::abs(dot(sub(c[1], c[0]), cross(sub(c[2], c[0]), sub(c[3], c[0]))));
+    // Edges from corner 0: the volume here, the power centre below.
+    const V3 d1 = sub(c[1], c[0]), d2 = sub(c[2], c[0]), d3 = sub(c[3], c[0]);
+    const V3 n23 = cross(d2, d3);
+    const Real det = dot(d1, n23);
+    const Real six_vol = std::abs(det);
     vol[k - k0] = six_vol / 6;
     for (int i = 0; i < 4; ++i) {
       const int o1 = (i + 1) % 4, o2 = (i + 2) % 4, o3 = (i + 3) % 4;
@@ -102,13 +106,11 @@ void pore_geometry_3d(Network2D& net, const Particles3D& p, Index k0, Index k1) 
     // pore on the convex hull: its power centre lies outside the sample, where the network has no fluid
     // (with it, k/k_KC fell from 0.44 to 0.48 porosity; with the centroid 1.43 / 1.93 / 2.18 at 0.40 /
     // 0.44 / 0.48, and the 3D consolidation test's decay rate came 4 points closer to Terzaghi's).
-    const V3 d1 = sub(c[1], c[0]), d2 = sub(c[2], c[0]), d3 = sub(c[3], c[0]);
     const Real r0 = p.radius[v[0]] * p.radius[v[0]];
     const Real b1 = 0.5 * (dot(d1, d1) - p.radius[v[1]] * p.radius[v[1]] + r0);
     const Real b2 = 0.5 * (dot(d2, d2) - p.radius[v[2]] * p.radius[v[2]] + r0);
     const Real b3 = 0.5 * (dot(d3, d3) - p.radius[v[3]] * p.radius[v[3]] + r0);
-    const V3 n23 = cross(d2, d3), n31 = cross(d3, d1), n12 = cross(d1, d2);
-    const Real det = dot(d1, n23);
+    const V3 n31 = cross(d3, d1), n12 = cross(d1, d2);
     const Real scale = (dot(d1, d1) + dot(d2, d2) + dot(d3, d3)) / 3;
     if (!net.pore_hull[k] && std::abs(det) > 1e-9 * scale * std::sqrt(scale)) {
       const Real inv = 1 / det;
@@ -190,9 +192,9 @@ void throat_geometry_3d(Network2D& net, const Particles3D& p, Index c0, Index c1
     // Two tetrahedra with almost coincident power centres are halves of one pore body, not a throat of
     // length ~0: L at least a quarter of the facet's mean radius. The packings' permeability does not see
     // the floor (k/k_KC 1.50 / 2.11 / 1.37 with it, 1.51 / 2.11 / 1.38 at a tenth of the radius; hull pores
-    // then on their power centres too), but the
-    // two-phase transport step does: a tenth made such throats 2.5x more conductive and the implicit
-    // steps halved 2.7x more often (SaturatedUcs3D.SmallestPoresFirstDrainedStepsWithoutHalving).
+    // then on their power centres too), but the two-phase transport step does: a tenth made such throats
+    // 2.5x more conductive and the implicit steps halved 2.7x more often
+    // (SaturatedUcs3D.SmallestPoresFirstDrainedStepsWithoutHalving).
     const Real L = std::max(norm(d), 0.25 * (p.radius[v[0]] + p.radius[v[1]] + p.radius[v[2]]) / 3);
     net.ch_length[c] = L;
     net.ch_aperture[c] = 2 * rh;
