@@ -146,8 +146,21 @@ void add_shear_forces_3d(const Network2D& net, const Particles3D& p, std::span<c
     const Real dp = P[static_cast<std::size_t>(a)] - P[static_cast<std::size_t>(b)];
     if (dp == 0) continue;
     const Index* v = &net.ch_part[3 * static_cast<std::size_t>(c)];
-    const Real ux = p.x[v[1]] - p.x[v[0]], uy = p.y[v[1]] - p.y[v[0]], uz = p.z[v[1]] - p.z[v[0]];
-    const Real wx = p.x[v[2]] - p.x[v[0]], wy = p.y[v[2]] - p.y[v[0]], wz = p.z[v[2]] - p.z[v[0]];
+    // The facet's plane: spanned by the edges from its first sphere; an edge to a wall (walls sort last)
+    // runs along the wall's axis.
+    Real u[3], t[3];
+    for (int j = 1; j < 3; ++j) {
+      Real* e = j == 1 ? u : t;
+      if (net.is_wall_vertex(v[j])) {
+        e[0] = e[1] = e[2] = 0;
+        e[(v[j] - net.n_particles) / 2] = 1;
+      } else {
+        e[0] = p.x[v[j]] - p.x[v[0]];
+        e[1] = p.y[v[j]] - p.y[v[0]];
+        e[2] = p.z[v[j]] - p.z[v[0]];
+      }
+    }
+    const Real ux = u[0], uy = u[1], uz = u[2], wx = t[0], wy = t[1], wz = t[2];
     Real nx = uy * wz - uz * wy, ny = uz * wx - ux * wz, nz = ux * wy - uy * wx;
     const Real len = std::sqrt(nx * nx + ny * ny + nz * nz);
     if (!(len > 0)) continue;
@@ -156,6 +169,7 @@ void add_shear_forces_3d(const Network2D& net, const Particles3D& p, std::span<c
                       nz * (net.pore_cz[b] - net.pore_cz[a]);
     const Real s = (side < 0 ? -dp : dp) / len;
     for (int k = 0; k < 3; ++k) {
+      if (net.is_wall_vertex(v[k])) continue;  // a wall's share is not applied (ch_shear holds none)
       const Real w = s * net.ch_shear[3 * static_cast<std::size_t>(c) + k];
       const auto j = static_cast<std::size_t>(v[k]);
       fx[j] += w * nx;
@@ -186,6 +200,18 @@ void add_pressure_forces_3d(const Network2D& net, const Particles3D& p, std::spa
     fy[j] += s[1];
     fz[j] += s[2];
   }
+}
+
+std::array<Real, 6> wall_pressure_forces_3d(const Network2D& net, std::span<const Real> P) {
+  if (P.size() != static_cast<std::size_t>(net.n_pores()))
+    throw InputError(fmt::format("porenet: {} pressures for {} pores", P.size(), net.n_pores()));
+  std::array<Real, 6> f{};
+  for (int w = 0; w < net.n_walls; ++w)
+    for (Index e = net.wp_start[w]; e < net.wp_start[w + 1]; ++e) {
+      const Real* a = &net.pore_patch[12 * static_cast<std::size_t>(net.wp_pore[e]) + 3 * net.wp_corner[e]];
+      f[static_cast<std::size_t>(w)] += P[static_cast<std::size_t>(net.wp_pore[e])] * std::abs(a[w / 2]);
+    }
+  return f;
 }
 
 }  // namespace ff::porenet

@@ -9,6 +9,7 @@
 // Forces are added to fx, fy [N] (one entry per particle); each particle sums its own pores and
 // channels in CSR order, so the result is independent of the thread count.
 #pragma once
+#include <array>
 #include <cmath>
 #include <span>
 
@@ -65,6 +66,9 @@ void add_pressure_forces_3d(const Network2D& net, const Particles3D& particles, 
 // fz [N]; one pass over the throats in order (the same sums on any thread count).
 void add_shear_forces_3d(const Network2D& net, const Particles3D& particles, std::span<const Real> pore_pressure,
                          std::span<Real> fx, std::span<Real> fy, std::span<Real> fz);
+// With walls (BoxWalls): the force [N] the pore pressures exert on each wall, along d_w (outward), sum
+// over its pores of P_k times the pore's area on the wall. Channel shear on the walls is not included.
+std::array<Real, 6> wall_pressure_forces_3d(const Network2D& net, std::span<const Real> pore_pressure);
 // The force per unit pressure [m^2] on the sphere of pore-corner entry e (pore net.pp_pore[e]):
 // sum_f n_f theta_f R^2 / 2 (forces.cpp); add_pressure_forces_3d sums P_k times it.
 void unit_patch_force_3d(const Network2D& net, Index e, Real out[3]);

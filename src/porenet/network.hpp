@@ -18,6 +18,7 @@
 // every per-pore or per-particle sum runs in a fixed order (bit-identical on any thread count).
 // Units: SI. Positions [m], stresses [Pa] (compression positive), apertures [m].
 #pragma once
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <span>
@@ -123,6 +124,19 @@ struct Network2D {
   // of pore k, -int_patch n dA (forces.cpp), at pore_patch[12k + 3c .. 12k + 3c + 2].
   std::vector<Real> pore_patch;
 
+  // 3D with walls (build_network_3d with BoxWalls): wall w (= 2 axis + side) is vertex n_particles + w
+  // of pore_v and ch_part; its plane is axis = wall_plane[w], and d_w (side 0: -e_axis, side 1: +e_axis)
+  // points from the sample into it. The patch of a wall corner (pore_patch) is A d_w, A the pore's area
+  // on the wall: the force on the wall per unit pressure (wall_pressure_forces_3d).
+  int n_walls = 0;                       // 0 or 6
+  std::array<Real, 6> wall_plane{};      // [m]
+  std::vector<std::uint8_t> pore_walls;  // 3D: bit w set if wall w is a corner of pore k
+  std::vector<Index> wall_pores, wall_throats;  // pores and throats with a wall corner, ascending
+  // CSR: pore corners on wall w: (wp_pore, wp_corner) in [wp_start[w], wp_start[w+1]).
+  std::vector<Index> wp_start, wp_pore;
+  std::vector<std::uint8_t> wp_corner;
+  bool is_wall_vertex(Index v) const { return v >= n_particles; }
+
   Index hidden_particles = 0;  // 3D regular triangulation: spheres with an empty power cell (no pore)
   // Floor of every pore's void [m^3] (min_void_relative x the mean cell; 2D: of the last update; a pore
   // at the floor keeps its volume as its grains move). 3D: kept from the build for update_network_3d.
@@ -160,17 +174,36 @@ struct Particles3D {
   std::span<const std::int64_t> gid;
 };
 
+// Walls of an axis-aligned box around a 3D sample, planes x = lo[0], x = hi[0], y = lo[1], ...: in the
+// triangulation they are PFV's boundary spheres (Chareyre et al. 2012: spheres so large that their
+// surface is the wall plane), so the pores between the outermost spheres and the walls are part of the
+// network. Without them the network ends at the convex hull of the sphere centres, whose flat hull
+// tetrahedra carry throats at the conductance cap along the sample's faces (docs/porenet.md section 9).
+struct BoxWalls {
+  std::array<Real, 3> lo{}, hi{};
+};
+
 // 3D network, PFV style (Chareyre et al. 2012, Transp. Porous Media 94:595; METHODS.md §5.1–5.3a):
 // regular (weighted, w = R^2) Delaunay triangulation of the sphere centres (CGAL
 // Regular_triangulation_3); pores = tetrahedra with void V = V_tet - sum_k Omega_k R_k^3 / 3 (solid
 // angles); throats = shared facets with fluid area A_f = A - sum_k theta_k R_k^2 / 2, hydraulic radius
 // R_h = A_f / (sum_k theta_k R_k) (the facet's wetted perimeter: a 2D simplification of PFV's
 // volume/surface ratio) and conductance g = pfv_factor A_f R_h^2 / (2 mu L) (ch_cond = g mu),
-// L the centroid distance. Contacts/bonds do not form extra channels in 3D (not yet).
-Network2D build_network_3d(const Particles3D& particles, const NetworkParams& params = {}, Real pfv_factor = 1.0);
+// L the distance between the pores' power centres. Contacts/bonds do not form extra channels in 3D (not
+// yet). With walls (all six; every centre strictly inside the box) a pore may have one to three walls
+// as corners: one wall, the prism between the triangle of its three spheres and the wall; two, the
+// region between the edge of its two spheres and the box edge; three, the box corner at its sphere.
+// Such a pore's power centre lies on its walls (PFV's), and pore_hull marks the pores with a wall.
+Network2D build_network_3d(const Particles3D& particles, const NetworkParams& params = {}, Real pfv_factor = 1.0,
+                           const BoxWalls* walls = nullptr);
 
-// Pore volumes, centroids and throat conductances for moved spheres, keeping the topology (3D).
-void update_network_3d(Network2D& net, const Particles3D& particles);
+// Pore volumes, centroids and throat conductances for moved spheres, keeping the topology (3D). A
+// network with walls takes their new planes from `walls` (nullptr: the planes stay).
+void update_network_3d(Network2D& net, const Particles3D& particles, const BoxWalls* walls = nullptr);
+
+// dV/dx [m^2] of the void (without the relative floor) of pore k, which has walls, for a move of the
+// sphere at its corner `corner` (0 for a wall corner): central differences of the wall pore's geometry.
+void wall_pore_void_gradient(const Network2D& net, const Particles3D& particles, Index k, int corner, Real g[3]);
 
 // Eq. B1 aperture for a contact/bond channel (+ opening for a broken bond).
 Real aperture_b1(const NetworkParams& p, PairState state, Real sigma_n, Real opening);
