@@ -29,7 +29,37 @@ void DemPorenet3D::gather(const dem::DemSystem& sys) {
     z_[k] = sys.particles.pos[k].z();
     r_[k] = sys.particles.radius[k];
   }
+  if (prm_.walls)
+    for (int w = 0; w < 6; ++w) {
+      const Real plane = sys.walls[static_cast<std::size_t>(wall_ids_[static_cast<std::size_t>(w)])].point[w / 2];
+      (w % 2 ? box_.hi : box_.lo)[static_cast<std::size_t>(w / 2)] = plane;
+    }
 }
+
+namespace {
+// The DemSystem's plane wall of each box face: normal +e_a (pointing to the particles) for the lower
+// wall of axis a, -e_a for the upper.
+std::array<int, 6> find_box_walls(const dem::DemSystem& sys) {
+  std::array<int, 6> ids;
+  ids.fill(-1);
+  for (std::size_t i = 0; i < sys.walls.size(); ++i) {
+    const auto& w = sys.walls[i];
+    if (w.kind != dem::Wall::Kind::Plane || !w.active) continue;
+    for (int a = 0; a < 3; ++a)
+      for (int side = 0; side < 2; ++side) {
+        const Real s = side ? -1.0 : 1.0;
+        if (std::abs(w.normal[a] - s) < 1e-12 && ids[static_cast<std::size_t>(2 * a + side)] < 0)
+          ids[static_cast<std::size_t>(2 * a + side)] = static_cast<int>(i);
+      }
+  }
+  for (int w = 0; w < 6; ++w)
+    if (ids[static_cast<std::size_t>(w)] < 0)
+      throw InputError(fmt::format("coupling.porenet3d: walls = true needs six axis-aligned plane walls around the "
+                                   "sample; none has the normal {}{} (pointing to the particles): {} walls in all",
+                                   w % 2 ? "-" : "+", "xyz"[w / 2], sys.walls.size()));
+  return ids;
+}
+}  // namespace
 
 void DemPorenet3D::set_boundaries(porenet::TwoPhaseFlow& flow, const porenet::Network2D& net) {
   if (prm_.drained)
@@ -42,7 +72,8 @@ void DemPorenet3D::set_boundaries(porenet::TwoPhaseFlow& flow, const porenet::Ne
 void DemPorenet3D::make_network_and_flow(std::unique_ptr<porenet::Network2D>& net,
                                          std::unique_ptr<porenet::TwoPhaseFlow>& flow) {
   const auto t0 = std::chrono::steady_clock::now();
-  net = std::make_unique<porenet::Network2D>(porenet::build_network_3d(view(), prm_.network, prm_.pfv_factor));
+  net = std::make_unique<porenet::Network2D>(porenet::build_network_3d(view(), prm_.network, prm_.pfv_factor, box()));
+  ref_box_ = box_;
   flow = std::make_unique<porenet::TwoPhaseFlow>(*net, prm_.fluid);
   ref_x_ = x_;
   ref_y_ = y_;
@@ -61,6 +92,8 @@ void DemPorenet3D::init(const dem::DemSystem& sys, const Porenet3DParams& params
   if (!(params.retriangulation_tolerance > 0))
     throw InputError("coupling.porenet3d: retriangulation_tolerance must be > 0");
   prm_ = params;
+  if (prm_.walls) wall_ids_ = find_box_walls(sys);
+  wall_force_.fill(0);
   const auto n = sys.particles.size();
   x_.assign(n, 0);
   y_ = z_ = r_ = fx_ = fy_ = fz_ = x_;
@@ -88,7 +121,7 @@ std::vector<Index> DemPorenet3D::pores_near(const Vec3& c, Real radius) const {
 }
 
 void DemPorenet3D::retriangulate() {
-  porenet::update_network_3d(*net_, view());  // old pores at the current positions: the remap's centroids
+  porenet::update_network_3d(*net_, view(), box());  // old pores at the current positions: the remap's centroids
   auto old_net = std::move(net_);
   auto old_flow = std::move(flow_);
   make_network_and_flow(net_, flow_);
@@ -124,6 +157,7 @@ void DemPorenet3D::compute_fluid_forces(Real p_floor) {
   std::fill(fy_.begin(), fy_.end(), 0.0);
   std::fill(fz_.begin(), fz_.end(), 0.0);
   if (prm_.channel_shear) porenet::add_shear_forces_3d(*net_, view(), pg_, fx_, fy_, fz_);
+  if (prm_.walls) wall_force_ = porenet::wall_pressure_forces_3d(*net_, pg_);
   if (prm_.pressure_force == PressureForce::Surface) {
     porenet::add_pressure_forces_3d(*net_, view(), pg_, fx_, fy_, fz_);
     return;
@@ -147,6 +181,11 @@ void DemPorenet3D::compute_fluid_forces(Real p_floor) {
 
 void DemPorenet3D::add_forces(dem::DemSystem& sys) {
   for (std::size_t k = 0; k < fx_.size(); ++k) sys.particles.ext_force[k] += Vec3(fx_[k], fy_[k], fz_[k]);
+  if (prm_.walls)  // outward: against the wall's normal, which points to the particles
+    for (int w = 0; w < 6; ++w) {
+      auto& wall = sys.walls[static_cast<std::size_t>(wall_ids_[static_cast<std::size_t>(w)])];
+      wall.force -= wall_force_[static_cast<std::size_t>(w)] * wall.normal;
+    }
 }
 
 long DemPorenet3D::choose_flow_every(const dem::DemSystem& sys) const {
@@ -179,7 +218,7 @@ bool DemPorenet3D::sync(const dem::DemSystem& sys) {
     return true;
   }
   const auto t0 = std::chrono::steady_clock::now();
-  porenet::update_network_3d(*net_, view());
+  porenet::update_network_3d(*net_, view(), box());
   stats_.t_update += seconds_since(t0);
   return false;
 }
@@ -244,6 +283,12 @@ void DemPorenet3D::save(CheckpointWriter& w) const {
   w.put("porenet3d.ref_x", ref_x_);
   w.put("porenet3d.ref_y", ref_y_);
   w.put("porenet3d.ref_z", ref_z_);
+  if (prm_.walls) {
+    std::vector<Real> b(ref_box_.lo.begin(), ref_box_.lo.end());
+    b.insert(b.end(), ref_box_.hi.begin(), ref_box_.hi.end());
+    b.insert(b.end(), wall_force_.begin(), wall_force_.end());
+    w.put("porenet3d.ref_box", b);
+  }
   const auto vec = [](std::span<const Real> s) { return std::vector<Real>(s.begin(), s.end()); };
   w.put("porenet3d.p", vec(flow_->pressure()));
   w.put("porenet3d.alpha", vec(flow_->liquid_fraction()));
@@ -264,6 +309,8 @@ void DemPorenet3D::save(CheckpointWriter& w) const {
 
 void DemPorenet3D::load(CheckpointReader& r, const dem::DemSystem& sys, const Porenet3DParams& params) {
   prm_ = params;
+  if (prm_.walls) wall_ids_ = find_box_walls(sys);
+  wall_force_.fill(0);
   const auto n = sys.particles.size();
   x_.assign(n, 0);
   y_ = z_ = r_ = fx_ = fy_ = fz_ = x_;
@@ -278,7 +325,17 @@ void DemPorenet3D::load(CheckpointReader& r, const dem::DemSystem& sys, const Po
   r.get("porenet3d.ref_y", y_);
   r.get("porenet3d.ref_z", z_);
   if (x_.size() != n) throw InputError(fmt::format("checkpoint: porenet3d positions for {} spheres; the sample has {}", x_.size(), n));
+  const porenet::BoxWalls current_box = box_;
+  if (prm_.walls) {
+    std::vector<Real> b;
+    if (r.has("porenet3d.ref_box")) r.get("porenet3d.ref_box", b);
+    if (b.size() != 12) throw InputError("checkpoint: porenet3d.ref_box (the walls at the last triangulation) is missing");
+    std::copy(b.begin(), b.begin() + 3, box_.lo.begin());
+    std::copy(b.begin() + 3, b.begin() + 6, box_.hi.begin());
+    std::copy(b.begin() + 6, b.end(), wall_force_.begin());
+  }
   make_network_and_flow(net_, flow_);
+  box_ = current_box;
   flow_->init(prm_.initial_pressure, prm_.saturation);
   set_boundaries(*flow_, *net_);
   x_ = cx;
@@ -355,6 +412,11 @@ Vec3 DemPorenet3D::void_gradient(Index j, Index e, const Vec3& a, bool floored) 
   // A pore at the fraction floor (overlapping spheres fill the tetrahedron) has V = phi V_tet:
   // g = phi dV_tet/dx_j, no sectors, no patch.
   if (floored && !(net.pore_void[i] > net.void_floor)) return Vec3::Zero();
+  if (net.pore_walls[i]) {
+    Real w[3];
+    porenet::wall_pore_void_gradient(net, view(), i, c, w);
+    return Vec3(w[0], w[1], w[2]);
+  }
   const bool at_fraction = net.pore_void[i] <= net.params.min_void_fraction * net.pore_cell[i];
   Vec3 g = at_fraction ? Vec3::Zero() : a;
   for (int f = 0; f < 3; ++f) {  // face (j, b, d); the corner opposite it is o

@@ -35,6 +35,7 @@
 // median conductance of the last triangulation). Staged use (drivers with their own step
 // order, e.g. drivers/hydrofrac/network_load.cpp): sync(), advance_flow(), compute_fluid_forces().
 #pragma once
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -93,6 +94,14 @@ struct Porenet3DParams {
   // example at S 0.5 went past the spinodal with it), and it halved the 3D hydrofrac block's breakdown
   // pressure (docs/porenet.md section 6).
   bool channel_shear = false;
+  // The DEM's six axis-aligned plane walls (one per face of the sample's box: normals +-x, +-y, +-z) in
+  // the triangulation as PFV's boundary spheres (porenet::BoxWalls): the pores between the outermost
+  // spheres and the walls join the network, the walls take the pressure of their pores (added to
+  // dem::Wall::force, what a servo reads), and the throats take PFV's hydraulic radius (permeability
+  // within 0.8-1.0 of Kozeny-Carman; without walls the flat tetrahedra of the hull carry throats at the
+  // conductance cap along the faces: docs/porenet.md section 9). With `drained` the pores on the walls
+  // are the ones held at the ambient pressure. The pressure prediction does not see the walls move.
+  bool walls = false;
 };
 
 struct Porenet3DStats {
@@ -124,6 +133,10 @@ class DemPorenet3D {
   Real max_pressure() const;
   // Fluid force of the last step on particle k [N].
   Vec3 fluid_force(Index k) const { return {fx_[k], fy_[k], fz_[k]}; }
+  // With walls: the fluid's force of the last flow step on box wall w (2 axis + side; side 1 the upper),
+  // outward along the axis [N], and the DemSystem's index of that wall.
+  Real wall_fluid_force(int w) const { return wall_force_[static_cast<std::size_t>(w)]; }
+  int wall_index(int w) const { return wall_ids_[static_cast<std::size_t>(w)]; }
   // Stiffness the pore fluid adds to each sphere [N/m], for the DEM's critical step (as
   // DemPorenetCoupling::fluid_stiffness in 2D): tetrahedron i pushes on sphere j with p_i a_ij
   // (a_ij = porenet::unit_patch_force_3d; with the void-gradient force a_ij = g_ij) and moving j by dx
@@ -187,7 +200,12 @@ class DemPorenet3D {
   long choose_flow_every(const dem::DemSystem& sys) const;  // the stiffness bound on N (flow_every = 0)
   porenet::Particles3D view() const { return {x_, y_, z_, r_, {}}; }
 
+  const porenet::BoxWalls* box() const { return prm_.walls ? &box_ : nullptr; }
+
   Porenet3DParams prm_;
+  std::array<int, 6> wall_ids_{};             // walls: DemSystem wall of box wall w
+  porenet::BoxWalls box_, ref_box_;           // walls: now and at the last triangulation
+  std::array<Real, 6> wall_force_{};          // walls: fluid force, outward [N]
   std::unique_ptr<porenet::Network2D> net_;
   std::unique_ptr<porenet::TwoPhaseFlow> flow_;
   std::vector<Real> x_, y_, z_, r_, ref_x_, ref_y_, ref_z_, fx_, fy_, fz_, pg_;

@@ -132,6 +132,7 @@ void DemPorenet3D::add_predicted_forces(dem::DemSystem& sys, Real p_floor) {
     Real dv = 0;  // V - V0
     for (std::size_t c = 0; c < 4; ++c) {
       const auto k = static_cast<std::size_t>(net.pore_v[4 * u + c]);
+      if (net.is_wall_vertex(static_cast<Index>(k))) continue;  // the walls' motion is not predicted
       const Real* g = &pred_g_[3 * (4 * u + c)];
       dv += g[0] * (pos[k].x() - pred_x0_[3 * k]) + g[1] * (pos[k].y() - pred_x0_[3 * k + 1]) +
             g[2] * (pos[k].z() - pred_x0_[3 * k + 2]);

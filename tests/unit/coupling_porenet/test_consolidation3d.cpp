@@ -9,7 +9,9 @@
 // Terzaghi (1943, Theoretical Soil Mechanics, Wiley, ch. XIII): after a total-stress step the mean excess
 // pore pressure of a layer of height H drained at the top and impermeable at the bottom falls as
 //   pbar / pbar(0) = sum_m 2 / M_m^2 exp(-M_m^2 T_v), M_m = (2m + 1) pi / 2, T_v = c_v t / H^2, c_v = G / S_A,
-// so that past T_v ~ 0.2 it decays at the rate pi^2 c_v / (4 H^2).
+// so that past T_v ~ 0.2 it decays at the rate pi^2 c_v / (4 H^2). Run twice: with the network ending at
+// the hull of the sphere centres, and with the oedometer's walls in the triangulation (Porenet3DParams::
+// walls, PFV's boundary spheres).
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -33,12 +35,13 @@ namespace {
 
 // A bonded column 4 x 4 x 12 mm (radii 0.4-0.6 mm, ~220 spheres): bonds that do not break make the
 // skeleton linear elastic under the small load step.
-const std::string kColumn =
-    "[dem]\ndim = 3\nbond_law = \"parallel\"\n[dem.group.matrix]\ndensity = 2400\n"
-    "[dem.contact.matrix-matrix]\nemod = 2.0e8\nkratio = 2.5\nfriction = 0.4\n"
-    "[dem.bond.matrix-matrix]\nemod = 2.0e8\nkratio = 2.5\ntensile_strength = 1e12\ncohesion = 1e12\n"
-    "[sample]\nshape = \"box\"\nwidth = 4e-3\ndepth = 4e-3\nheight = 12e-3\nradius_min = 0.4e-3\n"
-    "radius_max = 0.6e-3\nporosity = 0.45\nseed = 11\n";
+std::string column_scenario(Real height) {
+  return "[dem]\ndim = 3\nbond_law = \"parallel\"\n[dem.group.matrix]\ndensity = 2400\n"
+         "[dem.contact.matrix-matrix]\nemod = 2.0e8\nkratio = 2.5\nfriction = 0.4\n"
+         "[dem.bond.matrix-matrix]\nemod = 2.0e8\nkratio = 2.5\ntensile_strength = 1e12\ncohesion = 1e12\n"
+         "[sample]\nshape = \"box\"\nwidth = 4e-3\ndepth = 4e-3\nheight = " + std::to_string(height) +
+         "\nradius_min = 0.4e-3\nradius_max = 0.6e-3\nporosity = 0.45\nseed = 11\n";
+}
 
 struct Column {
   ParamTable table;
@@ -48,11 +51,11 @@ struct Column {
   std::size_t top = 1;  // the top platen's wall index
 };
 
-std::unique_ptr<Column> column() {
+std::unique_ptr<Column> column(Real height) {
   auto c = std::make_unique<Column>();
   dem::declare_dem_params(c->table);
   dem::declare_sample_params(c->table);
-  c->cfg = load_scenario(c->table, "", kColumn, {});
+  c->cfg = load_scenario(c->table, "", column_scenario(height), {});
   c->sys.settings = dem::build_settings(c->cfg);
   c->sys.materials = dem::build_materials(c->cfg);
   c->info = dem::build_sample(c->cfg, c->sys);
@@ -97,7 +100,15 @@ Real platen_position(const Column& c) { return c.sys.walls[c.top].point[c.info.a
 
 }  // namespace
 
-TEST(CouplingPorenet3D, TerzaghiConsolidationOfADemColumn) {
+struct Consolidation {
+  Real rate_ratio, storage_ratio;  // measured / Terzaghi's, measured / (n / K_f + 1 / M) A
+};
+
+// With `walls` the network has the oedometer's six walls in its triangulation (Porenet3DParams::walls):
+// the top platen's pores are the drained boundary, H the platens' distance and G from a steady flow
+// between the platens; without, a band of pores below the highest sphere centre is drained and G comes
+// from a flow between two bands.
+Consolidation consolidate(bool walls, Real column_height, long load_steps) {
   omp_set_num_threads(1);
   const Real sigma0 = 2e5, dsigma = 2e5;  // preload and load step [Pa]
   // A soft, viscous liquid: the column consolidates over ~20,000 DEM steps while the skeleton settles in
@@ -106,7 +117,7 @@ TEST(CouplingPorenet3D, TerzaghiConsolidationOfADemColumn) {
   const Real Kf = 2e7, mu = 4.0, p0 = 1e5;
 
   // 1. Dry preload to sigma0, then the dry step: M = dsigma / strain.
-  auto dry = column();
+  auto dry = column(column_height);
   const Real area = dry->info.area;
   auto settle = [&](Column& c, Real sigma, long steps) {
     for (long k = 0; k < steps; ++k) {
@@ -123,11 +134,11 @@ TEST(CouplingPorenet3D, TerzaghiConsolidationOfADemColumn) {
   std::printf("dry column: %zu spheres, dt %.3g s, height %.4f mm, preload %.3g Pa, step %.3g Pa: settlement %.4g um, "
               "M = %.4g Pa\n", dry->sys.particles.size(), dry->sys.settings.dt, 1e3 * height, sigma0, dsigma,
               1e6 * (z0 - z1), M);
-  ASSERT_GT(M, 0);
+  EXPECT_GT(M, 0);
 
   // 2. The same preload, then the column saturated (p0 everywhere), drained at the top: pores whose
   // centroid lies within 0.6 mm (about a grain radius) of the highest sphere centre are held at p0.
-  auto wet = column();
+  auto wet = column(column_height);
   settle(*wet, sigma0, 3000);
   const int ax = wet->info.axis;
   Real zc_lo = 1e9, zc_hi = -1e9;
@@ -147,14 +158,21 @@ TEST(CouplingPorenet3D, TerzaghiConsolidationOfADemColumn) {
   prm.initial_pressure = prm.ambient_pressure = p0;
   prm.flow_every = 0;  // automatic, with the pressure prediction (a flow step every DEM step: the same rate)
   prm.retriangulation_tolerance = 1.0;  // strains of ~1e-3: one network throughout
+  prm.walls = walls;
+  // The box walls' bits (Network2D::pore_walls): 2 axis + side, the top platen on the upper side.
+  const unsigned top_bit = 1u << (2 * ax + 1), bottom_bit = 1u << (2 * ax);
+  auto drained = [&](const porenet::Network2D& n, Index i) {
+    return walls ? (n.pore_walls[i] & top_bit) != 0 : cz(n, i) > z_cut;
+  };
   c.on_network = [&](porenet::TwoPhaseFlow& f, const porenet::Network2D& n) {
     for (Index i = 0; i < n.n_pores(); ++i)
-      if (cz(n, i) > z_cut) f.set_bc(i, porenet::PoreBc::Pressure, p0);
+      if (drained(n, i)) f.set_bc(i, porenet::PoreBc::Pressure, p0);
   };
   c.init(wet->sys, prm);
   dem::choose_time_step(wet->cfg, wet->sys, c.fluid_stiffness(false));
   const auto& net = c.network();
-  const Real H = z_cut - zc_lo;  // drained boundary to the impermeable bottom
+  // Drained boundary to the impermeable bottom.
+  const Real H = walls ? platen_position(*wet) - wet->sys.walls[0].point[ax] : z_cut - zc_lo;
 
   // 3. G = Q L / dp [m^4/(Pa s)] from a steady flow between the drained band and a bottom band of the
   // same width (the conductances the coupled flow uses).
@@ -168,11 +186,11 @@ TEST(CouplingPorenet3D, TerzaghiConsolidationOfADemColumn) {
     Real z_in = 0, z_out = 0;
     int n_in = 0, n_out = 0;
     for (Index i = 0; i < net.n_pores(); ++i) {
-      if (cz(net, i) > z_cut) {
+      if (drained(net, i)) {
         f.set_bc(i, porenet::PoreBc::Pressure, p0 + 1e3);
         z_in += cz(net, i);
         ++n_in;
-      } else if (cz(net, i) < zc_lo + 0.6e-3) {
+      } else if (walls ? (net.pore_walls[i] & bottom_bit) != 0 : cz(net, i) < zc_lo + 0.6e-3) {
         f.set_bc(i, porenet::PoreBc::Pressure, p0);
         z_out += cz(net, i);
         ++n_out;
@@ -180,13 +198,14 @@ TEST(CouplingPorenet3D, TerzaghiConsolidationOfADemColumn) {
     }
     f.init(p0);
     for (int k = 0; k < 30; ++k) f.step_implicit(0.1);  // each step ~10 consolidation times
-    G = f.pressure_pores_inflow_rate(true) / 1000 * (z_in / n_in - z_out / n_out) / 1e3;
+    const Real length = walls ? H : z_in / n_in - z_out / n_out;
+    G = f.pressure_pores_inflow_rate(true) / 1000 * length / 1e3;
   }
 
   // 4. The load step at constant total stress; the mean excess pressure of the undrained pores and their
   // liquid volume (at the reference density) against time.
   std::vector<Real> t, pbar, vol;
-  for (long k = 0; k < 40000; ++k) {
+  for (long k = 0; k < load_steps; ++k) {
     servo(*wet, (sigma0 + dsigma) * area);
     c.step(wet->sys);
     if (k % 20) continue;
@@ -211,7 +230,10 @@ TEST(CouplingPorenet3D, TerzaghiConsolidationOfADemColumn) {
     return k;
   };
   const std::size_t k1 = first_below(0.4), k2 = first_below(0.1);
-  ASSERT_LT(k2, pbar.size()) << "the pressure did not fall to a tenth of its peak";
+  if (k2 >= pbar.size()) {
+    ADD_FAILURE() << "the pressure did not fall to a tenth of its peak";
+    return {0, 0};
+  }
   // The late decay (between 0.4 and 0.1 of the peak: Terzaghi's first mode) and the storage over the same
   // window.
   const Real lambda = std::log(pbar[k1] / pbar[k2]) / (t[k2] - t[k1]);
@@ -223,9 +245,9 @@ TEST(CouplingPorenet3D, TerzaghiConsolidationOfADemColumn) {
     sum_void += net.pore_void[i];
     sum_cell += net.pore_cell[i];
   }
-  const Real SA_dry = (sum_void / Kf + sum_cell / M) / (zc_hi - zc_lo);
-  std::printf("wet column: dt %.3g s, %d pores, H %.3f mm, G %.4g m^4/(Pa s), S_A %.4g m^2/Pa ((n / K_f + 1 / M) A "
-              "with the dry M: %.4g, %+.1f %%), c_v %.4g m^2/s\n", wet->sys.settings.dt, net.n_pores(), 1e3 * H, G, SA,
+  const Real SA_dry = (sum_void / Kf + sum_cell / M) / (walls ? H : zc_hi - zc_lo);
+  std::printf("wet column (%s): dt %.3g s, %d pores, H %.3f mm, G %.4g m^4/(Pa s), S_A %.4g m^2/Pa ((n / K_f + 1 / M) A "
+              "with the dry M: %.4g, %+.1f %%), c_v %.4g m^2/s\n", walls ? "walls in the network" : "no walls", wet->sys.settings.dt, net.n_pores(), 1e3 * H, G, SA,
               SA_dry, 100 * (SA / SA_dry - 1), cv);
   std::printf("  peak excess %.4g Pa at t %.3g s; decay rate %.5g 1/s, Terzaghi %.5g 1/s (%+.2f %%)\n", pu, t[peak],
               lambda, lambda_th, 100 * (lambda / lambda_th - 1));
@@ -239,13 +261,28 @@ TEST(CouplingPorenet3D, TerzaghiConsolidationOfADemColumn) {
     std::printf("  T_v %.2f: pbar / peak %.4f, Terzaghi %.4f\n", Tv, pbar[static_cast<std::size_t>(it - t.begin())] / pu,
                 test::terzaghi_mean_excess(Tv));
   }
-  // Measured 2026-11-29: rate -13.8 %, S_A -13 % of the dry estimate. The network's flat tetrahedra along
-  // the side walls carry throats at the conductance cap (100 x the median) that run the column's length:
-  // the steady flow (G) goes mostly through them while the interior drains sideways into them, so the
-  // column decays slower than a uniform one (with the cap at 10 x the median -7.6 %; a 24 mm column
-  // -36 %). Walls in the triangulation (PFV's boundary spheres) would remove them: docs/porenet.md.
-  EXPECT_NEAR(lambda / lambda_th, 1.0, 0.2);
-  EXPECT_NEAR(SA / SA_dry, 1.0, 0.2);
+  return {lambda / lambda_th, SA / SA_dry};
+}
+
+// Without walls in the network, measured 2026-11-29: rate -13.8 %, S_A -13 % of the dry estimate. The
+// network's flat tetrahedra along the side walls carry throats at the conductance cap (100 x the median)
+// that run the column's length: the steady flow (G) goes mostly through them while the interior drains
+// sideways into them, so the column decays slower than a uniform one (with the cap at 10 x the median
+// -7.6 %; a 24 mm column -36 %). Bounds 20 %.
+TEST(CouplingPorenet3D, TerzaghiConsolidationOfADemColumn) {
+  const Consolidation r = consolidate(false, 12e-3, 40000);
+  EXPECT_NEAR(r.rate_ratio, 1.0, 0.2);
+  EXPECT_NEAR(r.storage_ratio, 1.0, 0.2);
+}
+
+// With the oedometer's walls in the triangulation (PFV's boundary spheres), measured 2026-11-30: rate
+// +0.97 %, S_A -10.8 % of the dry estimate; the curve 0.716 / 0.549 / 0.333 / 0.123 of the peak at T_v 0.1 /
+// 0.2 / 0.4 / 0.8 where Terzaghi's is 0.643 / 0.496 / 0.302 / 0.113 (the peak comes after the load ramp).
+// Bounds: rate 10 %, storage 20 %.
+TEST(CouplingPorenet3D, TerzaghiConsolidationWithTheWallsInTheNetwork) {
+  const Consolidation r = consolidate(true, 12e-3, 40000);
+  EXPECT_NEAR(r.rate_ratio, 1.0, 0.1);
+  EXPECT_NEAR(r.storage_ratio, 1.0, 0.2);
 }
 
 }  // namespace ff::coupling

@@ -1,0 +1,271 @@
+// The DEM's box walls in the 3D network (Porenet3DParams::walls; porenet::BoxWalls, PFV's boundary
+// spheres): a bonded sphere specimen between six plane walls (two platens and four side walls).
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "coupling/porenet/dem_porenet3d.hpp"
+#include "dem/dem_checkpoint.hpp"
+#include "dem/dem_params.hpp"
+#include "dem/sample_builder.hpp"
+#include "io/scenario.hpp"
+#include "porenet/eos.hpp"
+#include "porenet/forces.hpp"
+
+namespace ff::coupling {
+namespace {
+
+const std::string kScenario =
+    "[dem]\ndim = 3\nbond_law = \"parallel\"\n[dem.group.matrix]\ndensity = 2400\n"
+    "[dem.contact.matrix-matrix]\nemod = 2.0e9\nkratio = 2.5\nfriction = 0.4\n"
+    "[dem.bond.matrix-matrix]\nemod = 2.0e9\nkratio = 2.5\ntensile_strength = 17.4e6\ncohesion = 4.35e6\n"
+    "[sample]\nshape = \"box\"\nwidth = 6e-3\ndepth = 6e-3\nheight = 6e-3\nradius_min = 0.4e-3\nradius_max = 0.6e-3\n"
+    "porosity = 0.45\nseed = 5\n";
+
+struct Specimen {
+  ParamTable table;
+  Config cfg;
+  dem::DemSystem sys;
+  dem::SampleInfo info;
+};
+
+// The specimen with its platens (moving together at platen_v) and four frictionless side walls at the
+// spheres' extent.
+std::unique_ptr<Specimen> boxed(Real platen_v) {
+  auto s = std::make_unique<Specimen>();
+  dem::declare_dem_params(s->table);
+  dem::declare_sample_params(s->table);
+  s->cfg = load_scenario(s->table, "", kScenario, {});
+  s->sys.settings = dem::build_settings(s->cfg);
+  s->sys.settings.parallel_min = 1;
+  s->sys.materials = dem::build_materials(s->cfg);
+  s->info = dem::build_sample(s->cfg, s->sys);
+  dem::add_platens(s->sys, s->info, 0.0);
+  const auto& P = s->sys.particles;
+  for (int a = 0; a < 3; ++a) {
+    if (a == s->info.axis) continue;
+    Real lo = 1e9, hi = -1e9;
+    for (std::size_t i = 0; i < P.size(); ++i) {
+      lo = std::min(lo, P.pos[i][a] - P.radius[i]);
+      hi = std::max(hi, P.pos[i][a] + P.radius[i]);
+    }
+    for (int side = 0; side < 2; ++side) {
+      dem::Wall w;
+      w.name = "side";
+      w.normal = Vec3::Zero();
+      w.normal[a] = side == 0 ? 1 : -1;
+      w.point = Vec3::Zero();
+      w.point[a] = side == 0 ? lo : hi;
+      w.friction = 0;
+      s->sys.walls.push_back(w);
+    }
+  }
+  s->sys.initialise();
+  dem::choose_time_step(s->cfg, s->sys);
+  s->sys.walls[0].velocity[s->info.axis] = platen_v;
+  s->sys.walls[1].velocity[s->info.axis] = -platen_v;
+  return s;
+}
+
+Porenet3DParams fluid(Real saturation, Real K) {
+  Porenet3DParams p;
+  p.fluid.liquid = porenet::Eos::barotropic(1000, 1e5, K);
+  p.fluid.gas = porenet::Eos::ideal_gas(293.15, 28.9586);
+  p.saturation = saturation;
+  p.walls = true;
+  return p;
+}
+
+// The box the walls enclose [m^3] and the area of wall w (2 axis + side) [m^2].
+Real box_volume(const dem::DemSystem& sys, const DemPorenet3D& c) {
+  Real v = 1;
+  for (int a = 0; a < 3; ++a)
+    v *= sys.walls[static_cast<std::size_t>(c.wall_index(2 * a + 1))].point[a] -
+         sys.walls[static_cast<std::size_t>(c.wall_index(2 * a))].point[a];
+  return v;
+}
+Real wall_area(const dem::DemSystem& sys, const DemPorenet3D& c, int w) {
+  Real area = 1;
+  for (int a = 0; a < 3; ++a)
+    if (a != w / 2)
+      area *= sys.walls[static_cast<std::size_t>(c.wall_index(2 * a + 1))].point[a] -
+              sys.walls[static_cast<std::size_t>(c.wall_index(2 * a))].point[a];
+  return area;
+}
+
+std::vector<Real> state_of(const dem::DemSystem& sys, DemPorenet3D& c) {
+  std::vector<Real> v;
+  for (const auto& p : sys.particles.pos) v.insert(v.end(), {p.x(), p.y(), p.z()});
+  for (const auto& w : sys.walls) v.insert(v.end(), {w.force.x(), w.force.y(), w.force.z()});
+  for (Real p : c.flow().pressure()) v.push_back(p);
+  for (Real p : c.flow().liquid_mass()) v.push_back(p);
+  return v;
+}
+
+}  // namespace
+
+// Uniform gauge pressure P: no net force on any sphere (with the walls every sphere's cones close, the
+// ones against the walls included; without walls only the interior spheres' do), and each wall takes
+// P times its area, pushed outward (the DEM wall's force, what a servo reads, gains it). Tolerances:
+// 1e-9 P 4 pi R^2 per sphere, 1e-6 of P A per wall (the wall spheres' finite radius).
+TEST(CouplingPorenet3DWalls, UniformPressurePushesOnlyTheWalls) {
+  auto s = boxed(0);
+  DemPorenet3D c;
+  auto prm = fluid(1.0, 5e7);
+  prm.ambient_pressure = 0;
+  c.init(s->sys, prm);
+  const Real P = 1e6;
+  c.set_uniform_state(P, 1.0);
+  c.step(s->sys);
+  Real worst = 0;
+  for (std::size_t k = 0; k < s->sys.particles.size(); ++k) {
+    const Real r = s->sys.particles.radius[k];
+    worst = std::max(worst, c.fluid_force(static_cast<Index>(k)).norm() / (P * 4 * M_PI * r * r));
+  }
+  const auto& net = c.network();
+  int wall_pores = 0;
+  for (Index i = 0; i < net.n_pores(); ++i) wall_pores += net.pore_walls[i] != 0;
+  std::printf("uniform pressure with walls: %zu spheres, %d pores (%d on walls), max |F|/(P 4 pi r^2) = %.3g\n",
+              s->sys.particles.size(), net.n_pores(), wall_pores, worst);
+  EXPECT_LT(worst, 1e-9);
+  for (int w = 0; w < 6; ++w) {
+    const auto& wall = s->sys.walls[static_cast<std::size_t>(c.wall_index(w))];
+    EXPECT_NEAR(c.wall_fluid_force(w) / (P * wall_area(s->sys, c, w)), 1.0, 1e-6) << "wall " << w;
+    // The DEM wall's force (contacts + fluid), outward along -normal: the fluid's part at least.
+    EXPECT_GT(-wall.force.dot(wall.normal), 0.99 * c.wall_fluid_force(w)) << "wall " << w;
+  }
+}
+
+// The pores tile the box, so moving one sphere leaves the total void unchanged: for every sphere whose
+// pores are all above the floors, sum over its pore corners of dV_i/dx_j (void_gradient: Reynolds
+// transport in the interior pores, central differences of the geometry in the wall pores) is zero.
+// Tolerance 1e-6 of 4 pi R^2 (the differences' truncation and round-off); without walls the hull
+// spheres' sums are of the order of their surface.
+TEST(CouplingPorenet3DWalls, VoidGradientsOfEverySphereSumToZero) {
+  auto s = boxed(0);
+  DemPorenet3D c;
+  c.init(s->sys, fluid(1.0, 5e7));
+  const auto& net = c.network();
+  int tested = 0, at_walls = 0;
+  Real worst = 0;
+  for (Index j = 0; j < net.n_particles; ++j) {
+    bool floored = false, wall = false;
+    Vec3 sum = Vec3::Zero();
+    for (Index e = net.pp_start[j]; e < net.pp_start[j + 1]; ++e) {
+      const Index i = net.pp_pore[e];
+      floored = floored || net.pore_void[i] <= net.void_floor ||
+                net.pore_void[i] <= net.params.min_void_fraction * net.pore_cell[i] * (1 + 1e-12);
+      wall = wall || net.pore_walls[i] != 0;
+      Real a[3];
+      porenet::unit_patch_force_3d(net, e, a);
+      sum += c.void_gradient(j, e, Vec3(a[0], a[1], a[2]), false);
+    }
+    if (floored) continue;
+    ++tested;
+    at_walls += wall;
+    const Real r = s->sys.particles.radius[static_cast<std::size_t>(j)];
+    worst = std::max(worst, sum.norm() / (4 * M_PI * r * r));
+  }
+  std::printf("void gradients: %d spheres tested (%d on walls), max |sum dV/dx| / (4 pi R^2) = %.3g\n", tested,
+              at_walls, worst);
+  EXPECT_GT(at_walls, 20);
+  EXPECT_LT(worst, 1e-6);
+}
+
+// Undrained compression between the platens (closed: every wall impermeable, liquid K 5e7 Pa): with the
+// walls the pores fill the box, so the void the liquid sees shrinks by what the platens sweep, and once
+// the pressure has evened out p - p0 = K ln(V0 / V) with V the pores' void (barotropic liquid, mass
+// conserved; Wang 2000 with B = 1), within 1 % of the rise; the platens' fluid force is the gauge pressure
+// times their area within 2 % (the pores along them hold the mean pressure).
+TEST(CouplingPorenet3DWalls, UndrainedCompressionBetweenThePlatens) {
+  auto s = boxed(0.02);
+  DemPorenet3D c;
+  auto prm = fluid(1.0, 5e7);
+  prm.pfv_factor = 1.0;
+  prm.retriangulation_tolerance = 10;  // one network
+  c.init(s->sys, prm);
+  Real v0 = 0;
+  for (Real v : c.network().pore_void) v0 += v;
+  const Real box0 = box_volume(s->sys, c);
+  c.run(s->sys, 300);
+  s->sys.walls[0].velocity.setZero();
+  s->sys.walls[1].velocity.setZero();
+  c.run(s->sys, 300);
+  const auto& net = c.network();
+  Real v = 0, pv = 0;
+  const auto p = c.flow().pressure();
+  for (Index i = 0; i < net.n_pores(); ++i) {
+    v += net.pore_void[i];
+    pv += p[i] * net.pore_void[i];
+  }
+  const Real rise = pv / v - 1e5, expected = 5e7 * std::log(v0 / v);
+  const Real box = box_volume(s->sys, c);
+  const int ax = s->info.axis;
+  const Real platen = 0.5 * (c.wall_fluid_force(2 * ax) + c.wall_fluid_force(2 * ax + 1)) / wall_area(s->sys, c, 2 * ax);
+  std::printf("undrained with walls: box %.4g -> %.4g m^3 (%.3g %%), void %.4g -> %.4g m^3; rise %.5g Pa, K ln(V0/V) "
+              "%.5g Pa (%+.3f %%); platens' fluid force / area %.5g Pa\n", box0, box, 100 * (box / box0 - 1), v0, v,
+              rise, expected, 100 * (rise / expected - 1), platen);
+  EXPECT_GT(rise, 1e4);
+  EXPECT_NEAR(rise / expected, 1.0, 0.01);
+  EXPECT_NEAR(platen / rise, 1.0, 0.02);
+}
+
+// Resume from a checkpoint (DEM + network with its walls + fluid) continues bit-for-bit through a
+// retriangulation while the platens move; 1 and 2 threads agree.
+TEST(CouplingPorenet3DWalls, CheckpointResumeAndThreadsBitIdentical) {
+  auto prm = fluid(0.5, 2.2e9);
+  prm.retriangulation_tolerance = 0.0015;
+  const int n1 = 120, n2 = 120;
+  omp_set_num_threads(2);
+  auto ref = boxed(0.05);
+  DemPorenet3D cref;
+  cref.init(ref->sys, prm);
+  cref.run(ref->sys, n1 + n2);
+  const auto a = state_of(ref->sys, cref);
+  EXPECT_GE(cref.stats().retriangulations, 1);
+
+  omp_set_num_threads(1);
+  auto one = boxed(0.05);
+  DemPorenet3D c1;
+  c1.init(one->sys, prm);
+  c1.run(one->sys, n1);
+  const auto path = std::filesystem::temp_directory_path() / "ff_coupling_porenet3d_walls_test.ckpt";
+  {
+    CheckpointWriter w(path);
+    dem::save_dem(w, one->sys);
+    c1.save(w);
+    w.commit();
+  }
+  auto resumed = boxed(0);
+  {
+    CheckpointReader r(path);
+    dem::load_dem(r, resumed->sys);
+    DemPorenet3D c2;
+    c2.load(r, resumed->sys, prm);
+    c2.run(resumed->sys, n2);
+    const auto b = state_of(resumed->sys, c2);
+    c1.run(one->sys, n2);
+    const auto d = state_of(one->sys, c1);
+    ASSERT_EQ(a.size(), d.size());
+    ASSERT_EQ(b.size(), d.size());
+    long diff_resume = 0, diff_threads = 0;
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      diff_resume += b[k] != d[k];
+      diff_threads += a[k] != d[k];
+    }
+    std::printf("3D walls resume: %ld values differ; 1 vs 2 threads: %ld differ (of %zu); %ld retriangulations\n",
+                diff_resume, diff_threads, a.size(), c1.stats().retriangulations);
+    EXPECT_EQ(diff_resume, 0) << "resumed vs uninterrupted";
+    EXPECT_EQ(diff_threads, 0) << "2 threads vs 1 thread";
+  }
+  std::filesystem::remove(path);
+  omp_set_num_threads(2);
+}
+
+}  // namespace ff::coupling
