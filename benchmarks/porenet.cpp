@@ -248,6 +248,21 @@ int main(int argc, char** argv) {
   for (Index k = 0; k < net3.n_pores(); ++k) p3[static_cast<std::size_t>(k)] = 1e5 * (1 + 1e-3 * (k % 7));
   std::vector<Real> fx3(x3.size()), fy3(x3.size()), fz3(x3.size());
   const double t_force3 = median_ms(11, [&] { add_pressure_forces_3d(net3, parts3, p3, fx3, fy3, fz3); });
+  // The same packing with the box's walls in the triangulation (BoxWalls: wall pores and throats, PFV's
+  // hydraulic radius for every throat): build, then the geometry update interleaved with the one without
+  // walls (pairs of calls, medians of each).
+  BoxWalls box3;
+  box3.lo = {0, 0, 0};
+  box3.hi = {side3, side3, side3};
+  Network2D net3w;
+  const double t_build3w = median_ms(3, [&] { net3w = build_network_3d({x3, y3, z3, pk3.radius, {}}, {}, 1.0, &box3); });
+  std::vector<double> t_plain, t_walls;
+  for (int rep = 0; rep < 11; ++rep) {
+    t_plain.push_back(median_ms(1, [&] { update_network_3d(net3, parts3); }));
+    t_walls.push_back(median_ms(1, [&] { update_network_3d(net3w, parts3); }));
+  }
+  std::sort(t_plain.begin(), t_plain.end());
+  std::sort(t_walls.begin(), t_walls.end());
   const std::string mode = argc > 3 ? argv[3] : "";
   const bool quick = mode == "quick", nodem = mode == "nodem";
   std::printf("porenet 3D: %zu spheres (porosity %.3f, generated in %.1f s), %d pores, %d throats, %d hidden\n",
@@ -256,6 +271,9 @@ int main(int argc, char** argv) {
   std::printf("  single-phase explicit step      %9.3f ms  (stable dt %.3e s, water)\n", t_expl3, 2 * dt3);
   std::printf("  geometry update (pores, throats) %8.3f ms\n", t_update3);
   std::printf("  pressure forces (patches)       %9.3f ms\n", t_force3);
+  std::printf("  with walls: %d pores (%zu on walls), %d throats; build %.2f ms; geometry update %.3f ms against %.3f ms "
+              "without (interleaved, x %.2f)\n", net3w.n_pores(), net3w.wall_pores.size(), net3w.n_channels(), t_build3w,
+              t_walls[5], t_plain[5], t_walls[5] / t_plain[5]);
   std::fflush(stdout);
   if (mode == "geometry") return 0;  // the 3D network's per-step geometry and forces only
   // The DEM sample of the same size: its step is the reference (and interleaved with the flow steps).

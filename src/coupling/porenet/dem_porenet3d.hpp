@@ -137,6 +137,13 @@ class DemPorenet3D {
   // outward along the axis [N], and the DemSystem's index of that wall.
   Real wall_fluid_force(int w) const { return wall_force_[static_cast<std::size_t>(w)]; }
   int wall_index(int w) const { return wall_ids_[static_cast<std::size_t>(w)]; }
+  // ... and that force over the wall's area between the other walls (at the last sync) [Pa].
+  Real wall_fluid_pressure(int w) const {
+    Real area = 1;
+    for (std::size_t a = 0; a < 3; ++a)
+      if (static_cast<int>(a) != w / 2) area *= box_.hi[a] - box_.lo[a];
+    return wall_force_[static_cast<std::size_t>(w)] / area;
+  }
   // Stiffness the pore fluid adds to each sphere [N/m], for the DEM's critical step (as
   // DemPorenetCoupling::fluid_stiffness in 2D): tetrahedron i pushes on sphere j with p_i a_ij
   // (a_ij = porenet::unit_patch_force_3d; with the void-gradient force a_ij = g_ij) and moving j by dx

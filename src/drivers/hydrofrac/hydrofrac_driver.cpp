@@ -212,6 +212,7 @@ void HydrofracRun::make_fluid() {
     n.predict_pressures = cfg.boolean("network.predict_pressures");
     const std::string faces = cfg.string("network.faces");
     n.drained_faces = faces == "drained" || (faces == "auto" && sys.settings.dim == 3);
+    n.walls = sys.settings.dim == 3 && cfg.string("network.walls") != "off";
     n.cell = s.cell;
     n.inflate = s.inflate;
     n.reach = s.reach;
@@ -860,7 +861,8 @@ void HydrofracRun::finish(const std::string& stop) {
                                      "closed block: the residual is the scheme's mass error; drained faces: plus what the "
                                      "hull pores exchanged with the far field); ramp mode: injected is defined as the "
                                      "change (residual 0)"}}},
-                    {"faces", net_->drained_faces() ? "drained" : "closed"}};
+                    {"faces", net_->drained_faces() ? "drained" : "closed"},
+                    {"walls", net_->walls()}};
     log::info("hydrofrac: network mass budget over {} flow steps ({} retriangulations; kg{}): injected {:.6g}, pores "
               "{:.6g} -> {:.6g}, residual {:.3g}; wall time: network update {:.1f} s (retriangulations {:.1f} s in this "
               "session), flow {:.1f} s, forces {:.1f} s of {:.1f} s",

@@ -84,11 +84,19 @@ void declare_params(ParamTable& t) {
             "linearised at the last flow step, so that the held forces follow the grains: where the fluid-grain "
             "stiffness would allow fewer than 20 DEM steps per flow step, 20 (or network.flow_every when set)");
   t.string("network.faces", "auto",
-           "network: the pores on the block's hull: drained (held at network.pore_pressure, the far field, with every "
-           "pore within one largest radius of the outermost centres), closed "
-           "(undrained) or auto (drained in 3D, closed in 2D). Closed 3D hulls fail: the flat tetrahedra between grains "
-           "pressed on a wall reach 0.1-1 GPa as the grains move and break bonds at the faces (docs/hydrofrac.md)")
+           "network: the pores on the block's faces (3D with network.walls: the pores on the walls; otherwise the hull "
+           "and every pore within one largest radius of the outermost centres): drained (held at network.pore_pressure, "
+           "the far field), closed (undrained) or auto (drained in 3D, closed in 2D). Closed 3D hulls without walls "
+           "fail: the flat tetrahedra between grains pressed on a wall reach 0.1-1 GPa as the grains move and break "
+           "bonds at the faces (docs/hydrofrac.md)")
       .one_of({"auto", "drained", "closed"});
+  t.string("network.walls", "auto",
+           "network: on (3D only) puts the block's six servo walls in the triangulation (PFV's boundary spheres): the "
+           "pores between the outermost grains and the walls join the network (drained faces: those pores held at "
+           "network.pore_pressure instead of the hull and its band; closed: their pressure pushes the walls), and the "
+           "throats take PFV's hydraulic radius (Kozeny-Carman within 0.8-1.0; docs/porenet.md section 2); off: the "
+           "network ends at the hull of the grain centres; auto: on in 3D, off in 2D")
+      .one_of({"auto", "on", "off"});
   t.boolean("network.vtk", true, "network: write the pores (vtk/pores_*.vtu: gauge pressure per pore) with the particle snapshots");
   // The lattice Boltzmann fluid (injection.fluid = "lbm"), SI units (coupling::FluidSpec).
   t.real("fluid.density", 1000, "kg/m^3", "lbm: fluid density").positive();
@@ -215,6 +223,9 @@ void validate_scenario(const Config& cfg) {
              fmt::format("{} Pa is not below network.pore_pressure = {} Pa: every pore would start cavitated (water at "
                          "20 C: 2.34e3 Pa; 0 lets the liquid take any tension)",
                          cfg.real("network.vapour_pressure"), cfg.real("network.pore_pressure")));
+  if (cfg.string("network.walls") == "on" && cfg.integer("dem.dim") != 3)
+    cfg.fail("network.walls", "walls in the network are 3D (PFV's boundary spheres): dem.dim = 3, or network.walls = "
+                              "\"auto\" / \"off\"");
   if (cfg.string("injection.lbm_source") == "velocity_box" &&
       (cfg.string("injection.fluid") != "lbm" || cfg.string("injection.mode") != "rate"))
     cfg.fail("injection.lbm_source", "velocity_box is the LBM fluid's rate-mode source: it needs injection.fluid = \"lbm\" "

@@ -59,6 +59,7 @@ coupling::Porenet3DParams params_3d(const NetworkSettings& s) {
   p.pressure_force = s.pressure_force;
   p.implicit = true;
   p.drained = s.drained_faces;
+  p.walls = s.walls;
   return p;
 }
 // DEM steps per flow step and whether the held steps predict the pressures (3D): from the fluid-grain
@@ -124,7 +125,9 @@ void NetworkLoad::make_coupling() {
 // at 0.1 MPa in the hole (the 30,000-sphere example), and its grains' bonds broke; not all of
 // them are on the hull. The band is fixed at the start (checkpointed with the state).
 void NetworkLoad::drain_faces(porenet::TwoPhaseFlow& f, const porenet::Network2D& net) const {
-  if (!s_.drained_faces) return;
+  // With walls in the network the pores on them are the faces (Porenet3DParams::drained holds them):
+  // no flat hull tetrahedra, no band.
+  if (!s_.drained_faces || s_.walls) return;
   for (Index i = 0; i < net.n_pores(); ++i) {
     const Real c[3] = {net.pore_cx[i], net.pore_cy[i], net.dim == 3 ? net.pore_cz[i] : 0.0};
     bool out = false;
@@ -142,7 +145,10 @@ void NetworkLoad::find_hole_pores(const porenet::Network2D& net) {
     bool in = in_hole(hole_, c, 0);
     if (!in) {
       in = true;
-      for (int k = 0; k < nv && in; ++k) in = is_wall_[static_cast<std::size_t>(net.pore_v[nv * i + k])] != 0;
+      for (int k = 0; k < nv && in; ++k) {
+        const Index q = net.pore_v[nv * i + k];
+        in = !net.is_wall_vertex(q) && is_wall_[static_cast<std::size_t>(q)] != 0;
+      }
     }
     if (in) hole_pores_.push_back(i);
   }
@@ -177,6 +183,7 @@ Real NetworkLoad::spring_time(const dem::DemSystem& sys) const {
     Real tmin = std::numeric_limits<Real>::infinity();
     for (int k = 0; k < nv; ++k) {
       const Index q = net.pore_v[nv * i + k];
+      if (net.is_wall_vertex(q)) continue;
       const Real r = sys.particles.radius[q], im = sys.particles.inv_mass[q];
       if (!(im > 0)) continue;
       const Real A = net.dim == 3 ? kPi * r * r : 2 * r * net.params.thickness;
@@ -479,6 +486,13 @@ void NetworkLoad::load(CheckpointReader& r, const dem::DemSystem& sys) {
   }
 }
 
+std::array<Real, 6> NetworkLoad::face_pressures() const {
+  std::array<Real, 6> p{};
+  if (c3_ && s_.walls)
+    for (int w = 0; w < 6; ++w) p[static_cast<std::size_t>(w)] = c3_->wall_fluid_pressure(w);
+  return p;
+}
+
 void NetworkLoad::write_vtu(const std::filesystem::path& file, const dem::DemSystem& sys) const {
   const auto& net = network();
   const int nv = net.dim == 3 ? 4 : 3;
@@ -486,18 +500,35 @@ void NetworkLoad::write_vtu(const std::filesystem::path& file, const dem::DemSys
   std::vector<char> hole(static_cast<std::size_t>(net.n_pores()), 0);
   for (Index i : hole_pores_) hole[static_cast<std::size_t>(i)] = 1;
   const auto& X = sys.particles.pos;
+  // A pore on a wall (network.walls) is drawn as a tetrahedron whose wall corners are its centroid's
+  // projections onto those walls (extra points after the particles).
+  std::vector<Vec3> extra;
+  std::vector<Index> conn(static_cast<std::size_t>(nv) * static_cast<std::size_t>(net.n_pores()));
+  for (Index i = 0; i < net.n_pores(); ++i)
+    for (int k = 0; k < nv; ++k) {
+      Index q = net.pore_v[nv * i + k];
+      if (net.is_wall_vertex(q)) {
+        const int w = static_cast<int>(q - net.n_particles);
+        Vec3 x(net.pore_cx[i], net.pore_cy[i], net.pore_cz[i]);
+        x[w / 2] = net.wall_plane[static_cast<std::size_t>(w)];
+        q = static_cast<Index>(X.size() + extra.size());
+        extra.push_back(x);
+      }
+      conn[static_cast<std::size_t>(nv * i + k)] = q;
+    }
   std::string out;
-  out.reserve(static_cast<std::size_t>(net.n_pores()) * 64 + X.size() * 48);
+  out.reserve(static_cast<std::size_t>(net.n_pores()) * 64 + (X.size() + extra.size()) * 48);
   auto o = std::back_inserter(out);
   fmt::format_to(o,
                  "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
                  "<UnstructuredGrid>\n<Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n<Points>\n"
                  "<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n",
-                 X.size(), net.n_pores());
+                 X.size() + extra.size(), net.n_pores());
   for (const Vec3& x : X) fmt::format_to(o, "{} {} {}\n", x.x(), x.y(), x.z());
+  for (const Vec3& x : extra) fmt::format_to(o, "{} {} {}\n", x.x(), x.y(), x.z());
   fmt::format_to(o, "</DataArray>\n</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n");
   for (Index i = 0; i < net.n_pores(); ++i) {
-    for (int k = 0; k < nv; ++k) fmt::format_to(o, "{} ", net.pore_v[nv * i + k]);
+    for (int k = 0; k < nv; ++k) fmt::format_to(o, "{} ", conn[static_cast<std::size_t>(nv * i + k)]);
     out.push_back('\n');
   }
   fmt::format_to(o, "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n");

@@ -73,6 +73,7 @@ struct NetworkSettings {
   coupling::PressureForce pressure_force = coupling::PressureForce::Surface;
   bool shear_forces = true;               // 2D: channel shear B25/B28
   bool drained_faces = true;              // network.faces = "drained": hull pores held at p0
+  bool walls = false;                     // 3D: the six walls in the triangulation (Porenet3DParams::walls)
   long flow_every = 0;                    // DEM steps per flow step; 0: from the fluid-grain stiffness
   Real flow_safety = 0.3;                 // N dt <= safety x sqrt(m / k) (median)
   long max_flow_every = 100;
@@ -117,11 +118,15 @@ class NetworkLoad final : public FluidLoad {
   void advance(const dem::DemSystem& sys) override;
   FluidState state() const override;
   const std::vector<Index>& wall_particles() const override { return wall_; }
+  // With network.walls: the gauge pressure of the wall pores on each face (what the servos add); else 0
+  // (drained faces: the hull at p0).
+  std::array<Real, 6> face_pressures() const override;
   void save(CheckpointWriter& w) const override;
   void load(CheckpointReader& r, const dem::DemSystem& sys) override;
 
   const NetworkInfo& info() const { return info_; }
   bool drained_faces() const { return s_.drained_faces; }
+  bool walls() const { return s_.walls; }
   bool predicting() const { return predict_; }  // 3D: the held steps predict the pressures
   NetworkBudget budget() const;
   Real effective_radius() const { return st_.effective_radius; }

@@ -74,28 +74,63 @@ TEST(HydrofracNetwork, ThreeDimensionalBlockBreaksFromTheHole) {
 
 #else  // test_hydrofrac_network3d_fast: the seconds-long ones, in make test
 
-// The 3D drained faces (network.faces = auto: hull pores and the band of one radius along the faces
-// held at p0; the band is fixed at the start) resume bit for bit: the same block to 3 MPa, stopped
-// mid-injection and resumed, gives the whole run's series and cracks; and no grain near a face
-// breaks before the hole does (with closed faces the flat pores between the grains on a wall broke
-// bonds at 0.1-0.4 MPa on the 30,000-sphere example: docs/hydrofrac.md, "Faces"). With the pressure
-// prediction (the default) the resume falls mid-cycle: the prediction's state is in the checkpoint.
+// The 3D drained faces (network.faces = auto; with network.walls = auto the pores between the grains and
+// the six walls, held at p0) resume bit for bit: the same block to 3 MPa, stopped mid-injection and
+// resumed, gives the whole run's series and cracks; and no grain near a face breaks before the hole
+// does. With the pressure prediction (the default) the resume falls mid-cycle: the prediction's state is
+// in the checkpoint. The same with closed faces: the wall pores' pressure pushes the servo walls (and is
+// in the checkpoint).
 TEST(HydrofracNetwork, ThreeDimensionalDrainedFacesResumeBitForBit) {
   Scratch s;
   const fs::path file = small_block(s);
-  const std::string sets = kSmallBlock + " --set injection.fluid=network --set injection.max_pressure=3e6";
-  const auto j = run_scenario(file, s / "whole", sets);
-  EXPECT_EQ(j["network"]["faces"].get<std::string>(), "drained");
-  EXPECT_EQ(j["cracks"]["total"].get<long>(), 0);
-  ff::test::expect_resume_identical(file, s / "whole", s / "parts", 707, sets);  // mid-cycle (N = 20)
+  for (const std::string faces : {"drained", "closed"}) {
+    const std::string sets =
+        kSmallBlock + " --set injection.fluid=network --set injection.max_pressure=3e6 --set network.faces=" + faces;
+    const auto j = run_scenario(file, s / ("whole_" + faces), sets);
+    EXPECT_EQ(j["network"]["faces"].get<std::string>(), faces);
+    EXPECT_TRUE(j["network"]["walls"].get<bool>());
+    EXPECT_EQ(j["cracks"]["total"].get<long>(), 0);
+    ff::test::expect_resume_identical(file, s / ("whole_" + faces), s / ("parts_" + faces), 707, sets);  // mid-cycle
+  }
+}
+
+// Walls in the network (network.walls, PFV's boundary spheres) against the network that ends at the hull
+// of the grain centres, on the same block with closed faces: without walls the flat tetrahedra between
+// the grains pressed on a wall build pressures of their own as the grains move, and the block breaks at
+// its faces (measured 2026-11-30: breakdown 0.66 MPa, the first cracks 4.9-5.7 mm from the axis, 712
+// cracks; on the 30,000-sphere example 0.1-1.7 GPa in such pores, docs/hydrofrac.md); with the walls the
+// pores along the faces are the gaps between the grains and the walls, and the block holds until the
+// hole breaks (17.26 MPa, first cracks at 2.73-2.78 mm, the hole's effective radius 2.72 mm; the fracture
+// at 0.0 deg from sigma_H). With drained faces the walls change little: 19.47 MPa (19.69 without; the
+// breakdown of closed faces is lower: the pore pressure the injection raises in the block stays).
+TEST(HydrofracNetwork, WallsLetClosedFacesHoldUntilTheHoleBreaks) {
+  Scratch s;
+  const fs::path file = small_block(s);
+  const std::string sets = kSmallBlock + " --set injection.fluid=network --set network.faces=closed";
+  const auto hull = run_scenario(file, s / "hull", sets + " --set network.walls=off");
+  const auto walls = run_scenario(file, s / "walls", sets);
+  ASSERT_FALSE(walls["breakdown"]["pressure_Pa"].is_null());
+  const double a = walls["borehole"]["effective_radius_m"].get<double>();
+  const double pw = walls["breakdown"]["pressure_Pa"].get<double>();
+  const double ph = hull["breakdown"]["pressure_Pa"].is_null() ? NAN : hull["breakdown"]["pressure_Pa"].get<double>();
+  std::printf("3D closed faces: breakdown with walls %.2f MPa (%ld cracks), without %.2f MPa (%ld cracks)\n", 1e-6 * pw,
+              walls["cracks"]["total"].get<long>(), 1e-6 * ph, hull["cracks"]["total"].get<long>());
+  EXPECT_FALSE(hull["network"]["walls"].get<bool>());
+  EXPECT_TRUE(walls["network"]["walls"].get<bool>());
+  EXPECT_GT(pw, 10e6);
+  for (double x : ff::test::first_crack_distances(s / "walls" / "cracks.csv", 6e-3, 6e-3, 3))
+    EXPECT_LT(x, a + 4 * 0.6e-3) << "with walls: a first crack away from the hole";
+  EXPECT_LT(ph, 0.2 * pw) << "without walls the closed block no longer breaks at its faces: update the comment";
 }
 
 // The held steps' pressure prediction (network.predict_pressures, on by default): the same block
 // fractured with a flow step every DEM step (the stiffness of the water allows no more without it)
-// and with one every 20, the pressures predicted in between. Measured 2026-11-29 (one thread):
-// breakdown 19.69 MPa and initiation 18.14 MPa in both, 49 and 48 cracks, fracture 10.1 and 9.6 mm
-// at 0.3 and 1.2 deg from sigma_H; 11.5 s and 4.7 s (network update 5.6 -> 0.3 s, flow 3.3 -> 0.3 s,
-// forces and prediction 0.3 -> 1.9 s). Asserted: the pressures within 2 %, the cracks within 20 %.
+// and with one every 20, the pressures predicted in between. Measured 2026-11-29 (one thread, no walls
+// in the network): breakdown 19.69 MPa and initiation 18.14 MPa in both, 49 and 48 cracks, fracture
+// 10.1 and 9.6 mm at 0.3 and 1.2 deg from sigma_H; 11.5 s and 4.7 s (network update 5.6 -> 0.3 s, flow
+// 3.3 -> 0.3 s, forces and prediction 0.3 -> 1.9 s). With the walls (2026-11-30): breakdown 19.47 MPa in
+// both, initiation 17.48 / 17.70 MPa, 61 / 64 cracks. Asserted: the pressures within 2 %, the cracks
+// within 20 %.
 TEST(HydrofracNetwork, PressurePredictionKeepsTheBreakdownPressure) {
   Scratch s;
   const fs::path file = small_block(s);
