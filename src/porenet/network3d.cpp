@@ -219,13 +219,29 @@ void throat_geometry_3d(Network2D& net, const Particles3D& p, Index c0, Index c1
       x[j] = dot(sub(P[(j + 1) % 3], P[j]), sub(P[(j + 2) % 3], P[j]));
     }
     if (!pfv) continue;
+    // solid_angle_args at both ends of each edge, sharing what they share: the edge's length, each sphere's
+    // distances to p1 and p2, and the tetrahedron's triple product (the same at both ends).
     const V3 p1 = pc(net.ch_pore[2 * c]), p2 = pc(net.ch_pore[2 * c + 1]);
+    V3 b[3], d[3];
+    Real lb[3], ld[3], bd[3];
+    for (int j = 0; j < 3; ++j) {
+      b[j] = sub(p1, P[j]);
+      d[j] = sub(p2, P[j]);
+      lb[j] = norm(b[j]);
+      ld[j] = norm(d[j]);
+      bd[j] = dot(b[j], d[j]);
+    }
     Real vol = 0;
     for (int j = 0; j < 3; ++j) {
-      const V3 u = P[j], w = P[(j + 1) % 3];
-      vol += std::abs(dot(sub(w, u), cross(sub(p1, u), sub(p2, u)))) / 6;
-      solid_angle_args(u, w, p1, p2, y[2 + 2 * j], x[2 + 2 * j]);
-      solid_angle_args(w, u, p1, p2, y[3 + 2 * j], x[3 + 2 * j]);
+      const int k = (j + 1) % 3;
+      const V3 e = sub(P[k], P[j]);
+      const Real le = norm(e);
+      const Real det = std::abs(dot(e, cross(b[j], d[j])));
+      vol += det / 6;
+      y[2 + 2 * j] = det;  // at P[j]: edges e, b_j, d_j
+      x[2 + 2 * j] = le * lb[j] * ld[j] + dot(e, b[j]) * ld[j] + dot(e, d[j]) * lb[j] + bd[j] * le;
+      y[3 + 2 * j] = det;  // at P[k]: edges -e, b_k, d_k
+      x[3 + 2 * j] = le * lb[k] * ld[k] - dot(e, b[k]) * ld[k] - dot(e, d[k]) * lb[k] + bd[k] * le;
     }
     region[c - c0] = vol;
   }
