@@ -36,6 +36,7 @@ void DemPorenetCoupling::build_pairs(const dem::DemSystem& sys) {
   pair_bond_.clear();
   std::vector<std::uint64_t> bonded;
   bonded.reserve(sys.bonds.size());
+  bond_keys_.reserve(sys.bonds.size());  // remap_pair_bonds: the bond set only shrinks
   for (std::size_t b = 0; b < sys.bonds.size(); ++b) {
     const Index a = sys.bonds.i[b], c = sys.bonds.j[b];
     pairs_.add(a, c, sys.bonds.broken[b] ? porenet::PairState::BrokenBond : porenet::PairState::Bond);
@@ -54,10 +55,40 @@ void DemPorenetCoupling::build_pairs(const dem::DemSystem& sys) {
   }
 }
 
+// The DEM drops broken bonds at each neighbour rebuild (DemSystem::compact_bonds), which shifts the
+// indices of the bonds after them: each pair's bond is found again by its two particles; a pair whose
+// bond is gone was a bond that broke (only broken bonds are dropped). Before 2026-11-30 the stale
+// indices read other bonds' loads (the B1 apertures' sigma_n) and broken flags.
+void DemPorenetCoupling::remap_pair_bonds(const dem::DemSystem& sys) {
+  bond_keys_.clear();
+  for (std::size_t b = 0; b < sys.bonds.size(); ++b)
+    bond_keys_.emplace_back(pair_key(sys.bonds.i[b], sys.bonds.j[b]), static_cast<Index>(b));
+  std::sort(bond_keys_.begin(), bond_keys_.end());
+  for (std::size_t q = 0; q < pairs_.size(); ++q) {
+    if (pair_bond_[q] < 0) continue;
+    const std::uint64_t key = pair_key(pairs_.i[q], pairs_.j[q]);
+    const auto it = std::lower_bound(bond_keys_.begin(), bond_keys_.end(), std::make_pair(key, Index(-1)));
+    if (it != bond_keys_.end() && it->first == key) {
+      pair_bond_[q] = it->second;
+    } else {
+      pair_bond_[q] = -1;
+      pairs_.state[q] = porenet::PairState::BrokenBond;
+    }
+  }
+}
+
 // sigma_n = F_n / (2 min(R) h), h the force's height (t or 2 min(R)), from the bond's and the
 // contact's loads of this step (F on the second particle; compression pushes it away from the first:
 // F.n > 0).
 void DemPorenetCoupling::fill_pair_state(const dem::DemSystem& sys) {
+  for (std::size_t q = 0; q < pairs_.size(); ++q) {
+    const Index b = pair_bond_[q];
+    if (b >= 0 && (static_cast<std::size_t>(b) >= sys.bonds.size() || pair_key(sys.bonds.i[b], sys.bonds.j[b]) !=
+                                                                            pair_key(pairs_.i[q], pairs_.j[q]))) {
+      remap_pair_bonds(sys);
+      break;
+    }
+  }
   const auto& P = sys.particles;
   const auto adj_off = sys.neighbors().adjacency_offsets();
   const auto adj = sys.neighbors().adjacency();

@@ -162,6 +162,7 @@ class DemPorenetCoupling {
   void gather_positions(const dem::DemSystem& sys);
   void build_pairs(const dem::DemSystem& sys);
   void fill_pair_state(const dem::DemSystem& sys);
+  void remap_pair_bonds(const dem::DemSystem& sys);  // pair_bond_ after the DEM dropped broken bonds
   void make_network_and_flow(std::unique_ptr<porenet::Network2D>& net, std::unique_ptr<porenet::TwoPhaseFlow>& flow);
   void set_boundaries(porenet::TwoPhaseFlow& flow, const porenet::Network2D& net);
   void retriangulate(const dem::DemSystem& sys);
@@ -174,6 +175,7 @@ class DemPorenetCoupling {
   std::unique_ptr<porenet::TwoPhaseFlow> flow_;
   porenet::PairList pairs_;
   std::vector<Index> pair_bond_;  // bond index per pair, -1 for a contact
+  std::vector<std::pair<std::uint64_t, Index>> bond_keys_;  // remap_pair_bonds' scratch
   std::vector<Real> x_, y_, r_, ref_x_, ref_y_, fx_, fy_, pg_;
   // Vapour bookkeeping (cavitate): vapour mass per pore, each pore's gas mass after the last
   // cavitate() (the flow's change since then moves vapour), prescribed-pressure pores (no vapour).

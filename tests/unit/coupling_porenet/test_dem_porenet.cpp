@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -296,4 +298,55 @@ TEST(CouplingPorenet, CheckpointResumeAndThreadsBitIdentical) {
 }
 
 }  // namespace
+}  // namespace ff::coupling
+
+namespace ff::coupling {
+
+// The DEM drops broken bonds at each neighbour rebuild (DemSystem::compact_bonds), shifting the indices
+// of the bonds after them. The coupling finds each pair's bond again by its particles: after three bonds
+// break and are dropped and the specimen is loaded for 200 steps, every pair of the running coupling has
+// the sigma_n (B1) of a coupling built afresh on the same state, the dropped bonds are broken-bond
+// pairs, and each pair's bond joins its own particles. Before 2026-11-30 the stale indices read the
+// loads of the bonds one to three places further (tested: it fails then).
+TEST(CouplingPorenet, DroppedBrokenBondsKeepEachPairsOwnBond) {
+  auto s = specimen(0.05);
+  auto& sys = s->sys;
+  DemPorenetCoupling c;
+  c.init(sys, fluid(1.0));
+  for (int k = 0; k < 50; ++k) c.step(sys);
+  // Break three bonds near the start of the list (every later index shifts) and drop them.
+  std::vector<std::pair<Index, Index>> dropped;
+  for (std::size_t b : {std::size_t(2), std::size_t(5), std::size_t(9)}) {
+    sys.bonds.broken[b] = 1;
+    dropped.emplace_back(sys.bonds.i[b], sys.bonds.j[b]);
+  }
+  sys.compact_bonds();
+  for (int k = 0; k < 200; ++k) c.step(sys);
+  c.sync(sys);  // the pair states at the current loads
+  DemPorenetCoupling fresh;
+  fresh.init(sys, fluid(1.0));
+  fresh.sync(sys);
+  const auto& a = c.pairs();
+  const auto& b = fresh.pairs();
+  std::map<std::pair<Index, Index>, std::size_t> in_fresh;
+  for (std::size_t q = 0; q < b.size(); ++q) in_fresh[{std::min(b.i[q], b.j[q]), std::max(b.i[q], b.j[q])}] = q;
+  int compared = 0, differ = 0, broken_dropped = 0;
+  for (std::size_t q = 0; q < a.size(); ++q) {
+    const std::pair<Index, Index> key{std::min(a.i[q], a.j[q]), std::max(a.i[q], a.j[q])};
+    if (std::find(dropped.begin(), dropped.end(), key) != dropped.end()) {
+      broken_dropped += a.state[q] == porenet::PairState::BrokenBond;
+      continue;
+    }
+    const auto it = in_fresh.find(key);
+    if (it == in_fresh.end() || a.state[q] != porenet::PairState::Bond) continue;
+    ++compared;
+    differ += a.sigma_n[q] != b.sigma_n[it->second];
+  }
+  std::printf("dropped bonds: %d of 3 pairs broken-bond; %d bonded pairs compared, %d sigma_n differ\n", broken_dropped,
+              compared, differ);
+  EXPECT_EQ(broken_dropped, 3);
+  EXPECT_GT(compared, 100);
+  EXPECT_EQ(differ, 0);
+}
+
 }  // namespace ff::coupling
