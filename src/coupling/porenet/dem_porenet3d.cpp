@@ -215,12 +215,50 @@ bool DemPorenet3D::sync(const dem::DemSystem& sys) {
   if (stats_.max_displacement > prm_.retriangulation_tolerance * mean_radius_) {
     retriangulate();
     stats_.max_displacement = 0;
+    add_crack_channels(sys);
     return true;
   }
   const auto t0 = std::chrono::steady_clock::now();
   porenet::update_network_3d(*net_, view(), box());
+  add_crack_channels(sys);
   stats_.t_update += seconds_since(t0);
   return false;
+}
+
+// The DEM's crack log in order (every bond that broke, by the global ids of its spheres; the bond set
+// itself drops broken bonds at each neighbour rebuild), each throat whose facet holds both spheres
+// (found from the pores of the first; a facet counted from the first of its two pores): serial, the
+// same sums on any thread count.
+void DemPorenet3D::add_crack_channels(const dem::DemSystem& sys) {
+  if (!prm_.crack_channels || sys.cracks.events.empty()) return;
+  const auto& ids = sys.particles.id;
+  if (id_index_.size() != static_cast<std::size_t>(std::max<std::int64_t>(sys.particles.next_id, 0))) {
+    id_index_.assign(static_cast<std::size_t>(std::max<std::int64_t>(sys.particles.next_id, 0)), -1);
+    for (std::size_t k = 0; k < ids.size(); ++k)
+      if (ids[k] >= 0 && static_cast<std::size_t>(ids[k]) < id_index_.size()) id_index_[static_cast<std::size_t>(ids[k])] = static_cast<Index>(k);
+  }
+  auto index = [&](std::int64_t id) {
+    return id >= 0 && static_cast<std::size_t>(id) < id_index_.size() ? id_index_[static_cast<std::size_t>(id)] : Index(-1);
+  };
+  auto& net = *net_;
+  for (const auto& e : sys.cracks.events) {
+    const Index a = index(e.i), c = index(e.j);
+    if (a < 0 || c < 0) continue;
+    const Real dx = x_[c] - x_[a], dy = y_[c] - y_[a], dz = z_[c] - z_[a];
+    const Real w = std::sqrt(dx * dx + dy * dy + dz * dz) - r_[a] - r_[c];
+    if (!(w > 0)) continue;
+    const Real slit = w * w * w * e.size / 12;  // e.size: the bond's radius
+    for (Index q = net.pp_start[a]; q < net.pp_start[a + 1]; ++q) {
+      const Index k = net.pp_pore[q];
+      for (Index m = net.pc_start[k]; m < net.pc_start[k + 1]; ++m) {
+        const Index ch = net.pc_ch[m];
+        if (net.ch_pore[2 * ch] != k) continue;
+        const Index* v = &net.ch_part[3 * static_cast<std::size_t>(ch)];
+        const bool has_a = v[0] == a || v[1] == a || v[2] == a, has_c = v[0] == c || v[1] == c || v[2] == c;
+        if (has_a && has_c) net.ch_cond[ch] += slit / net.ch_length[ch];
+      }
+    }
+  }
 }
 
 void DemPorenet3D::step(dem::DemSystem& sys) {

@@ -29,10 +29,9 @@
 // of 1 (docs/saturated.md gives accuracy and speed).
 // Channel shear (Porenet3DParams::channel_shear): A_f (P_a - P_b) per throat on its three spheres.
 // Results are bit-identical on any thread count.
-// Cracks in 3D: no separate crack channels; a broken bond's spheres move apart, and the facets
-// they share grow in fluid area and hydraulic radius (update_network_3d each step), so the
-// throats across an opening crack conduct more (up to NetworkParams::max_cond_ratio x the
-// median conductance of the last triangulation). Staged use (drivers with their own step
+// Cracks in 3D: a broken bond's spheres move apart, the facets they share grow in fluid area and
+// hydraulic radius (update_network_3d each step), and each of those throats gains the cubic-law
+// conductance of the bond's opening (Porenet3DParams::crack_channels). Staged use (drivers with their own step
 // order, e.g. drivers/hydrofrac/network_load.cpp): sync(), advance_flow(), compute_fluid_forces().
 #pragma once
 #include <array>
@@ -102,6 +101,15 @@ struct Porenet3DParams {
   // conductance cap along the faces: docs/porenet.md section 9). With `drained` the pores on the walls
   // are the ones held at the ambient pressure. The pressure prediction does not see the walls move.
   bool walls = false;
+  // Crack channels: each throat whose facet has a broken bond's two spheres among its corners (the DEM's
+  // crack log) conducts a slit of the bond's opening w = |x_b - x_a| - R_a - R_b (> 0) as well:
+  // g mu = w^3 r_b / (12 L) (the cubic law, METHODS 5.3b, over the half of the bond's disc, radius r_b,
+  // that lies in the facet; L the throat's length), added to the facet's own conductance after its cap
+  // and not scaled by pfv_factor: the crack's conductance is its opening's, not the matrix's (the 2D
+  // network's broken-bond S2S channel). Off by default (the drivers' keys: network.crack_channels,
+  // fluid.crack_channels): the implicit step's outflow limit (a pore gives at most the mass it holds per
+  // step) halves the step many times over in the pores along an open crack, whose throughflow is large.
+  bool crack_channels = false;
 };
 
 struct Porenet3DStats {
@@ -200,6 +208,7 @@ class DemPorenet3D {
   void make_network_and_flow(std::unique_ptr<porenet::Network2D>& net, std::unique_ptr<porenet::TwoPhaseFlow>& flow);
   void set_boundaries(porenet::TwoPhaseFlow& flow, const porenet::Network2D& net);
   void retriangulate();
+  void add_crack_channels(const dem::DemSystem& sys);  // crack_channels: after every geometry update
   void flow_step(Real dt);
   void add_forces(dem::DemSystem& sys);
   void linearise_pressures();                       // pred_* at the flow step (predict_pressures)
@@ -213,6 +222,7 @@ class DemPorenet3D {
   std::array<int, 6> wall_ids_{};             // walls: DemSystem wall of box wall w
   porenet::BoxWalls box_, ref_box_;           // walls: now and at the last triangulation
   std::array<Real, 6> wall_force_{};          // walls: fluid force, outward [N]
+  std::vector<Index> id_index_;               // crack channels: particle index of each global id (-1: none)
   std::unique_ptr<porenet::Network2D> net_;
   std::unique_ptr<porenet::TwoPhaseFlow> flow_;
   std::vector<Real> x_, y_, z_, r_, ref_x_, ref_y_, ref_z_, fx_, fy_, fz_, pg_;

@@ -79,6 +79,11 @@ void declare_params(ParamTable& t) {
   t.integer("network.flow_every", 0, "steps",
             "network: DEM steps per implicit flow step (0: from the fluid-grain stiffness, see docs/hydrofrac.md)")
       .non_negative();
+  t.boolean("network.crack_channels", false,
+            "network, 3D: each throat beside a broken bond conducts the cubic law of the bond's opening w as well, "
+            "w^3 r_bond / (12 mu L), not scaled by network.throat_factor (the 2D network's cracks are channels of their "
+            "own); false: a crack conducts only as its widened facets. Off by default: on the 30,000-sphere example the "
+            "implicit flow then halves its step thousands of times once cracks open (docs/hydrofrac.md)");
   t.boolean("network.predict_pressures", true,
             "network, 3D: between flow steps advance the pore pressures every DEM step by the flow's implicit step "
             "linearised at the last flow step, so that the held forces follow the grains: where the fluid-grain "

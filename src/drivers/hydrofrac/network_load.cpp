@@ -60,6 +60,7 @@ coupling::Porenet3DParams params_3d(const NetworkSettings& s) {
   p.implicit = true;
   p.drained = s.drained_faces;
   p.walls = s.walls;
+  p.crack_channels = s.crack_channels;
   return p;
 }
 // DEM steps per flow step and whether the held steps predict the pressures (3D): from the fluid-grain

@@ -91,6 +91,11 @@ void declare(ParamTable& t) {
             "fluid's stiffness would bound fluid.flow_every (water-full samples) or when fluid.flow_every > 1 "
             "(false: the forces held as they are)")
       .fallback();
+  t.boolean("fluid.crack_channels", false,
+            "3D: each throat beside a broken bond conducts the cubic law of the bond's opening as well "
+            "(coupling::Porenet3DParams::crack_channels). Off by default here: with two phases (S 0.8) the 3D example's "
+            "pores reached 1.6 GPa after the peak with it (75.6 MPa without; docs/saturated.md)")
+      .fallback();
   t.real("fluid.cg_tolerance", 1e-12, "-",
          "3D implicit flow: relative residual of the conjugate-gradient pressure solve (porenet; the phase masses stay "
          "conserved at any value, the channel fluxes being antisymmetric)")
@@ -141,7 +146,7 @@ const std::vector<std::string> k2DOnly = {"fluid.aperture_h0", "fluid.aperture_h
                                           "fluid.shear_forces", "fluid.cavitation_pressure", "fluid.force_height",
                                           "fluid.remap", "fluid.implicit_above"};
 const std::vector<std::string> k3DOnly = {"fluid.pfv_factor", "fluid.cg_tolerance", "fluid.flow_every",
-                                          "fluid.predict_pressures"};
+                                          "fluid.predict_pressures", "fluid.crack_channels"};
 
 porenet::TwoPhaseParams fluid_params(const Config& cfg) {
   porenet::TwoPhaseParams f;
@@ -204,6 +209,7 @@ coupling::Porenet3DParams params_3d(const Config& cfg) {
   p.implicit = cfg.string("fluid.flow_scheme") != "explicit";
   p.flow_every = cfg.integer("fluid.flow_every");
   p.predict_pressures = cfg.boolean("fluid.predict_pressures");
+  p.crack_channels = cfg.boolean("fluid.crack_channels");
   p.drained = false;  // the lateral hull pores only: set by SaturatedUcsRun's on_network
   p.pressure_force = pressure_force(cfg, true);
   return p;
