@@ -65,6 +65,9 @@ TwoPhaseFlow::TwoPhaseFlow(const Network2D& net, const TwoPhaseParams& params)
   fp_ = fq_;
   lim_q_.assign(n, 1);
   lim_p_ = lim_q_;
+  gross_q_.assign(n, 0);
+  net_bound_.assign(n, 0);
+  switch_.assign(n, 0);
   net_q_.assign(n, 0);
   net_p_ = net_q_;
   scratch_.assign(static_cast<std::size_t>(std::max<Index>(reduce_blocks(std::max(np_, nc_)), 1)), 0);
@@ -309,31 +312,73 @@ void TwoPhaseFlow::step_explicit(Real dt) {
 // a DEM step), its outgoing rates of that phase are scaled down to its mass (1 - 1e-12). Each channel's
 // rate is scaled once, by its upstream pore (apply_outflow_limits): conservative to round-off.
 Index TwoPhaseFlow::find_outflow_limits(Real dt, Index* bulk) {
-  Index limited = 0, limited_bulk = 0;
-#pragma omp parallel for schedule(static) reduction(+ : limited, limited_bulk) if (np_ > kParallelMin)
+#pragma omp parallel for schedule(static) if (np_ > kParallelMin)
   for (Index i = 0; i < np_; ++i) {
     lim_q_[i] = lim_p_[i] = 1;
+    net_bound_[i] = 0;
     if (bc_[i] == PoreBc::Pressure) continue;
-    Real oq = 0, op = 0, nq = 0, np = 0;
+    Real oq = 0, op = 0, nq = 0, np = 0, gas_in = 0;
     for (Index e = net_.pc_start[i]; e < net_.pc_start[i + 1]; ++e) {
       const Index c = net_.pc_ch[e];
       const bool first = net_.ch_pore[2 * c] == i;
       const Real sg = first ? 1.0 : -1.0;
       oq += std::max(sg * fq_[c], 0.0);
       op += std::max(sg * fp_[c], 0.0);
+      gas_in += std::max(-sg * fp_[c], 0.0);
       nq += first ? fq_[c] : -fq_[c];  // the net outflow, as update_pore_states sums it
       np += first ? fp_[c] : -fp_[c];
     }
     net_q_[i] = nq;
     net_p_[i] = np;
-    oq *= dt;
+    gross_q_[i] = oq * dt;
+    // A liquid-full pore that takes in no gas has no saturation to keep in [0, 1]: what it must not
+    // exceed is its net loss of liquid, not its gross outflow. Liquid flowing through it (the pores along
+    // a crack) would otherwise trip the limit every step: the 30,000-sphere hydrofrac example with crack
+    // channels halved its steps thousands of times (docs/hydrofrac.md). Such a pore stays unlimited while
+    // its net outflow fits (net_bound_; checked again below with its neighbours' limits on its inflow);
+    // otherwise it takes the gross bound, which holds whatever its inflow.
+    if (1 - alpha_[i] <= kTraceFraction && gas_in == 0 && std::max(nq, 0.0) * dt <= mq_[i]) net_bound_[i] = 1;
+    else if (gross_q_[i] > mq_[i]) lim_q_[i] = (1 - 1e-12) * mq_[i] / gross_q_[i];
     op *= dt;
-    if (oq > mq_[i]) lim_q_[i] = (1 - 1e-12) * mq_[i] / oq;
     if (op > mp_[i]) lim_p_[i] = (1 - 1e-12) * mp_[i] / op;
-    limited += (oq > mq_[i] || op > mp_[i]) ? 1 : 0;
+  }
+  // A net-bound pore whose inflow the limits upstream cut may now lose more than it holds: it takes the
+  // gross bound, which cuts the inflow of the pores downstream of it in turn. Jacobi rounds (each reads
+  // the limits of the round before: the same on any thread count) until none switches.
+  for (;;) {
+    Index switched = 0;
+#pragma omp parallel for schedule(static) reduction(+ : switched) if (np_ > kParallelMin)
+    for (Index i = 0; i < np_; ++i) {
+      switch_[i] = 0;
+      if (!net_bound_[i]) continue;
+      Real in = 0;
+      for (Index e = net_.pc_start[i]; e < net_.pc_start[i + 1]; ++e) {
+        const Index c = net_.pc_ch[e];
+        const Index a = net_.ch_pore[2 * c], b = net_.ch_pore[2 * c + 1];
+        const Real into = a == i ? -fq_[c] : fq_[c];  // > 0: from the other pore into i
+        if (into > 0) in += into * lim_q_[a == i ? b : a];
+      }
+      if (gross_q_[i] - in * dt > mq_[i]) {
+        switch_[i] = 1;
+        ++switched;
+      }
+    }
+    if (switched == 0) break;
+#pragma omp parallel for schedule(static) if (np_ > kParallelMin)
+    for (Index i = 0; i < np_; ++i) {
+      if (!switch_[i]) continue;
+      net_bound_[i] = 0;
+      if (gross_q_[i] > mq_[i]) lim_q_[i] = (1 - 1e-12) * mq_[i] / gross_q_[i];
+    }
+  }
+  Index limited = 0, limited_bulk = 0;
+#pragma omp parallel for schedule(static) reduction(+ : limited, limited_bulk) if (np_ > kParallelMin)
+  for (Index i = 0; i < np_; ++i) {
+    const bool lq = lim_q_[i] < 1, lp = lim_p_[i] < 1;
+    limited += (lq || lp) ? 1 : 0;
     // A trace (a phase under kTraceFraction of the void) is limited but never asks for a halving:
     // it changes neither the pore's pressure nor its other phase.
-    limited_bulk += ((oq > mq_[i] && alpha_[i] > kTraceFraction) || (op > mp_[i] && 1 - alpha_[i] > kTraceFraction)) ? 1 : 0;
+    limited_bulk += ((lq && alpha_[i] > kTraceFraction) || (lp && 1 - alpha_[i] > kTraceFraction)) ? 1 : 0;
   }
   if (bulk) *bulk = limited_bulk;
   return limited;

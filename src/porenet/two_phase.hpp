@@ -183,6 +183,8 @@ class TwoPhaseFlow {
   std::unique_ptr<PressureSystem> sys_;
   Real liquid_max_density_ = 0, gas_max_density_ = 0, liquid_min_density_ = 0;  // the laws' bounds (B23's bracket)
   std::vector<Real> tq_, tp_, rhs_, dp_, pnew_, lim_q_, lim_p_, storage_;  // storage_: each row's C_i (state check)
+  std::vector<Real> gross_q_;                     // find_outflow_limits: each pore's gross liquid outflow over dt
+  std::vector<std::uint8_t> net_bound_, switch_;  // find_outflow_limits: liquid bounded by the net outflow
   std::vector<Real> net_q_, net_p_;  // each pore's net outflow rate per phase [kg/s] (find_outflow_limits)
   int cg_iters_ = 0, substeps_ = 0;
   Index limited_ = 0;
