@@ -29,6 +29,7 @@
 #include "porenet/eos.hpp"
 #include "porenet/flow.hpp"
 #include "../porenet/terzaghi.hpp"
+#include "side_walls.hpp"
 
 namespace ff::coupling {
 namespace {
@@ -60,26 +61,7 @@ std::unique_ptr<Column> column(Real height) {
   c->sys.materials = dem::build_materials(c->cfg);
   c->info = dem::build_sample(c->cfg, c->sys);
   dem::add_platens(c->sys, c->info, 0.0);
-  // Four frictionless side walls at the sample's extent: the oedometer.
-  const auto& P = c->sys.particles;
-  for (int a = 0; a < 3; ++a) {
-    if (a == c->info.axis) continue;
-    Real lo = 1e9, hi = -1e9;
-    for (std::size_t i = 0; i < P.size(); ++i) {
-      lo = std::min(lo, P.pos[i][a] - P.radius[i]);
-      hi = std::max(hi, P.pos[i][a] + P.radius[i]);
-    }
-    for (int s = 0; s < 2; ++s) {
-      dem::Wall w;
-      w.name = "side";
-      w.normal = Vec3::Zero();
-      w.normal[a] = s == 0 ? 1 : -1;
-      w.point = Vec3::Zero();
-      w.point[a] = s == 0 ? lo : hi;
-      w.friction = 0;
-      c->sys.walls.push_back(w);
-    }
-  }
+  test::add_side_walls(c->sys, c->info.axis);  // the oedometer
   c->sys.initialise();
   dem::choose_time_step(c->cfg, c->sys);
   return c;

@@ -20,6 +20,7 @@
 #include "porenet/eos.hpp"
 #include "porenet/flow.hpp"
 #include "porenet/forces.hpp"
+#include "side_walls.hpp"
 
 namespace ff::coupling {
 namespace {
@@ -50,25 +51,7 @@ std::unique_ptr<Specimen> boxed(Real platen_v) {
   s->sys.materials = dem::build_materials(s->cfg);
   s->info = dem::build_sample(s->cfg, s->sys);
   dem::add_platens(s->sys, s->info, 0.0);
-  const auto& P = s->sys.particles;
-  for (int a = 0; a < 3; ++a) {
-    if (a == s->info.axis) continue;
-    Real lo = 1e9, hi = -1e9;
-    for (std::size_t i = 0; i < P.size(); ++i) {
-      lo = std::min(lo, P.pos[i][a] - P.radius[i]);
-      hi = std::max(hi, P.pos[i][a] + P.radius[i]);
-    }
-    for (int side = 0; side < 2; ++side) {
-      dem::Wall w;
-      w.name = "side";
-      w.normal = Vec3::Zero();
-      w.normal[a] = side == 0 ? 1 : -1;
-      w.point = Vec3::Zero();
-      w.point[a] = side == 0 ? lo : hi;
-      w.friction = 0;
-      s->sys.walls.push_back(w);
-    }
-  }
+  test::add_side_walls(s->sys, s->info.axis);
   s->sys.initialise();
   dem::choose_time_step(s->cfg, s->sys);
   s->sys.walls[0].velocity[s->info.axis] = platen_v;

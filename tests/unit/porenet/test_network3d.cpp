@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <map>
 
+#include "box_network.hpp"
 #include "geometry/packing.hpp"
 #include "porenet/atan2_batch.hpp"
 #include "porenet/flow.hpp"
@@ -23,30 +24,8 @@ using namespace ff;
 using namespace ff::porenet;
 
 namespace {
-// A dense random packing of spheres (radii 0.4-0.6 mm) in the box [0, hi], as coordinate arrays.
-struct Spheres {
-  std::vector<Real> x, y, z, r;
-};
-Spheres box_spheres(const Vec3& hi, Real porosity, std::uint64_t seed) {
-  PackingSpec spec;
-  spec.dim = 3;
-  spec.container = PackingSpec::Container::Box;
-  spec.box_lo = {0, 0, 0};
-  spec.box_hi = hi;
-  spec.radius_min = 0.4e-3;
-  spec.radius_max = 0.6e-3;
-  spec.porosity = porosity;
-  spec.seed = seed;
-  const Packing pk = dense_random_packing(spec);
-  Spheres s;
-  for (const Vec3& c : pk.position) {
-    s.x.push_back(c.x());
-    s.y.push_back(c.y());
-    s.z.push_back(c.z());
-  }
-  s.r = pk.radius;
-  return s;
-}
+using test_packings::box_spheres;
+using test_packings::Spheres;
 }  // namespace
 
 TEST(PorenetNetwork3D, FourTouchingSpheresAndBoxFlow) {

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "box_network.hpp"
 #include "geometry/packing.hpp"
 #include "porenet/flow.hpp"
 #include "porenet/forces.hpp"
@@ -24,24 +25,13 @@ struct Sample {
 };
 // A dense random packing of spheres (radii 0.4-0.6 mm) inside the box [0, hi], walls on its faces.
 Sample box_sample(const Vec3& hi, Real porosity, std::uint64_t seed) {
-  PackingSpec spec;
-  spec.dim = 3;
-  spec.container = PackingSpec::Container::Box;
-  spec.box_lo = {0, 0, 0};
-  spec.box_hi = hi;
-  spec.radius_min = 0.4e-3;
-  spec.radius_max = 0.6e-3;
-  spec.porosity = porosity;
-  spec.seed = seed;
-  const Packing pk = dense_random_packing(spec);
+  const auto pk = test_packings::box_spheres(hi, porosity, seed);
   Sample s;
-  for (const Vec3& c : pk.position) {
-    s.x.push_back(c.x());
-    s.y.push_back(c.y());
-    s.z.push_back(c.z());
-  }
-  s.r = pk.radius;
-  s.porosity = pk.achieved_porosity;
+  s.x = pk.x;
+  s.y = pk.y;
+  s.z = pk.z;
+  s.r = pk.r;
+  s.porosity = pk.porosity;
   s.walls.lo = {0, 0, 0};
   s.walls.hi = {hi.x(), hi.y(), hi.z()};
   return s;
