@@ -17,6 +17,7 @@
 #include "io/scenario.hpp"
 #include "porenet/eos.hpp"
 #include "porenet/forces.hpp"
+#include "resume_check.hpp"
 
 namespace ff::coupling {
 namespace {
@@ -178,21 +179,7 @@ Real mean_rise(DemPorenet3D& c) {
 // steps and returns its state.
 std::vector<Real> resumed_state(const dem::DemSystem& sys, const DemPorenet3D& c, const Porenet3DParams& prm,
                                 int steps, const std::string& file) {
-  const auto path = std::filesystem::temp_directory_path() / file;
-  {
-    CheckpointWriter w(path);
-    dem::save_dem(w, sys);
-    c.save(w);
-    w.commit();
-  }
-  auto resumed = specimen(0, 1);
-  CheckpointReader r(path);
-  dem::load_dem(r, resumed->sys);
-  DemPorenet3D c2;
-  c2.load(r, resumed->sys, prm);
-  c2.run(resumed->sys, steps);
-  std::filesystem::remove(path);
-  return state_of(resumed->sys, c2);
+  return test::resumed_state([](Real v) { return specimen(v, 1); }, sys, c, prm, steps, file, state_of);
 }
 
 // Sub-cycling (Porenet3DParams::flow_every = 0: N from the fluid's stiffness, growing 2, 4, 8, 16, 20
@@ -370,37 +357,8 @@ TEST(CouplingPorenet3D, PressurePredictionLetsSaturatedSamplesStride) {
 TEST(CouplingPorenet3D, CheckpointResumeAndThreadsBitIdentical) {
   auto prm = fluid(0.5, 2.2e9);
   prm.retriangulation_tolerance = 0.0015;
-  const int n1 = 120, n2 = 120;
-  omp_set_num_threads(2);
-  auto ref = specimen(0.05, 1);
-  DemPorenet3D cref;
-  cref.init(ref->sys, prm);
-  cref.run(ref->sys, n1 + n2);
-  const auto a = state_of(ref->sys, cref);
-  EXPECT_GE(cref.stats().retriangulations, 1);
-
-  omp_set_num_threads(1);
-  auto one = specimen(0.05, 1);
-  DemPorenet3D c1;
-  c1.init(one->sys, prm);
-  c1.run(one->sys, n1);
-  {
-    const auto b = resumed_state(one->sys, c1, prm, n2, "ff_coupling_porenet3d_test.ckpt");
-    c1.run(one->sys, n2);
-    const auto d = state_of(one->sys, c1);
-    ASSERT_EQ(a.size(), d.size());
-    ASSERT_EQ(b.size(), d.size());
-    long diff_resume = 0, diff_threads = 0;
-    for (std::size_t k = 0; k < a.size(); ++k) {
-      diff_resume += b[k] != d[k];
-      diff_threads += a[k] != d[k];
-    }
-    std::printf("3D resume: %ld values differ; 1 vs 2 threads: %ld differ (of %zu); %ld retriangulations\n",
-                diff_resume, diff_threads, a.size(), c1.stats().retriangulations);
-    EXPECT_EQ(diff_resume, 0) << "resumed vs uninterrupted";
-    EXPECT_EQ(diff_threads, 0) << "2 threads vs 1 thread";
-  }
-  omp_set_num_threads(2);
+  test::expect_resume_and_threads_identical([](Real v) { return specimen(v, 1); }, prm, 120, 120, state_of,
+                                            "ff_coupling_porenet3d_test.ckpt", "3D");
 }
 
 }  // namespace

@@ -6,20 +6,19 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "coupling/porenet/dem_porenet3d.hpp"
-#include "dem/dem_checkpoint.hpp"
 #include "dem/dem_params.hpp"
 #include "dem/sample_builder.hpp"
 #include "io/scenario.hpp"
 #include "porenet/eos.hpp"
 #include "porenet/flow.hpp"
 #include "porenet/forces.hpp"
+#include "resume_check.hpp"
 #include "side_walls.hpp"
 
 namespace ff::coupling {
@@ -207,51 +206,8 @@ TEST(CouplingPorenet3DWalls, UndrainedCompressionBetweenThePlatens) {
 TEST(CouplingPorenet3DWalls, CheckpointResumeAndThreadsBitIdentical) {
   auto prm = fluid(0.5, 2.2e9);
   prm.retriangulation_tolerance = 0.0015;
-  const int n1 = 120, n2 = 120;
-  omp_set_num_threads(2);
-  auto ref = boxed(0.05);
-  DemPorenet3D cref;
-  cref.init(ref->sys, prm);
-  cref.run(ref->sys, n1 + n2);
-  const auto a = state_of(ref->sys, cref);
-  EXPECT_GE(cref.stats().retriangulations, 1);
-
-  omp_set_num_threads(1);
-  auto one = boxed(0.05);
-  DemPorenet3D c1;
-  c1.init(one->sys, prm);
-  c1.run(one->sys, n1);
-  const auto path = std::filesystem::temp_directory_path() / "ff_coupling_porenet3d_walls_test.ckpt";
-  {
-    CheckpointWriter w(path);
-    dem::save_dem(w, one->sys);
-    c1.save(w);
-    w.commit();
-  }
-  auto resumed = boxed(0);
-  {
-    CheckpointReader r(path);
-    dem::load_dem(r, resumed->sys);
-    DemPorenet3D c2;
-    c2.load(r, resumed->sys, prm);
-    c2.run(resumed->sys, n2);
-    const auto b = state_of(resumed->sys, c2);
-    c1.run(one->sys, n2);
-    const auto d = state_of(one->sys, c1);
-    ASSERT_EQ(a.size(), d.size());
-    ASSERT_EQ(b.size(), d.size());
-    long diff_resume = 0, diff_threads = 0;
-    for (std::size_t k = 0; k < a.size(); ++k) {
-      diff_resume += b[k] != d[k];
-      diff_threads += a[k] != d[k];
-    }
-    std::printf("3D walls resume: %ld values differ; 1 vs 2 threads: %ld differ (of %zu); %ld retriangulations\n",
-                diff_resume, diff_threads, a.size(), c1.stats().retriangulations);
-    EXPECT_EQ(diff_resume, 0) << "resumed vs uninterrupted";
-    EXPECT_EQ(diff_threads, 0) << "2 threads vs 1 thread";
-  }
-  std::filesystem::remove(path);
-  omp_set_num_threads(2);
+  test::expect_resume_and_threads_identical(boxed, prm, 120, 120, state_of, "ff_coupling_porenet3d_walls_test.ckpt",
+                                            "3D walls");
 }
 
 }  // namespace ff::coupling
