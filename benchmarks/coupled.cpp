@@ -13,7 +13,7 @@
 // moving `slow` 0.002 cells per LBM step (bonded rock under load: few cells change per step) or
 // `fast` 0.05 cells per step (every particle's rim cells change within a few steps), both with
 // moving walls (the particles' velocities in the fluid's walls, the set handed over every step); or
-// `creep`, the hydrofrac LBM fluid's own mode (drivers/hydrofrac/lbm_load.cpp): quasi-static walls
+// `creep`, the hydrofrac LBM fluid's own mode (coupling/hydrofrac/lbm_load.cpp): quasi-static walls
 // (zero wall velocities), the rim moving 1e-4 cells per step (the rock's creep measured there), the
 // set handed to the fluid again only once a particle has moved 0.02 cells (CouplerSettings::
 // wall_motion = 0, set_refresh = 0.02). The DEM runs its full step (contacts, bonds, integration)

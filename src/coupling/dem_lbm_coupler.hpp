@@ -41,7 +41,7 @@ struct CouplerSettings {
   // latitudes times twice as many longitudes (64: 8 x 16 = 128 points).
   int quadrature = 64;
   // The particles' velocities in the fluid's walls: 1 moving walls; 0 quasi-static walls (the
-  // hydrofrac LBM fluid's default, drivers/hydrofrac/lbm_load.cpp).
+  // hydrofrac LBM fluid's default, coupling/hydrofrac/lbm_load.cpp).
   double wall_motion = 1.0;
   // > 0: the set is handed to the fluid again only once a particle has moved this many cells since
   // the last hand-over (and the fluid steps with the set it has in between), as the hydrofrac LBM

@@ -149,7 +149,7 @@ class DemPorenetCoupling {
   void load(CheckpointReader& r, dem::DemSystem& sys, const PorenetCouplingParams& params);
 
   // Staged use by a driver with its own step order (hydrofrac's network fluid,
-  // drivers/hydrofrac/network_load.cpp), instead of step(): sync() brings the network to the
+  // coupling/hydrofrac/network_load.cpp), instead of step(): sync() brings the network to the
   // system's current positions and pair loads (after compute_forces), retriangulating past the
   // tolerance (returns true then: a new flow object, boundary conditions to set again); the
   // caller steps flow() itself; compute_fluid_forces() fills fluid_fx/fluid_fy from the current

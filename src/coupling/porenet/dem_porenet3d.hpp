@@ -32,7 +32,7 @@
 // Cracks in 3D: a broken bond's spheres move apart, the facets they share grow in fluid area and
 // hydraulic radius (update_network_3d each step), and each of those throats gains the cubic-law
 // conductance of the bond's opening (Porenet3DParams::crack_channels). Staged use (drivers with their own step
-// order, e.g. drivers/hydrofrac/network_load.cpp): sync(), advance_flow(), compute_fluid_forces().
+// order, e.g. coupling/hydrofrac/network_load.cpp): sync(), advance_flow(), compute_fluid_forces().
 #pragma once
 #include <array>
 #include <cstdint>

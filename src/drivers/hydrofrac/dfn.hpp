@@ -10,10 +10,12 @@
 #include <vector>
 
 #include "dem/dem_system.hpp"
-#include "drivers/hydrofrac/fluid_load.hpp"
+#include "coupling/hydrofrac/fluid_load.hpp"
 #include "io/params.hpp"
 
 namespace ff::drivers::hydrofrac {
+
+using coupling::hydrofrac::JointPair;  // a bond cut by a joint (the fluid loads read them too)
 
 struct Joint {
   Vec3 centre = Vec3::Zero();

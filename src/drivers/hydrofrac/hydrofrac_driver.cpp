@@ -30,13 +30,13 @@
 #include "dem/sample_builder.hpp"
 #include "drivers/dem_results.hpp"
 #include "drivers/flow/flow_runner.hpp"
-#include "drivers/hydrofrac/borehole.hpp"
+#include "coupling/hydrofrac/borehole.hpp"
 #include "drivers/hydrofrac/dfn.hpp"
 #include "drivers/hydrofrac/hydrofrac_params.hpp"
 #include "drivers/hydrofrac/kirsch.hpp"
 #include "drivers/hydrofrac/sleeve_load.hpp"
-#include "drivers/hydrofrac/lbm_load.hpp"
-#include "drivers/hydrofrac/network_load.hpp"
+#include "coupling/hydrofrac/lbm_load.hpp"
+#include "coupling/hydrofrac/network_load.hpp"
 #include "io/pvd.hpp"
 #include "coupling/fluid_spec.hpp"
 #include "drivers/run_control.hpp"
@@ -46,6 +46,11 @@
 #include "io/csv.hpp"
 #include "io/json_out.hpp"
 #include "io/plot.hpp"
+
+// The fluid loads (LBM, pore network) and the borehole geometry live in src/coupling/hydrofrac/.
+namespace ff::drivers::hydrofrac {
+using namespace coupling::hydrofrac;
+}
 
 namespace fs = std::filesystem;
 

@@ -14,7 +14,12 @@
 #include "dem/sample_builder.hpp"
 #include "drivers/flow/flow_runner.hpp"
 #include "drivers/hydrofrac/dfn.hpp"
-#include "drivers/hydrofrac/lbm_load.hpp"
+#include "coupling/hydrofrac/lbm_load.hpp"
+
+// The fluid loads (LBM, pore network) and the borehole geometry live in src/coupling/hydrofrac/.
+namespace ff::drivers::hydrofrac {
+using namespace coupling::hydrofrac;
+}
 
 namespace ff::drivers::hydrofrac {
 
@@ -43,7 +48,7 @@ void declare_params(ParamTable& t) {
            "lbm (lattice Boltzmann fluid over the block, keys fluid.*; docs/hydrofrac.md); network (pore-network flow from the "
            "hole into the rock and its cracks, keys network.*)")
       .one_of({"sleeve", "lbm", "network"});
-  // The pore network (injection.fluid = "network"; drivers/hydrofrac/network_load.hpp).
+  // The pore network (injection.fluid = "network"; coupling/hydrofrac/network_load.hpp).
   t.real("network.viscosity", 1e-3, "Pa s", "network: dynamic viscosity of the injected liquid").positive();
   t.real("network.density", 1000, "kg/m^3", "network: liquid density at network.pore_pressure").positive();
   t.real("network.pore_pressure", 1e5, "Pa",

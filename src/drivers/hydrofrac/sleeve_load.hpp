@@ -10,10 +10,14 @@
 #pragma once
 #include <vector>
 
-#include "drivers/hydrofrac/borehole.hpp"
-#include "drivers/hydrofrac/fluid_load.hpp"
+#include "coupling/hydrofrac/borehole.hpp"
+#include "coupling/hydrofrac/fluid_load.hpp"
 
 namespace ff::drivers::hydrofrac {
+
+// The borehole geometry and the FluidLoad interface (src/coupling/hydrofrac/), which the sleeve
+// implements without a second physics module.
+using namespace coupling::hydrofrac;
 
 struct SleeveSettings {
   bool rate_mode = false;

@@ -1,4 +1,4 @@
-// The LBM fluid of the hydrofrac driver (drivers/hydrofrac/lbm_load.hpp) on hand-built rock:
+// The LBM fluid of the hydrofrac driver (coupling/hydrofrac/lbm_load.hpp) on hand-built rock:
 //  - the load the rock feels is the physical pressure: a ring of overlapping disks (a sealed
 //    borehole wall) under a hole pressure p gets from the lattice p times each disk's wetted chord
 //    (the exact load of a uniform pressure on its surface between the necks), in total and per
@@ -17,11 +17,13 @@
 #include <vector>
 
 #include "../coupling/coupling_fixture.hpp"
-#include "drivers/hydrofrac/lbm_load.hpp"
+#include "coupling/hydrofrac/lbm_load.hpp"
 #include "drivers/hydrofrac/sleeve_load.hpp"
 
 using namespace ff;
-using namespace ff::drivers::hydrofrac;
+using namespace ff::coupling::hydrofrac;
+using ff::drivers::hydrofrac::SleeveLoad;
+using ff::drivers::hydrofrac::SleeveSettings;
 
 namespace {
 

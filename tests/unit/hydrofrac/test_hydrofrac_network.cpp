@@ -1,4 +1,4 @@
-// injection.fluid = "network" (drivers/hydrofrac/network_load.hpp): hydraulic fracturing from a
+// injection.fluid = "network" (coupling/hydrofrac/network_load.hpp): hydraulic fracturing from a
 // borehole through the pore network of issue 16, run through the fracflow program as a user does:
 //  1. before breakdown the hole pressure loads the rock as the sleeve model does (Kirsch): the
 //     stress increments on measurement circles around the hole, network against sleeve, on the

@@ -1,4 +1,4 @@
-// injection.fluid = "network" in 3D (drivers/hydrofrac/network_load.hpp): a block of bonded
+// injection.fluid = "network" in 3D (coupling/hydrofrac/network_load.hpp): a block of bonded
 // spheres fractured from a vertical borehole through the 3D pore network (regular triangulation,
 // PFV throats), run through the fracflow program. The 2D tests: test_hydrofrac_network.cpp.
 #include <fmt/format.h>

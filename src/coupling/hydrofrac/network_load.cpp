@@ -1,4 +1,4 @@
-#include "drivers/hydrofrac/network_load.hpp"
+#include "coupling/hydrofrac/network_load.hpp"
 
 #include <fmt/format.h>
 
@@ -15,7 +15,7 @@
 #include "coupling/porenet/dem_porenet3d.hpp"
 #include "porenet/two_phase.hpp"
 
-namespace ff::drivers::hydrofrac {
+namespace ff::coupling::hydrofrac {
 
 namespace {
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -549,4 +549,4 @@ void NetworkLoad::write_vtu(const std::filesystem::path& file, const dem::DemSys
   f << out;
 }
 
-}  // namespace ff::drivers::hydrofrac
+}  // namespace ff::coupling::hydrofrac

@@ -34,8 +34,8 @@
 #include <string>
 #include <vector>
 
-#include "drivers/hydrofrac/borehole.hpp"
-#include "drivers/hydrofrac/fluid_load.hpp"
+#include "coupling/hydrofrac/borehole.hpp"
+#include "coupling/hydrofrac/fluid_load.hpp"
 #include "porenet/network.hpp"
 #include "coupling/porenet/pressure_force.hpp"
 #include "porenet/remap.hpp"
@@ -49,7 +49,7 @@ namespace ff::porenet {
 class TwoPhaseFlow;
 }
 
-namespace ff::drivers::hydrofrac {
+namespace ff::coupling::hydrofrac {
 
 struct NetworkSettings {
   bool rate_mode = false;
@@ -183,4 +183,4 @@ class NetworkLoad final : public FluidLoad {
   std::unique_ptr<coupling::DemPorenet3D> c3_;
 };
 
-}  // namespace ff::drivers::hydrofrac
+}  // namespace ff::coupling::hydrofrac

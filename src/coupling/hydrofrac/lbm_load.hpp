@@ -31,10 +31,10 @@
 #include <vector>
 
 #include "coupling/fluid_spec.hpp"
-#include "drivers/hydrofrac/fluid_load.hpp"
+#include "coupling/hydrofrac/fluid_load.hpp"
 #include "lbm/moving_boundary.hpp"
 
-namespace ff::drivers::hydrofrac {
+namespace ff::coupling::hydrofrac {
 
 struct LbmSettings {
   coupling::FluidSpec fluid;  // dx and one of bulk_modulus / sound_speed / time_step / tau set
@@ -95,4 +95,4 @@ LbmInfo lbm_info(const LbmSettings& s, Real dem_dt);
 // The lattice over the particles (every particle plus one cell): sets info.n and info.origin.
 void size_lattice(const dem::ParticleStore& p, Real dx, int dim, LbmInfo& info);
 
-}  // namespace ff::drivers::hydrofrac
+}  // namespace ff::coupling::hydrofrac

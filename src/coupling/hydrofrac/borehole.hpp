@@ -6,9 +6,9 @@
 #include <vector>
 
 #include "dem/dem_system.hpp"
-#include "drivers/hydrofrac/fluid_load.hpp"
+#include "coupling/hydrofrac/fluid_load.hpp"
 
-namespace ff::drivers::hydrofrac {
+namespace ff::coupling::hydrofrac {
 
 // Whether x lies in the hole or a perforation slot, both widened by `pad` [m] (x-y only).
 bool in_hole(const BoreholeGeometry& g, const Vec3& x, Real pad);
@@ -55,4 +55,4 @@ struct FractureShape {
 };
 FractureShape fracture_shape(const dem::DemSystem& sys, const std::vector<std::size_t>& events, const Vec3& centre);
 
-}  // namespace ff::drivers::hydrofrac
+}  // namespace ff::coupling::hydrofrac

@@ -1,4 +1,4 @@
-#include "drivers/hydrofrac/lbm_load.hpp"
+#include "coupling/hydrofrac/lbm_load.hpp"
 
 #include <fmt/format.h>
 
@@ -9,12 +9,12 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "coupling/particle_set.hpp"
-#include "drivers/hydrofrac/borehole.hpp"
+#include "coupling/hydrofrac/borehole.hpp"
 #include "io/vtk.hpp"
 #include "lbm/lattice_budget.hpp"
 #include "lbm/solver.hpp"
 
-namespace ff::drivers::hydrofrac {
+namespace ff::coupling::hydrofrac {
 
 std::string LbmInfo::describe() const {
   return fmt::format("{}\nLBM lattice {} x {} x {} cells; dt_lbm = {:.4g} s = n dt_dem with dt_dem = {:.4g} s and n = {} DEM "
@@ -592,4 +592,4 @@ std::unique_ptr<LbmLoadBase> make_lbm_load(const LbmSettings& s, int dim) {
   return std::make_unique<LbmLoad<lbm::D2Q9>>(s);
 }
 
-}  // namespace ff::drivers::hydrofrac
+}  // namespace ff::coupling::hydrofrac

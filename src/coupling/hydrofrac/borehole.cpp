@@ -1,4 +1,4 @@
-#include "drivers/hydrofrac/borehole.hpp"
+#include "coupling/hydrofrac/borehole.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 
 #include "core/error.hpp"
 
-namespace ff::drivers::hydrofrac {
+namespace ff::coupling::hydrofrac {
 
 bool in_hole(const BoreholeGeometry& g, const Vec3& x, Real pad) {
   const Real dx = x.x() - g.centre.x(), dy = x.y() - g.centre.y();
@@ -269,4 +269,4 @@ FractureShape fracture_shape(const dem::DemSystem& sys, const std::vector<std::s
   return f;
 }
 
-}  // namespace ff::drivers::hydrofrac
+}  // namespace ff::coupling::hydrofrac

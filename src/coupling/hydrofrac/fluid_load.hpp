@@ -1,8 +1,11 @@
 // The fluid side of the hydraulic-fracturing driver, behind one small interface, so that the
 // driver's rock (block, borehole, in-situ stresses, cracks) does not depend on how the fluid is
-// modelled. Two implementations are meant: "sleeve" (sleeve_load.hpp: a pressure acting on the
-// particles that line the borehole, and on crack faces connected to it with penetration) and
-// "lbm" (the lattice Boltzmann coupling of src/coupling/, plugged in later).
+// modelled. Three implementations: "sleeve" (src/drivers/hydrofrac/sleeve_load.hpp: a pressure on
+// the particles that line the borehole, and on crack faces connected to it with penetration; the
+// DEM alone), and the two that couple the rock to a second physics module and so live here, in
+// src/coupling/ (docs ARCHITECTURE: the only code that sees two of them): "lbm" (lbm_load.hpp, the
+// lattice Boltzmann fluid) and "network" (network_load.hpp, the pore network). borehole.hpp is the
+// geometry they share with the driver (the hole's wetted surface, the cracks connected to it).
 //
 // The driver calls, per DEM step, in this order:
 //   sys.update_neighbors(); sys.compute_forces();
@@ -23,7 +26,7 @@
 #include "dem/dem_system.hpp"
 #include "io/checkpoint.hpp"
 
-namespace ff::drivers::hydrofrac {
+namespace ff::coupling::hydrofrac {
 
 // The borehole as the driver carved it (2D: a circle in x-y; 3D: a vertical cylinder along z
 // through the whole block) and its perforations (slots along the azimuth, from the wall out).
@@ -102,4 +105,4 @@ class FluidLoad {
   virtual void load(CheckpointReader& r, const dem::DemSystem& sys) = 0;
 };
 
-}  // namespace ff::drivers::hydrofrac
+}  // namespace ff::coupling::hydrofrac
