@@ -1,4 +1,5 @@
-// The hydraulic-fracturing driver: stages, time loop, outputs (docs/hydrofrac.md).
+// The hydraulic-fracturing driver: stages, time loop, checkpoints (docs/hydrofrac.md); what it
+// reports at the end: hydrofrac_summary.cpp.
 //   set-up     sample (sample builder) -> borehole and perforations carved -> DFN bonds cut ->
 //              servo walls on every face (x: sigma_H, y: sigma_h, 3D z: sigma_v) -> time step
 //   stage 0    the walls servo to the in-situ stresses until they hold within insitu.tolerance
@@ -9,19 +10,22 @@
 // The loop mirrors DemRun's (dem_run_loop.cpp): checkpoint/resume bit for bit, --max-steps,
 // --max-wall, signals, cracks.csv and the VTK series; its curve is pressure against time.
 #include "drivers/hydrofrac/hydrofrac_driver.hpp"
+#include "drivers/hydrofrac/hydrofrac_run.hpp"
 
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <iterator>
 #include <memory>
 
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/progress.hpp"
+#include "coupling/fluid_spec.hpp"
+#include "coupling/hydrofrac/borehole.hpp"
+#include "coupling/hydrofrac/lbm_load.hpp"
+#include "coupling/hydrofrac/network_load.hpp"
 #include "dem/dem_checkpoint.hpp"
 #include "dem/dem_output.hpp"
 #include "dem/dem_params.hpp"
@@ -30,38 +34,16 @@
 #include "dem/sample_builder.hpp"
 #include "drivers/dem_results.hpp"
 #include "drivers/flow/flow_runner.hpp"
-#include "coupling/hydrofrac/borehole.hpp"
 #include "drivers/hydrofrac/dfn.hpp"
 #include "drivers/hydrofrac/hydrofrac_params.hpp"
 #include "drivers/hydrofrac/kirsch.hpp"
 #include "drivers/hydrofrac/sleeve_load.hpp"
-#include "coupling/hydrofrac/lbm_load.hpp"
-#include "coupling/hydrofrac/network_load.hpp"
-#include "io/pvd.hpp"
-#include "coupling/fluid_spec.hpp"
 #include "drivers/run_control.hpp"
 #include "drivers/run_estimate.hpp"
-#include "drivers/run_record.hpp"
-#include "fracflow/version.hpp"
 #include "io/csv.hpp"
-#include "io/json_out.hpp"
-#include "io/plot.hpp"
 
-// The fluid loads (LBM, pore network) and the borehole geometry live in src/coupling/hydrofrac/.
 namespace ff::drivers::hydrofrac {
-using namespace coupling::hydrofrac;
-}
-
-namespace fs = std::filesystem;
-
-namespace ff::drivers {
 namespace {
-
-using hydrofrac::BoreholeGeometry;
-using hydrofrac::CircleStress;
-using hydrofrac::Block;
-using hydrofrac::block_of;
-using hydrofrac::lbm_fluid_spec;
 
 const std::vector<std::string> kColumns = {
     "step", "time_s", "stage", "pressure_Pa", "injected_volume_m3", "borehole_volume_m3", "sigma_xx_wall_Pa",
@@ -70,107 +52,17 @@ const std::vector<std::string> kColumns = {
     "unbalanced_force_ratio", "sigma_xx_fluid_Pa", "sigma_yy_fluid_Pa", "sigma_zz_fluid_Pa"};
 constexpr std::size_t kUnbalancedColumn = 18;  // kColumns' "unbalanced_force_ratio"
 
-// The loop's state (raw bytes in the checkpoint: its layout is the format).
-struct HfState {
-  long rows = 0, cracks_written = 0, vtk_index = 0, stage = 0, finished = 0;
-  long insitu_steps = 0, injection_step = 0, equilibrium = 0;
-  long breakdown_found = 0, breakdown_row = 0, probe_taken = 0, initiation_found = 0;
-  Real breakdown_pressure = 0, breakdown_time = 0, peak_pressure = 0, peak_time = 0;
-  Real initiation_pressure = 0, effective_radius = 0, probe_pressure_actual = 0;
-  long breakdown_cracks = 0, peak_cracks = 0;
-  Real last_vtk_time = 0;
-  Real bd_azimuth = 0, bd_length = 0, bd_extent = 0, bd_anisotropy = 0, bd_normal_azimuth = 0;  // the fracture at breakdown
-  long bd_connected = 0;
-  Real injection_time = 0;  // sys.time when injection began
-};
-
-// One measurement circle with Kirsch's prediction (compression positive), a checkpoint record.
-struct CircleRecord {
-  Real r_over_a = 0, angle_deg = 0, x = 0, y = 0, radius = 0, porosity = 0;
-  long particles = 0, far = 0;  // far: one of the four interior-stress circles
-  Real xx = 0, yy = 0, xy = 0, zz = 0, k_xx = 0, k_yy = 0, k_xy = 0, pressure = 0;
-};
-
 }  // namespace
-}  // namespace ff::drivers
 
-namespace ff::drivers {
-namespace {
-
-class HydrofracRun {
- public:
-  HydrofracRun(const Config& c, const RunOptions& o) : cfg(c), opt(o), control_(c, o) {
-    sys.settings = dem::build_settings(cfg);
-    sys.materials = dem::build_materials(cfg);
-    cp_dir_ = opt.out_dir / "checkpoint";
-    const int dim = sys.settings.dim;
-    targets_ = Vec3(cfg.real("insitu.sigma_H"), cfg.real("insitu.sigma_h"), dim == 3 ? cfg.real("insitu.sigma_v") : 0.0);
-    servo_v_ = cfg.real("insitu.servo_velocity");
-    servo_alpha_ = cfg.real("insitu.servo_relaxation");
-  }
-  RunStatus run();
-
- private:
-  void set_up();
-  double planned_steps() const;
-  static constexpr const char* kShortenKeys = "injection.ramp_rate, injection.max_time or insitu.max_steps";
-  void make_fluid();
-  void servo();
-  void advance(long steps);
-  Vec3 wall_areas() const;
-  std::array<Real, 6> face_pressures() const;
-  Vec3 wall_stress() const;
-  Vec3 fluid_wall_stress() const;
-  Real face_gap() const;  // distance from the hole's wall to the nearest wall [m]
-  void measure_row();
-  std::vector<CircleRecord> snapshot(Real pressure) const;
-  void save(const fs::path& dir);
-  void load();
-  void checkpoint() {
-    save(cp_dir_);
-    control_.checkpoint_written();
-  }
-  void begin_injection();
-  void vtk();
-  void finish(const std::string& stop);
-  void plots();
-  nlohmann::json circles_json(const std::vector<CircleRecord>& c) const;
-
-  const Config& cfg;
-  const RunOptions& opt;
-  RunControl control_;
-  dem::DemSystem sys;
-  dem::SampleInfo info;
-  BoreholeGeometry hole_;
-  std::vector<hydrofrac::JointPair> joints_;
-  std::unique_ptr<hydrofrac::FluidLoad> fluid_;
-  hydrofrac::LbmLoadBase* lbm_ = nullptr;  // fluid_ when injection.fluid = "lbm"
-  hydrofrac::NetworkLoad* net_ = nullptr;  // fluid_ when injection.fluid = "network"
-  PvdSeries pores_pvd_;                    // vtk/pores.pvd: the pore network, same times as the particles
-  PvdSeries fluid_pvd_;                    // vtk/fluid.pvd: the lattice, same times as the particles
-  HfState st_;
-  Vec3 targets_;
-  Real servo_v_ = 0, servo_alpha_ = 0;
-  std::vector<CircleRecord> insitu_, probe_;
-  fs::path cp_dir_;
-  CsvWriter series_;
-  dem::DemVtkWriter vtk_writer_;
-  bool vtk_on_ = false;
-  std::vector<double> row_;
-  std::string status_;
-  // fracture measurement scratch (refreshed each row)
-  std::vector<Index> id_index_;
-  std::vector<std::size_t> ev_, jt_;
-  std::vector<char> visited_;
-  hydrofrac::FractureShape shape_;
-  Real extent_ = 0;  // connected fracture beyond the wall [m]
-};
-
-}  // namespace
-}  // namespace ff::drivers
-
-namespace ff::drivers {
-namespace {
+HydrofracRun::HydrofracRun(const Config& c, const RunOptions& o) : cfg(c), opt(o), control_(c, o) {
+  sys.settings = dem::build_settings(cfg);
+  sys.materials = dem::build_materials(cfg);
+  cp_dir_ = opt.out_dir / "checkpoint";
+  const int dim = sys.settings.dim;
+  targets_ = Vec3(cfg.real("insitu.sigma_H"), cfg.real("insitu.sigma_h"), dim == 3 ? cfg.real("insitu.sigma_v") : 0.0);
+  servo_v_ = cfg.real("insitu.servo_velocity");
+  servo_alpha_ = cfg.real("insitu.servo_relaxation");
+}
 
 void HydrofracRun::make_fluid() {
   hydrofrac::SleeveSettings s;
@@ -708,246 +600,7 @@ RunStatus HydrofracRun::run() {
   return RunStatus::Finished;
 }
 
-nlohmann::json HydrofracRun::circles_json(const std::vector<CircleRecord>& cs) const {
-  nlohmann::json a = nlohmann::json::array();
-  for (const auto& c : cs) {
-    const Real t = std::atan2(c.y, c.x), co = std::cos(t), si = std::sin(t);
-    auto polar = [&](Real xx, Real yy, Real xy) {
-      return std::array<Real, 3>{xx * co * co + yy * si * si + 2 * xy * si * co, xx * si * si + yy * co * co - 2 * xy * si * co,
-                                 (yy - xx) * si * co + xy * (co * co - si * si)};
-    };
-    const auto m = polar(c.xx, c.yy, c.xy), k = polar(c.k_xx, c.k_yy, c.k_xy);
-    nlohmann::json j = {{"kind", c.far ? "interior" : "near_hole"},
-                        {"r_over_a", c.r_over_a},
-                        {"azimuth_deg", c.angle_deg},
-                        {"x_m", c.x},
-                        {"y_m", c.y},
-                        {"radius_m", c.radius},
-                        {"particles", c.particles},
-                        {"porosity", c.porosity},
-                        {"pressure_Pa", c.pressure},
-                        {"measured_Pa", {{"xx", c.xx}, {"yy", c.yy}, {"xy", c.xy}, {"rr", m[0]}, {"tt", m[1]}, {"rt", m[2]}}},
-                        {"kirsch_Pa", {{"xx", c.k_xx}, {"yy", c.k_yy}, {"xy", c.k_xy}, {"rr", k[0]}, {"tt", k[1]}, {"rt", k[2]}}}};
-    if (sys.settings.dim == 3) j["measured_Pa"]["zz"] = c.zz;
-    a.push_back(j);
-  }
-  return a;
-}
-
-void HydrofracRun::finish(const std::string& stop) {
-  vtk();
-  const hydrofrac::FluidState f = fluid_->state();
-  nlohmann::json j;
-  j["fracflow_version"] = kVersion;
-  j["driver"] = "hydrofrac";
-  j["title"] = cfg.string("title");
-  j["stop_reason"] = stop;
-  const bool rate_mode = cfg.string("injection.mode") == "rate";
-  j["injection"] = {{"fluid", cfg.string("injection.fluid")},
-                    {"mode", cfg.string("injection.mode")},
-                    {"penetration", cfg.boolean("injection.penetration")},
-                    {"final_pressure_Pa", f.pressure},
-                    {"injected_volume_m3", f.injected_volume},
-                    {"borehole_volume_m3", f.borehole_volume},
-                    {"wall_particles", f.wetted_particles},
-                    {"wetted_cracks", f.wetted_cracks},
-                    {"peak_pressure_Pa", st_.peak_pressure},
-                    {"start_time_s", st_.injection_time}};
-  if (sys.settings.dim == 2) j["injection"]["note"] = "2D: volumes and rates per metre of thickness";
-  nlohmann::json bd;
-  bd["definition"] = rate_mode ? "first pressure peak followed by a drop of injection.peak_drop"
-                               : fmt::format("pressure when the fracture connected to the hole first reached {} m beyond its wall "
-                                             "(injection.breakdown_length)",
-                                             cfg.real("injection.breakdown_length") > 0 ? cfg.real("injection.breakdown_length")
-                                                                                        : hole_.radius);
-  if (st_.breakdown_found) {
-    bd["pressure_Pa"] = st_.breakdown_pressure;
-    bd["time_s"] = st_.breakdown_time;
-    bd["cracks"] = st_.breakdown_cracks;
-    bd["fracture"] = {{"connected_cracks", st_.bd_connected},
-                      {"length_m", st_.bd_length},
-                      {"extent_beyond_wall_m", st_.bd_extent},
-                      {"azimuth_deg", st_.bd_azimuth},
-                      {"anisotropy", st_.bd_anisotropy},
-                      {"normal_azimuth_deg", st_.bd_normal_azimuth}};
-  } else {
-    bd["pressure_Pa"] = nullptr;
-    bd["reason"] = fmt::format("no breakdown before the run stopped: {}", stop);
-  }
-  bd["initiation_pressure_Pa"] = st_.initiation_found ? nlohmann::json(st_.initiation_pressure) : nlohmann::json(nullptr);
-  bd["initiation_definition"] = "pressure at the first series row with a crack connected to the hole";
-  j["breakdown"] = bd;
-  j["fracture"] = {{"connected_cracks", shape_.cracks},
-                   {"length_m", shape_.length},
-                   {"extent_beyond_wall_m", extent_},
-                   {"azimuth_deg", shape_.azimuth_deg},
-                   {"anisotropy", shape_.anisotropy},
-                   {"normal_azimuth_deg", shape_.normal_azimuth_deg},
-                   {"definition", "cracks connected to the hole through broken bonds: principal axis of sum d d^T about the "
-                                  "axis (azimuth from x = sigma_H), tip-to-tip length along it, largest distance minus the "
-                                  "effective hole radius; normal_azimuth_deg: normal to the principal axis of the cracks' "
-                                  "normals sum n n^T"}};
-  j["borehole"] = {{"radius_m", hole_.radius},
-                   {"effective_radius_m", st_.effective_radius},
-                   {"centre_m", {hole_.centre.x(), hole_.centre.y()}},
-                   {"perforation_length_m", hole_.perforation_length},
-                   {"perforation_azimuth_deg", cfg.real("borehole.perforation_azimuth")},
-                   {"natural_fracture_bonds", joints_.size()}};
-  j["insitu"] = {{"targets_Pa", {{"sigma_H", targets_.x()}, {"sigma_h", targets_.y()}}},
-                 {"equilibrium_reached", st_.equilibrium != 0},
-                 {"steps", st_.insitu_steps},
-                 {"tolerance", cfg.real("insitu.tolerance")}};
-  if (sys.settings.dim == 3) j["insitu"]["targets_Pa"]["sigma_v"] = targets_.z();
-  j["elastic_state"] = {
-      {"method", "measurement circles (2D) / spheres (3D) with PFC's porosity correction against Kirsch's solution averaged over "
-                 "the same region (a = effective hole radius, far field = the in-situ targets, compression positive)"},
-      {"insitu", circles_json(insitu_)}};
-  if (!probe_.empty()) j["elastic_state"]["pressurised"] = circles_json(probe_);
-  if (lbm_) {
-    const auto& in = lbm_->info();
-    const hydrofrac::LbmBudget b = lbm_->budget();
-    j["lbm"] = {{"scheme", cfg.string("fluid.scheme")},
-                {"dt_lbm_s", in.scales.dt()},
-                {"dt_dem_s", in.dem_dt},
-                {"sub_steps", in.stride},
-                {"tau", in.scales.units.tau()},
-                {"mach_reference", in.scales.mach},
-                {"max_mach", b.max_mach},
-                {"bulk_modulus_eff_Pa", in.scales.bulk_modulus},
-                {"dx_m", in.scales.units.dx()},
-                {"lattice", {in.n[0], in.n[1], in.n[2]}},
-                {"lbm_steps", b.lbm_steps},
-                {"particle_set_changes", b.set_changes},
-                {"mass_budget_m3",
-                 {{"injected", b.injected},
-                  {"lattice_change", b.lattice_change},
-                  {"drained", b.drained},
-                  {"covering_refill", b.covering_refill},
-                  {"residual", b.residual},
-                  {"definition", "volumes at the reference density: lattice_change = injected + drained + covering_refill + "
-                                 "residual; drained is what the drained faces added (negative: outflow; 0 with closed faces), "
-                                 "the residual what the bounce-back walls created or destroyed"}}},
-                {"faces", cfg.string("fluid.faces")}};
-    log::info("hydrofrac: LBM mass budget over {} LBM steps ({} new particle sets; m^3 at rho_f): injected {:.4g}, lattice "
-              "change {:.4g}, drained {:.4g}, covering and refill {:.4g}, residual (walls) {:.4g}; largest Mach number {:.3g}",
-              b.lbm_steps, b.set_changes, b.injected, b.lattice_change, b.drained, b.covering_refill, b.residual, b.max_mach);
-  }
-  if (net_) {
-    const auto& in = net_->info();
-    const hydrofrac::NetworkBudget b = net_->budget();
-    const double wall = control_.run_wall_s();  // (the timings are checkpointed: every session's)
-    j["network"] = {{"pores", in.pores},
-                    {"channels", in.channels},
-                    {"hole_pores", in.hole_pores},
-                    {"dt_flow_s", in.dt_flow},
-                    {"dt_dem_s", in.dt_dem},
-                    {"flow_every", in.flow_every},
-                    {"predict_pressures", net_->predicting()},
-                    {"dt_explicit_s", in.dt_explicit},
-                    {"spring_period_s", in.t_spring},
-                    {"flow_steps", b.flow_steps},
-                    {"retriangulations", b.retriangulations},
-                    {"max_cg_iterations", b.max_cg_iterations},
-                    {"max_substeps", b.max_substeps},
-                    {"cavitations", b.cavitations},
-                    {"vapour_volume_m3", b.vapour_volume},
-                    {"wall_s", {{"network_update", b.t_sync}, {"flow", b.t_flow}, {"forces", b.t_forces},
-                                {"rest_dem_and_output", wall - b.t_sync - b.t_flow - b.t_forces}}},
-                    // Issue 16's budget: retriangulation rare enough to stay under 10 % of the run. The
-                    // updates that retriangulated, over this process's wall time.
-                    {"retriangulation_wall_share", control_.elapsed_s() > 0 ? b.t_triangulation / control_.elapsed_s() : 0.0},
-                    {"mass_budget_kg",
-                     {{"injected", b.injected_mass},
-                      {"pore_mass_start", b.pore_mass0},
-                      {"pore_mass_end", b.pore_mass},
-                      {"remap_change", b.remap_change},
-                      {"residual", b.residual},
-                      {"definition", "(pore_mass_end - pore_mass_start) - injected - remap_change (the mass the "
-                                     "retriangulations added: network.remap = pressure); rate mode: injected = rho Q t (a "
-                                     "closed block: the residual is the scheme's mass error; drained faces: plus what the "
-                                     "hull pores exchanged with the far field); ramp mode: injected is defined as the "
-                                     "change (residual 0)"}}},
-                    {"faces", net_->drained_faces() ? "drained" : "closed"},
-                    {"walls", net_->walls()}};
-    log::info("hydrofrac: network mass budget over {} flow steps ({} retriangulations; kg{}): injected {:.6g}, pores "
-              "{:.6g} -> {:.6g}, residual {:.3g}; wall time: network update {:.1f} s (retriangulations {:.1f} s in this "
-              "session), flow {:.1f} s, forces {:.1f} s of {:.1f} s",
-              b.flow_steps, b.retriangulations, sys.settings.dim == 2 ? " per m" : "", b.injected_mass, b.pore_mass0,
-              b.pore_mass, b.residual, b.t_sync, b.t_triangulation, b.t_flow, b.t_forces, wall);
-  }
-  j["cracks"] = cracks_json(sys);
-  j["sample"] = sample_json(sys, info);
-  j["time_step_s"] = sys.settings.dt;
-  j["steps"] = sys.step_count;
-  j["wall_time_s"] = control_.run_wall_s();  // every session of the run
-  j["threads"] = opt.threads;
-  j["parameters"] = params_json(cfg);
-  add_run_record(j, opt);
-  write_json_atomic(opt.out_dir / "summary.json", j);
-  plots();
-  st_.finished = 1;
-  checkpoint();
-  log::info("hydrofrac: {}; breakdown {}, cracks {} ({} tensile, {} shear), {} connected: fracture {:.3g} m long at {:.1f} deg "
-            "from sigma_H",
-            stop,
-            st_.breakdown_found ? fmt::format("{:.3f} MPa", 1e-6 * st_.breakdown_pressure) : std::string("not reached"),
-            sys.cracks.total(), sys.cracks.tensile, sys.cracks.shear, shape_.cracks, shape_.length, shape_.azimuth_deg);
-}
-
-void HydrofracRun::plots() {
-  if (!cfg.boolean("output.plots")) return;
-  const fs::path out = opt.out_dir;
-  fs::create_directories(out / "plots");
-  // Outline of the hole (and the block) for the fracture picture; the cracks are the markers.
-  const fs::path outline = out / "plots" / "outline.csv";
-  {
-    std::ofstream o(outline);
-    o << "x_m,y_m\n";
-    const Real a = st_.effective_radius;
-    for (int k = 0; k <= 72; ++k)
-      o << hole_.centre.x() + a * std::cos(2 * kPi * k / 72) << "," << hole_.centre.y() + a * std::sin(2 * kPi * k / 72) << "\n";
-    const auto& W = sys.walls;
-    o << "nan,nan\n";
-    for (int k : {0, 1, 3, 2, 0}) {
-      const Real x = W[k % 2 ? 1 : 0].point.x(), y = W[k / 2 ? 3 : 2].point.y();
-      o << x << "," << y << "\n";
-    }
-  }
-  PlotJob p{out / "series.csv", out / "plots" / "pressure_cracks.png", {}};
-  p.spec.title = "Hydraulic fracturing: borehole pressure and cracks";
-  p.spec.x = "time_s";
-  p.spec.x_scale = 1e3;
-  p.spec.xlabel = "time [ms]";
-  p.spec.y = {"pressure_Pa"};
-  p.spec.y_scale = 1e-6;
-  p.spec.ylabel = "borehole pressure [MPa]";
-  p.spec.y2 = {"cracks_total", "cracks_tensile", "cracks_shear", "cracks_connected"};
-  p.spec.y2label = "number of cracks";
-  PlotJob v{out / "series.csv", out / "plots" / "injected_volume.png", {}};
-  v.spec.title = "Injected volume";
-  v.spec.x = "time_s";
-  v.spec.x_scale = 1e3;
-  v.spec.xlabel = "time [ms]";
-  v.spec.y = {"injected_volume_m3"};
-  v.spec.y_scale = 1e6;
-  v.spec.ylabel = sys.settings.dim == 2 ? "injected volume [cm^3 per m]" : "injected volume [cm^3]";
-  PlotJob c{outline, out / "plots" / "fracture_pattern.png", {}};
-  c.spec.title = "Cracks (circles) around the borehole";
-  c.spec.x = "x_m";
-  c.spec.x_scale = 1e3;
-  c.spec.xlabel = "x (sigma_H) [mm]";
-  c.spec.y = {"y_m"};
-  c.spec.y_scale = 1e3;
-  c.spec.ylabel = "y (sigma_h) [mm]";
-  c.spec.reference_csv = out / "cracks.csv";
-  c.spec.ref_x = "x_m";
-  c.spec.ref_y = "y_m";
-  c.spec.ref_label = "cracks";
-  c.spec.y_labels = {"block and borehole"};
-  c.spec.equal_aspect = true;
-  const std::vector<PlotJob> jobs = {p, v, c};
-  plot_series(jobs);
-}
+namespace {
 
 RunStatus run(const Config& cfg, const RunOptions& opt) {
   // On resume the scenario is the results folder's copy: files it names (dfn.file) are relative
@@ -957,11 +610,14 @@ RunStatus run(const Config& cfg, const RunOptions& opt) {
 }
 
 }  // namespace
+}  // namespace ff::drivers::hydrofrac
+
+namespace ff::drivers {
 
 Driver hydrofrac_driver() {
   return Driver{"hydrofrac",
                 "hydraulic fracturing from a borehole in a bonded block under servo-controlled in-situ stresses (sleeve pressure)",
-                hydrofrac::declare_params, run, hydrofrac::validate_scenario};
+                hydrofrac::declare_params, hydrofrac::run, hydrofrac::validate_scenario};
 }
 
 }  // namespace ff::drivers
