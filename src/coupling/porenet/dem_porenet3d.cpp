@@ -102,6 +102,8 @@ void DemPorenet3D::init(const dem::DemSystem& sys, const Porenet3DParams& params
   for (Real r : r_) mean_radius_ += r;
   mean_radius_ /= static_cast<Real>(n);
   stats_ = {};
+  early_flow_steps_ = 0;
+  pred_strain_ = 0;
   make_network_and_flow(net_, flow_);
   flow_->init(prm_.initial_pressure, prm_.saturation, prm_.placement);
   set_boundaries(*flow_, *net_);
@@ -265,7 +267,12 @@ void DemPorenet3D::step(dem::DemSystem& sys) {
   sys.update_neighbors();
   sys.compute_forces();
   bool held = true;
-  if (stats_.cycle_left <= 0) {  // a flow step for the next N DEM steps
+  const bool cut = stats_.cycle_left > 0 && prm_.flow_every == 0 &&
+                   (predicting() ? prm_.hold_strain > 0 && pred_strain_ > prm_.hold_strain : moved_past_hold(sys));
+  if (stats_.cycle_left <= 0 || cut) {  // a flow step for the next N DEM steps
+    // The DEM steps since the last flow step: the time this one advances the fluid over.
+    const long elapsed = stats_.flow_steps > 0 ? stats_.flow_every - stats_.cycle_left : 0;
+    if (cut) ++early_flow_steps_;
     (void)sync(sys);
     bool predict = false;
     if (prm_.flow_every > 0) {
@@ -289,9 +296,10 @@ void DemPorenet3D::step(dem::DemSystem& sys) {
       stats_.until_choice -= stats_.flow_every;
     }
     stats_.cycle_left = stats_.flow_every;
-    advance_flow(static_cast<Real>(stats_.flow_every) * sys.settings.dt);
+    if (elapsed > 0) advance_flow(static_cast<Real>(elapsed) * sys.settings.dt);
     const auto t1 = std::chrono::steady_clock::now();
     compute_fluid_forces(-std::numeric_limits<Real>::infinity());
+    pred_strain_ = 0;
     if (predict && stats_.flow_every > 1)
       start_prediction(sys.settings.dt);
     else
@@ -309,6 +317,17 @@ void DemPorenet3D::step(dem::DemSystem& sys) {
     stats_.t_forces += seconds_since(t1);
   }
   sys.integrate();
+}
+
+bool DemPorenet3D::moved_past_hold(const dem::DemSystem& sys) const {
+  if (!(prm_.hold_displacement > 0)) return false;
+  const Real lim = prm_.hold_displacement * mean_radius_, lim2 = lim * lim;
+  const auto& pos = sys.particles.pos;
+  for (std::size_t k = 0; k < x_.size(); ++k) {
+    const Real dx = pos[k].x() - x_[k], dy = pos[k].y() - y_[k], dz = pos[k].z() - z_[k];
+    if (dx * dx + dy * dy + dz * dz > lim2) return true;
+  }
+  return false;
 }
 
 Real DemPorenet3D::max_pressure() const {
@@ -339,6 +358,12 @@ void DemPorenet3D::save(CheckpointWriter& w) const {
   w.put("porenet3d.fx", fx_);  // the forces held until the next flow step
   w.put("porenet3d.fy", fy_);
   w.put("porenet3d.fz", fz_);
+  // The flow step's positions (hold_displacement measures from them) and the early cycles' count.
+  w.put("porenet3d.flow_x", x_);
+  w.put("porenet3d.flow_y", y_);
+  w.put("porenet3d.flow_z", z_);
+  w.put("porenet3d.early_flow_steps",
+        std::vector<Real>{static_cast<Real>(early_flow_steps_), pred_strain_});
   // The prediction of the current cycle (empty without held steps).
   for (const auto& [tag, member] : kPredSections) w.put(std::string("porenet3d.pred_") + tag, this->*member);
   w.put("porenet3d.pred_dt", std::vector<Real>{pred_dt_, static_cast<Real>(pred_geom_age_)});
@@ -392,6 +417,22 @@ void DemPorenet3D::load(CheckpointReader& r, const dem::DemSystem& sys, const Po
   flow_->restore_state(p, a, mq, mp, rq, rp);
   if (prm_.implicit) flow_->restore_implicit_guess(g);
   stats_ = r.get_value<Porenet3DStats>("porenet3d.stats");
+  early_flow_steps_ = 0;
+  pred_strain_ = 0;
+  if (r.has("porenet3d.flow_x")) {  // checkpoints before 2026-11-30: measured from the resume's positions
+    std::vector<Real> fx, fy, fz, early;
+    r.get("porenet3d.flow_x", fx);
+    r.get("porenet3d.flow_y", fy);
+    r.get("porenet3d.flow_z", fz);
+    r.get("porenet3d.early_flow_steps", early);
+    if (fx.size() != n || fy.size() != n || fz.size() != n || early.size() != 2)
+      throw InputError(fmt::format("checkpoint: porenet3d flow-step positions for {} spheres; the sample has {}", fx.size(), n));
+    x_ = std::move(fx);
+    y_ = std::move(fy);
+    z_ = std::move(fz);
+    early_flow_steps_ = static_cast<long>(early[0]);
+    pred_strain_ = early[1];
+  }
   r.get("porenet3d.fx", fx_);
   r.get("porenet3d.fy", fy_);
   r.get("porenet3d.fz", fz_);
@@ -404,8 +445,10 @@ void DemPorenet3D::load(CheckpointReader& r, const dem::DemSystem& sys, const Po
     const std::string key = std::string("porenet3d.pred_") + tag;
     if (r.has(key)) r.get(key, v);
   }
+  if (!pred_g_.empty() && pred_v0_.empty())  // checkpoints before 2026-11-30: the network's voids now
+    pred_v0_.assign(net_->pore_void.begin(), net_->pore_void.begin() + net_->n_pores());
   if (!pred_g_.empty() &&
-      (pred_g_.size() != 12 * np || pred_a_.size() != 3 * static_cast<std::size_t>(net_->pp_start[net_->n_particles]) ||
+      (pred_v0_.size() != np || pred_g_.size() != 12 * np || pred_a_.size() != 3 * static_cast<std::size_t>(net_->pp_start[net_->n_particles]) ||
        pred_x0_.size() != 3 * n || pred_c_.size() != np || pred_q_.size() != np ||
        pred_w_.size() != static_cast<std::size_t>(net_->n_channels()) || pred_b_.size() != np ||
        pred_dp_.size() != np))

@@ -9,8 +9,11 @@
 //     `retriangulation_tolerance` x the mean radius (phase masses carried over by porenet's remap,
 //     conserving each phase), else update the pore volumes and throats for the moved spheres: the new
 //     void volumes drive the pressure (undrained compaction);
-//   flow over the N DEM steps: implicit two-phase (one backward-Euler step of N dt_dem; default: stiff
-//     liquids need no sub-steps) or explicit with n = ceil(dt_dem / (safety dt_stable)) sub-steps;
+//   flow over the DEM steps since the last flow step (none at the first): implicit two-phase (one
+//     backward-Euler step; default: stiff liquids need no sub-steps) or explicit with
+//     n = ceil(dt / (safety dt_stable)) sub-steps, so that the fluid's clock is the DEM's at every
+//     flow step (before 2026-11-30 the flow ran over the N steps to come, ahead of the DEM, and the
+//     held steps' prediction counted that outflow a second time);
 //   add_external_loads(); grain forces from the gauge pressure p - p_ambient (pressure integrated over
 //     each sphere's patches inside its tetrahedra, porenet::add_pressure_forces_3d); integrate().
 // Pressure prediction in the held steps (Porenet3DParams::predict_pressures; on where the fluid's
@@ -77,6 +80,16 @@ struct Porenet3DParams {
   // divides the next N by s (wide PFV throats: the phases' transport limit is below the DEM step
   // already, and a 20-fold implicit step exhausted the halvings: "phase masses (0, 0)").
   long flow_every = 1;
+  // Auto N (flow_every = 0): a held cycle ends early, with a flow step. Without the prediction (soft,
+  // gas-holding pores: N from the fluid's stiffness at the flow step) once a sphere has moved more than
+  // hold_displacement x the mean radius since the last flow step: a pore whose gas is squeezed out
+  // within the cycle stiffens past that bound unseen (the saturated 3D example at S 0.8: one pore at
+  // 1.6 GPa in a crack burst, the held forces never pushing back). With the prediction once a pore's
+  // void has changed by more than hold_strain of itself since the flow step (the prediction is linear
+  // in it; water-full, the example's post-peak pores reached 132-364 MPa without it, 27 MPa with it,
+  // 28 MPa with a flow step every DEM step). 0: never. Pre-peak neither ends a cycle early.
+  Real hold_displacement = 0.01;
+  Real hold_strain = 0.02;
   // Pressure prediction in the held steps (above), where the stiffness bound on N is below
   // max_flow_every (auto N) or for any fixed N > 1: N then up to max_flow_every (still divided by the
   // transport halvings). false: forces held as they are.
@@ -137,6 +150,7 @@ class DemPorenet3D {
   const porenet::Network2D& network() const { return *net_; }
   porenet::TwoPhaseFlow& flow() { return *flow_; }
   const Porenet3DStats& stats() const { return stats_; }
+  long early_flow_steps() const { return early_flow_steps_; }  // cycles ended by hold_displacement / hold_strain
   const Porenet3DParams& params() const { return prm_; }
   Real max_pressure() const;
   // Fluid force of the last step on particle k [N].
@@ -214,6 +228,7 @@ class DemPorenet3D {
   void linearise_pressures();                       // pred_* at the flow step (predict_pressures)
   porenet::CsrView fill_prediction_matrix();        // pred_sys_'s values from pred_c_, pred_w_ (creates it)
   long choose_flow_every(const dem::DemSystem& sys) const;  // the stiffness bound on N (flow_every = 0)
+  bool moved_past_hold(const dem::DemSystem& sys) const;     // hold_displacement exceeded since the flow step
   porenet::Particles3D view() const { return {x_, y_, z_, r_, {}}; }
 
   const porenet::BoxWalls* box() const { return prm_.walls ? &box_ : nullptr; }
@@ -225,7 +240,10 @@ class DemPorenet3D {
   std::vector<Index> id_index_;               // crack channels: particle index of each global id (-1: none)
   std::unique_ptr<porenet::Network2D> net_;
   std::unique_ptr<porenet::TwoPhaseFlow> flow_;
+  // x_, y_, z_: the positions of the last sync (the flow step's; hold_displacement measures from them).
   std::vector<Real> x_, y_, z_, r_, ref_x_, ref_y_, ref_z_, fx_, fy_, fz_, pg_;
+  long early_flow_steps_ = 0;  // cycles hold_displacement / hold_strain ended early (checkpointed)
+  Real pred_strain_ = 0;       // the last held step's largest |V - V0| / V0 (checkpointed)
   Real mean_radius_ = 0;
   Porenet3DStats stats_;
   // Pressure prediction (predict_pressures), fixed from one flow step to the next, checkpointed:
@@ -237,6 +255,7 @@ class DemPorenet3D {
   std::vector<Real> pred_q_;   // per pore: its net outflow at the flow step's pressures [m^3/s]
   std::vector<Real> pred_b_;   // per pore: -(V - V0) at the last held step [m^3]
   std::vector<Real> pred_dp_;  // per pore: the predicted p - p(flow step) [Pa]
+  std::vector<Real> pred_v0_;  // per pore: its void at the flow step [m^3] (hold_strain)
   std::vector<Real> pred_tmp_, pred_rhs_, pred_z_;  // per pore, scratch
   std::unique_ptr<porenet::PressureSystem> pred_sys_;  // C + dt L of the held steps (pattern, values)
   // Its V-cycle, without over-interpolation: exact Galerkin coarse matrices and symmetric Gauss-Seidel
@@ -249,7 +268,7 @@ class DemPorenet3D {
   static constexpr std::pair<const char*, std::vector<Real> DemPorenet3D::*> kPredSections[] = {
       {"g", &DemPorenet3D::pred_g_}, {"a", &DemPorenet3D::pred_a_}, {"x0", &DemPorenet3D::pred_x0_},
       {"c", &DemPorenet3D::pred_c_}, {"w", &DemPorenet3D::pred_w_}, {"q", &DemPorenet3D::pred_q_},
-      {"b", &DemPorenet3D::pred_b_}, {"dp", &DemPorenet3D::pred_dp_}};
+      {"b", &DemPorenet3D::pred_b_}, {"dp", &DemPorenet3D::pred_dp_}, {"v0", &DemPorenet3D::pred_v0_}};
 };
 
 }  // namespace ff::coupling

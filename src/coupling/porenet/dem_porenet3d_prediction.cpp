@@ -2,6 +2,7 @@
 // equations in dem_porenet3d.hpp): the linearisation at a flow step, its multigrid system, and the
 // per-DEM-step advance with the grain forces it adds.
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <vector>
 
@@ -28,6 +29,7 @@ void DemPorenet3D::linearise_pressures() {
   }
   pred_x0_.resize(3 * n);
   pred_c_.resize(np);
+  pred_v0_.assign(net.pore_void.begin(), net.pore_void.begin() + net.n_pores());
   pred_w_.resize(nc);
   pred_q_.resize(np);
   pred_b_.assign(np, 0.0);
@@ -125,8 +127,11 @@ void DemPorenet3D::add_predicted_forces(dem::DemSystem& sys, Real p_floor) {
   const auto& pos = sys.particles.pos;
   const Real dt = sys.settings.dt;
   const bool parallel_pores = net.n_pores() > porenet::kParallelMin;
-  // This step's backward-Euler right-hand side C dp_old - (V - V_old) - dt q (pred_b_: -(V_old - V0)).
-#pragma omp parallel for schedule(static) if (parallel_pores)
+  // This step's backward-Euler right-hand side C dp_old - (V - V_old) - dt q (pred_b_: -(V_old - V0)),
+  // and the largest |V - V0| / V0 (hold_strain: the linearisation's reach; a max, the same on any
+  // thread count).
+  Real strain = 0;
+#pragma omp parallel for schedule(static) reduction(max : strain) if (parallel_pores)
   for (Index i = 0; i < net.n_pores(); ++i) {
     const auto u = static_cast<std::size_t>(i);
     Real dv = 0;  // V - V0
@@ -140,7 +145,9 @@ void DemPorenet3D::add_predicted_forces(dem::DemSystem& sys, Real p_floor) {
     const Real rhs = pred_c_[u] < 0 ? 0.0 : pred_c_[u] * pred_dp_[u] - dv - pred_b_[u] - dt * pred_q_[u];
     pred_b_[u] = -dv;
     pred_rhs_[u] = rhs;
+    if (pred_c_[u] >= 0 && pred_v0_[u] > 0) strain = std::max(strain, std::abs(dv) / pred_v0_[u]);
   }
+  pred_strain_ = strain;
   // V-cycles on the residual from the last step's dp (warm start).
   const auto& A = pred_sys_->matrix();
   const Index* outer = A.outerIndexPtr();

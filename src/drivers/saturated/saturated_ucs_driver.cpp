@@ -85,6 +85,19 @@ void declare(ParamTable& t) {
             "stiffest grain-fluid period (re-evaluated every 200 DEM steps: saturated samples then hardly stride)")
       .non_negative()
       .fallback();
+  t.real("fluid.hold_displacement", 0.01, "-",
+         "3D, automatic fluid.flow_every, cycles without fluid.predict_pressures: a flow step comes early once a "
+         "grain has moved this fraction of the mean radius since the last one (a pore whose gas the grains squeeze "
+         "out within a held cycle stiffens past the bound the cycle was chosen by: one pore reached 1.6 GPa in a crack "
+         "burst without it); 0 = never")
+      .non_negative()
+      .fallback();
+  t.real("fluid.hold_strain", 0.02, "-",
+         "3D, automatic fluid.flow_every, cycles with fluid.predict_pressures: a flow step comes early once a pore's "
+         "void has changed by this fraction of itself since the last one (the prediction is linear in it: the water-full "
+         "example reached 132-434 MPa in single pores after the peak without it, 27 MPa with it); 0 = never")
+      .non_negative()
+      .fallback();
   t.boolean("fluid.predict_pressures", true,
             "3D, between flow steps: advance the pore pressures every DEM step by the flow's implicit step linearised "
             "at the last flow step (multigrid V-cycles), so that the held forces follow the grains; on where the "
@@ -146,7 +159,8 @@ const std::vector<std::string> k2DOnly = {"fluid.aperture_h0", "fluid.aperture_h
                                           "fluid.shear_forces", "fluid.cavitation_pressure", "fluid.force_height",
                                           "fluid.remap", "fluid.implicit_above"};
 const std::vector<std::string> k3DOnly = {"fluid.pfv_factor", "fluid.cg_tolerance", "fluid.flow_every",
-                                          "fluid.predict_pressures", "fluid.crack_channels"};
+                                          "fluid.predict_pressures", "fluid.crack_channels", "fluid.hold_displacement",
+                                          "fluid.hold_strain"};
 
 porenet::TwoPhaseParams fluid_params(const Config& cfg) {
   porenet::TwoPhaseParams f;
@@ -209,6 +223,8 @@ coupling::Porenet3DParams params_3d(const Config& cfg) {
   p.implicit = cfg.string("fluid.flow_scheme") != "explicit";
   p.flow_every = cfg.integer("fluid.flow_every");
   p.predict_pressures = cfg.boolean("fluid.predict_pressures");
+  p.hold_displacement = cfg.real("fluid.hold_displacement");
+  p.hold_strain = cfg.real("fluid.hold_strain");
   p.crack_channels = cfg.boolean("fluid.crack_channels");
   p.drained = false;  // the lateral hull pores only: set by SaturatedUcsRun's on_network
   p.pressure_force = pressure_force(cfg, true);
@@ -279,7 +295,8 @@ class PoreFluid {
           e.what(),
           dim3_ ? "fluid.pfv_factor (the throats' conductance)"
                 : "fluid.aperture_h0, fluid.aperture_hinf and fluid.aperture_gamma (the channels' conductance)",
-          dim3_ ? ", fluid.cg_tolerance" : ", fluid.cavitation_pressure, fluid.implicit_above"));
+          dim3_ ? ", fluid.hold_displacement, fluid.hold_strain, fluid.cg_tolerance"
+                : ", fluid.cavitation_pressure, fluid.implicit_above"));
     }
   }
   bool dim3() const { return dim3_; }
@@ -514,6 +531,7 @@ class SaturatedUcsRun final : public UcsRun {
       f["pressure_forces"] = coupling::name(c.params().pressure_force);
       f["flow_steps"] = c.stats().flow_steps;
       f["flow_every_last"] = c.stats().flow_every;
+      f["early_flow_steps"] = c.early_flow_steps();  // held cycles ended by hold_displacement / hold_strain
       f["throats"] = fluid_.network().n_channels();
       f["drained_pores"] = fluid_.drained_pores();
       const auto& s = c.stats();

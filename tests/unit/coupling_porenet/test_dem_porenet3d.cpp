@@ -349,6 +349,78 @@ TEST(CouplingPorenet3D, PressurePredictionLetsSaturatedSamplesStride) {
       << "resumed mid-cycle vs uninterrupted";
 }
 
+// Automatic N, (a) without the prediction (a partly saturated sample: soft gas pores, N at its cap of
+// 20) and (b) with it (water-full, at the wet DEM step). (1) A cycle ends early, with a flow step, once a
+// sphere has moved hold_displacement x the mean radius (a) or a pore's void has changed by hold_strain
+// of itself (b) since the last flow step. (2) Every flow step advances the fluid over the DEM steps since
+// the last one, so the fluid's clock is the DEM's: a pore injecting liquid at Q has injected Q t at each
+// flow step, to round-off, whether its cycle ran its N steps or ended early (before 2026-11-30 the flow
+// ran over the N steps to come: Q (t + N dt), and a cycle cut short would leave the fluid ahead of the
+// grains). (3) With such cuts, a resume and 2 threads give the uninterrupted run's state bit for bit.
+// Set so that the 600 steps' compaction ends some cycles early and lets others run their N.
+constexpr Real kHoldDisplacement = 2.5e-4;  // x the mean radius (the default, 0.01, trips no cycle here)
+constexpr Real kHoldStrain = 0.02;          // the default
+TEST(CouplingPorenet3D, HeldCyclesEndEarlyAndTheFluidKeepsTheDemClock) {
+  for (const bool predict : {false, true}) {
+    auto s = specimen(0.05);
+    auto prm = predict ? fluid(1.0, 2.2e9) : fluid(0.5);  // water-full: the stiffness bound calls for the prediction
+    prm.flow_every = 0;
+    prm.predict_pressures = predict;
+    prm.hold_displacement = predict ? 0.0 : kHoldDisplacement;  // each variant by its own criterion
+    prm.hold_strain = predict ? kHoldStrain : 0.0;
+    DemPorenet3D c;
+    const Real q = 1e-9;  // [kg/s]
+    Index source = -1;
+    c.on_network = [&](porenet::TwoPhaseFlow& f, const porenet::Network2D& net) {
+      for (Index i = 0; i < net.n_pores() && source < 0; ++i)  // the first pore off the hull
+        if (!net.pore_hull[i]) source = i;
+      f.set_bc(source, porenet::PoreBc::Flux, q);
+    };
+    c.init(s->sys, prm);
+    ASSERT_GE(source, 0);
+    dem::choose_time_step(s->cfg, s->sys, c.fluid_stiffness(false));
+    const Real dt = s->sys.settings.dt;
+    long checked = 0, short_cycles = 0, full_cycles = 0, step_of_last_flow = 0, n_of_cycle = 0;
+    for (long k = 0; k < 600; ++k) {
+      const long before = c.stats().flow_steps;
+      const long left = c.stats().cycle_left;
+      c.step(s->sys);
+      if (c.stats().flow_steps == before) continue;
+      if (before > 0) {  // the cycle that just ended: its length against its N
+        ++(k - step_of_last_flow < n_of_cycle ? short_cycles : full_cycles);
+        EXPECT_EQ(left > 0, k - step_of_last_flow < n_of_cycle);
+      }
+      step_of_last_flow = k;
+      n_of_cycle = c.stats().flow_every;
+      EXPECT_NEAR(c.flow().injected_liquid(), q * static_cast<Real>(k) * dt, 1e-12 * q * static_cast<Real>(k + 1) * dt)
+          << "flow step at DEM step " << k;
+      ++checked;
+    }
+    std::printf("%s: flow steps %ld (%ld cycles ended early, %ld ran their N), last N %ld\n",
+                predict ? "prediction, hold_strain" : "held forces, hold_displacement", checked, short_cycles,
+                full_cycles, c.stats().flow_every);
+    EXPECT_EQ(c.predicting(), predict);
+    EXPECT_EQ(c.early_flow_steps(), short_cycles);
+    EXPECT_GT(short_cycles, 3);
+    EXPECT_GT(full_cycles, 3);
+
+    prm.retriangulation_tolerance = 0.0015;
+    test::expect_resume_and_threads_identical(
+        [predict, &prm](Real v) {
+          auto sp = specimen(v, 1);
+          if (predict) {  // the wet step, as above
+            DemPorenet3D probe;
+            probe.init(sp->sys, prm);
+            dem::choose_time_step(sp->cfg, sp->sys, probe.fluid_stiffness(false));
+          }
+          return sp;
+        },
+        prm, 150, 150, state_of,
+                                              "ff_coupling_porenet3d_hold.ckpt",
+                                              predict ? "3D cycles cut by hold_strain" : "3D cycles cut by hold_displacement");
+  }
+}
+
 // Resume from a checkpoint (DEM + network + fluid) continues bit-for-bit; 1 and 2 threads agree.
 TEST(CouplingPorenet3D, CheckpointResumeAndThreadsBitIdentical) {
   auto prm = fluid(0.5, 2.2e9);
