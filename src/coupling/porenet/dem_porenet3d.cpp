@@ -104,6 +104,7 @@ void DemPorenet3D::init(const dem::DemSystem& sys, const Porenet3DParams& params
   stats_ = {};
   early_flow_steps_ = 0;
   pred_strain_ = 0;
+  cracks_at_flow_ = sys.cracks.events.size();
   make_network_and_flow(net_, flow_);
   flow_->init(prm_.initial_pressure, prm_.saturation, prm_.placement);
   set_boundaries(*flow_, *net_);
@@ -267,8 +268,11 @@ void DemPorenet3D::step(dem::DemSystem& sys) {
   sys.update_neighbors();
   sys.compute_forces();
   bool held = true;
+  // (A crack with crack channels adds a channel: the prediction's mobilities and the held forces' flow
+  // are the flow step's.)
   const bool cut = stats_.cycle_left > 0 && prm_.flow_every == 0 &&
-                   (predicting() ? prm_.hold_strain > 0 && pred_strain_ > prm_.hold_strain : moved_past_hold(sys));
+                   ((prm_.crack_channels && sys.cracks.events.size() != cracks_at_flow_) ||
+                    (predicting() ? prm_.hold_strain > 0 && pred_strain_ > prm_.hold_strain : moved_past_hold(sys)));
   if (stats_.cycle_left <= 0 || cut) {  // a flow step for the next N DEM steps
     // The DEM steps since the last flow step: the time this one advances the fluid over.
     const long elapsed = stats_.flow_steps > 0 ? stats_.flow_every - stats_.cycle_left : 0;
@@ -300,6 +304,7 @@ void DemPorenet3D::step(dem::DemSystem& sys) {
     const auto t1 = std::chrono::steady_clock::now();
     compute_fluid_forces(-std::numeric_limits<Real>::infinity());
     pred_strain_ = 0;
+    cracks_at_flow_ = sys.cracks.events.size();
     if (predict && stats_.flow_every > 1)
       start_prediction(sys.settings.dt);
     else
@@ -363,7 +368,7 @@ void DemPorenet3D::save(CheckpointWriter& w) const {
   w.put("porenet3d.flow_y", y_);
   w.put("porenet3d.flow_z", z_);
   w.put("porenet3d.early_flow_steps",
-        std::vector<Real>{static_cast<Real>(early_flow_steps_), pred_strain_});
+        std::vector<Real>{static_cast<Real>(early_flow_steps_), pred_strain_, static_cast<Real>(cracks_at_flow_)});
   // The prediction of the current cycle (empty without held steps).
   for (const auto& [tag, member] : kPredSections) w.put(std::string("porenet3d.pred_") + tag, this->*member);
   w.put("porenet3d.pred_dt", std::vector<Real>{pred_dt_, static_cast<Real>(pred_geom_age_)});
@@ -419,19 +424,21 @@ void DemPorenet3D::load(CheckpointReader& r, const dem::DemSystem& sys, const Po
   stats_ = r.get_value<Porenet3DStats>("porenet3d.stats");
   early_flow_steps_ = 0;
   pred_strain_ = 0;
+  cracks_at_flow_ = sys.cracks.events.size();
   if (r.has("porenet3d.flow_x")) {  // checkpoints before 2026-11-30: measured from the resume's positions
     std::vector<Real> fx, fy, fz, early;
     r.get("porenet3d.flow_x", fx);
     r.get("porenet3d.flow_y", fy);
     r.get("porenet3d.flow_z", fz);
     r.get("porenet3d.early_flow_steps", early);
-    if (fx.size() != n || fy.size() != n || fz.size() != n || early.size() != 2)
+    if (fx.size() != n || fy.size() != n || fz.size() != n || early.size() != 3)
       throw InputError(fmt::format("checkpoint: porenet3d flow-step positions for {} spheres; the sample has {}", fx.size(), n));
     x_ = std::move(fx);
     y_ = std::move(fy);
     z_ = std::move(fz);
     early_flow_steps_ = static_cast<long>(early[0]);
     pred_strain_ = early[1];
+    cracks_at_flow_ = static_cast<std::size_t>(early[2]);
   }
   r.get("porenet3d.fx", fx_);
   r.get("porenet3d.fy", fy_);

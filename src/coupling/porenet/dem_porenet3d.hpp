@@ -87,7 +87,8 @@ struct Porenet3DParams {
   // 1.6 GPa in a crack burst, the held forces never pushing back). With the prediction once a pore's
   // void has changed by more than hold_strain of itself since the flow step (the prediction is linear
   // in it; water-full, the example's post-peak pores reached 132-364 MPa without it, 27 MPa with it,
-  // 28 MPa with a flow step every DEM step). 0: never. Pre-peak neither ends a cycle early.
+  // 28 MPa with a flow step every DEM step). 0: never. Pre-peak neither ends a cycle early. (With
+  // crack_channels a new crack ends it too, below.)
   Real hold_displacement = 0.01;
   Real hold_strain = 0.02;
   // Pressure prediction in the held steps (above), where the stiffness bound on N is below
@@ -119,9 +120,10 @@ struct Porenet3DParams {
   // g mu = w^3 r_b / (12 L) (the cubic law, METHODS 5.3b, over the half of the bond's disc, radius r_b,
   // that lies in the facet; L the throat's length), added to the facet's own conductance after its cap
   // and not scaled by pfv_factor: the crack's conductance is its opening's, not the matrix's (the 2D
-  // network's broken-bond S2S channel). Off by default (the drivers' keys: network.crack_channels,
-  // fluid.crack_channels): the implicit step's outflow limit (a pore gives at most the mass it holds per
-  // step) halves the step many times over in the pores along an open crack, whose throughflow is large.
+  // network's broken-bond S2S channel). With the automatic N a new crack ends the held cycle (its
+  // channel changes the flow the held forces were taken from). Off here and in the hydrofrac
+  // (network.crack_channels: the 30,000-sphere example's CG cost), on in saturated_ucs
+  // (fluid.crack_channels).
   bool crack_channels = false;
 };
 
@@ -244,6 +246,7 @@ class DemPorenet3D {
   std::vector<Real> x_, y_, z_, r_, ref_x_, ref_y_, ref_z_, fx_, fy_, fz_, pg_;
   long early_flow_steps_ = 0;  // cycles hold_displacement / hold_strain ended early (checkpointed)
   Real pred_strain_ = 0;       // the last held step's largest |V - V0| / V0 (checkpointed)
+  std::size_t cracks_at_flow_ = 0;  // the DEM's crack log's length at the last flow step (checkpointed)
   Real mean_radius_ = 0;
   Porenet3DStats stats_;
   // Pressure prediction (predict_pressures), fixed from one flow step to the next, checkpointed:

@@ -104,10 +104,10 @@ void declare(ParamTable& t) {
             "fluid's stiffness would bound fluid.flow_every (water-full samples) or when fluid.flow_every > 1 "
             "(false: the forces held as they are)")
       .fallback();
-  t.boolean("fluid.crack_channels", false,
+  t.boolean("fluid.crack_channels", true,
             "3D: each throat beside a broken bond conducts the cubic law of the bond's opening as well "
-            "(coupling::Porenet3DParams::crack_channels). Off by default here: with two phases (S 0.8) the 3D example's "
-            "pores reached 1.6 GPa after the peak with it (75.6 MPa without; docs/saturated.md)")
+            "(coupling::Porenet3DParams::crack_channels; with the automatic fluid.flow_every a new crack ends the held "
+            "cycle); false: a crack conducts only as its widened facets (the default before 2026-11-30)")
       .fallback();
   t.real("fluid.cg_tolerance", 1e-12, "-",
          "3D implicit flow: relative residual of the conjugate-gradient pressure solve (porenet; the phase masses stay "

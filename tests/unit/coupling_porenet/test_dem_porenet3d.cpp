@@ -421,6 +421,34 @@ TEST(CouplingPorenet3D, HeldCyclesEndEarlyAndTheFluidKeepsTheDemClock) {
   }
 }
 
+// With crack channels a new crack ends the held cycle at the next DEM step (its channel changes the
+// flow the held forces and the prediction were taken from); without them it does not.
+TEST(CouplingPorenet3D, ACrackEndsTheHeldCycleWithCrackChannels) {
+  for (const bool channels : {false, true}) {
+    auto s = specimen(0.0);
+    auto prm = fluid(0.5);
+    prm.flow_every = 0;
+    prm.predict_pressures = false;
+    prm.crack_channels = channels;
+    DemPorenet3D c;
+    c.init(s->sys, prm);
+    c.run(s->sys, 1);  // the first flow step: N = 2, then the stiffness bound lets it double
+    while (c.stats().flow_every < 8 || c.stats().cycle_left != c.stats().flow_every - 1) c.step(s->sys);
+    ASSERT_GT(c.stats().cycle_left, 2);  // mid-cycle, at rest: no other rule ends it
+    const long flows = c.stats().flow_steps;
+    const auto& b = s->sys.bonds;
+    ASSERT_GT(b.size(), 0u);
+    dem::CrackEvent e{};
+    e.i = s->sys.particles.id[static_cast<std::size_t>(b.i[0])];
+    e.j = s->sys.particles.id[static_cast<std::size_t>(b.j[0])];
+    e.mode = 1;
+    s->sys.cracks.add(e);
+    c.step(s->sys);
+    EXPECT_EQ(c.stats().flow_steps, flows + (channels ? 1 : 0)) << (channels ? "with" : "without") << " crack channels";
+    EXPECT_EQ(c.early_flow_steps(), channels ? 1 : 0);
+  }
+}
+
 // Resume from a checkpoint (DEM + network + fluid) continues bit-for-bit; 1 and 2 threads agree.
 TEST(CouplingPorenet3D, CheckpointResumeAndThreadsBitIdentical) {
   auto prm = fluid(0.5, 2.2e9);
