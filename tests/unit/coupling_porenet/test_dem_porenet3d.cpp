@@ -439,6 +439,8 @@ TEST(CouplingPorenet3D, ACrackEndsTheHeldCycleWithCrackChannels) {
     const auto& b = s->sys.bonds;
     ASSERT_GT(b.size(), 0u);
     dem::CrackEvent e{};
+    e.position = Vec3::Zero();
+    e.normal = Vec3::UnitX();
     e.i = s->sys.particles.id[static_cast<std::size_t>(b.i[0])];
     e.j = s->sys.particles.id[static_cast<std::size_t>(b.j[0])];
     e.mode = 1;
