@@ -60,6 +60,7 @@ void PressureSystem::setup_preconditioner(Preconditioner pc) {
     const CsrView v{n_, A_.outerIndexPtr(), inner, val};
     if (amg_rebuild_ || !amg_.ready()) {
       amg_.setup(v);
+      amg_setup_values_.assign(val, val + A_.nonZeros());
       amg_rebuild_ = false;
       amg_check_ = true;  // the next iteration count is the reference
       ++amg_setups_;
@@ -82,6 +83,28 @@ void PressureSystem::setup_preconditioner(Preconditioner pc) {
       pivot_[i] = 1 / d;  // stored inverted
     }
   }
+}
+
+std::vector<Real> PressureSystem::amg_state() const {
+  if (amg_setup_values_.empty()) return {};
+  std::vector<Real> s{amg_rebuild_ ? 1.0 : 0.0, amg_check_ ? 1.0 : 0.0, static_cast<Real>(amg_setup_iters_)};
+  s.insert(s.end(), amg_setup_values_.begin(), amg_setup_values_.end());
+  return s;
+}
+
+void PressureSystem::restore_amg_state(std::span<const Real> state) {
+  if (state.empty()) return;
+  const auto nnz = static_cast<std::size_t>(A_.nonZeros());
+  if (state.size() != 3 + nnz)
+    throw InputError(fmt::format("porenet: an AMG state of {} values for a pressure system of {} entries", state.size(), nnz));
+  amg_setup_values_.assign(state.begin() + 3, state.end());
+  std::vector<Real> current(A_.valuePtr(), A_.valuePtr() + nnz);
+  std::copy(amg_setup_values_.begin(), amg_setup_values_.end(), A_.valuePtr());
+  amg_.setup(CsrView{n_, A_.outerIndexPtr(), A_.innerIndexPtr(), A_.valuePtr()});
+  std::copy(current.begin(), current.end(), A_.valuePtr());
+  amg_rebuild_ = state[0] != 0;
+  amg_check_ = state[1] != 0;
+  amg_setup_iters_ = static_cast<int>(state[2]);
 }
 
 void PressureSystem::apply_preconditioner(Preconditioner pc, const std::vector<Real>& r, std::vector<Real>& z) {

@@ -64,6 +64,11 @@ class PressureSystem {
 
   // AMG: rebuild the aggregates at the next solve (e.g. after the conductances changed by orders).
   void reset_preconditioner() { amg_rebuild_ = true; }
+  // AMG's state for a checkpoint: the matrix values its aggregates were built from and the rebuild
+  // rule's counters (empty before the first AMG setup). Restored on the same pattern, the aggregates
+  // are built again from those values, so that the next solves are the uninterrupted run's.
+  std::vector<Real> amg_state() const;
+  void restore_amg_state(std::span<const Real> state);
   const Amg& amg() const { return amg_; }
   long amg_setups() const { return amg_setups_; }
   long floor_stops() const { return floor_stops_; }
@@ -80,6 +85,7 @@ class PressureSystem {
   std::vector<Real> pivot_;  // inverse pivots (DIC) or inverse diagonal (Jacobi)
   std::vector<Real> r_, z_, d_, ad_, x0_, scratch_, row_abs_;
   Amg amg_;
+  std::vector<Real> amg_setup_values_;  // A's values at the last AMG setup (amg_state)
   bool amg_rebuild_ = true, amg_check_ = false;
   int amg_setup_iters_ = 0;
   long amg_setups_ = 0, floor_stops_ = 0, amg_fallbacks_ = 0, state_iterations_ = 0;

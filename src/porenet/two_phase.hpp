@@ -114,6 +114,13 @@ class TwoPhaseFlow {
   const PressureSystem* pressure_system() const { return sys_.get(); }
   Index last_limited_pores() const { return limited_; }
   int last_substeps() const { return substeps_; }
+  // The AMG preconditioner's state (PressureSystem::amg_state; empty without an AMG setup): part of a
+  // checkpoint where the implicit step uses AMG.
+  std::vector<Real> amg_state() const { return sys_ ? sys_->amg_state() : std::vector<Real>{}; }
+  void restore_amg_state(std::span<const Real> state) {
+    prepare_implicit();
+    sys_->restore_amg_state(state);
+  }
   // The CG start of the next implicit step (the last pressure change): part of a checkpoint.
   std::span<const Real> implicit_guess() const { return dp_; }
   void restore_implicit_guess(std::span<const Real> g) {

@@ -27,6 +27,7 @@ porenet::TwoPhaseParams fluid_params(const NetworkSettings& s) {
   f.liquid = porenet::Eos::barotropic(s.density, s.pore_pressure, s.bulk_modulus);
   f.gas = porenet::Eos::air_pr(293.15);  // saturated: no gas; the law is only evaluated
   f.mu_liquid = s.viscosity;
+  f.preconditioner = s.amg ? porenet::Preconditioner::AMG : porenet::Preconditioner::DIC;
   return f;
 }
 

@@ -75,6 +75,7 @@ struct NetworkSettings {
   bool drained_faces = true;              // network.faces = "drained": hull pores held at p0
   bool walls = false;                     // 3D: the six walls in the triangulation (Porenet3DParams::walls)
   bool crack_channels = false;            // 3D: Porenet3DParams::crack_channels
+  bool amg = false;                       // the implicit flow's CG preconditioned by AMG (else DIC)
   long flow_every = 0;                    // DEM steps per flow step; 0: from the fluid-grain stiffness
   Real flow_safety = 0.3;                 // N dt <= safety x sqrt(m / k) (median)
   long max_flow_every = 100;

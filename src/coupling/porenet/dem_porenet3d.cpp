@@ -359,6 +359,7 @@ void DemPorenet3D::save(CheckpointWriter& w) const {
   w.put("porenet3d.rq", vec(flow_->liquid_density()));
   w.put("porenet3d.rp", vec(flow_->gas_density()));
   w.put("porenet3d.guess", prm_.implicit ? vec(flow_->implicit_guess()) : std::vector<Real>{});
+  w.put("porenet3d.amg", prm_.implicit ? flow_->amg_state() : std::vector<Real>{});  // empty unless AMG
   w.put_value("porenet3d.stats", stats_);
   w.put("porenet3d.fx", fx_);  // the forces held until the next flow step
   w.put("porenet3d.fy", fy_);
@@ -421,6 +422,11 @@ void DemPorenet3D::load(CheckpointReader& r, const dem::DemSystem& sys, const Po
     throw InputError(fmt::format("checkpoint: {} pore states for a rebuilt network of {} pores", p.size(), net_->n_pores()));
   flow_->restore_state(p, a, mq, mp, rq, rp);
   if (prm_.implicit) flow_->restore_implicit_guess(g);
+  if (prm_.implicit && r.has("porenet3d.amg")) {  // checkpoints before 2026-11-30 have none (DIC then)
+    std::vector<Real> amg;
+    r.get("porenet3d.amg", amg);
+    flow_->restore_amg_state(amg);
+  }
   stats_ = r.get_value<Porenet3DStats>("porenet3d.stats");
   early_flow_steps_ = 0;
   pred_strain_ = 0;

@@ -87,8 +87,14 @@ void declare_params(ParamTable& t) {
   t.boolean("network.crack_channels", false,
             "network, 3D: each throat beside a broken bond conducts the cubic law of the bond's opening w as well, "
             "w^3 r_bond / (12 mu L), not scaled by network.throat_factor (the 2D network's cracks are channels of their "
-            "own); false: a crack conducts only as its widened facets. Off by default: on the 30,000-sphere example the "
-            "implicit flow then halves its step thousands of times once cracks open (docs/hydrofrac.md)");
+            "own); false: a crack conducts only as its widened facets. Off by default: on the 30,000-sphere example its "
+            "pressure solves took up to ~600 CG iterations once cracks opened (1,035 s against 403 s without, "
+            "docs/hydrofrac.md)");
+  t.string("network.preconditioner", "dic",
+           "network: preconditioner of the implicit flow's conjugate gradients: dic (block diagonal incomplete "
+           "Cholesky) or amg (3D: algebraic multigrid, porenet/amg.hpp; fewer iterations where DIC needs hundreds, "
+           "e.g. with network.crack_channels; its aggregates are checkpointed, so a resume stays bit-for-bit)")
+      .one_of({"dic", "amg"});
   t.boolean("network.predict_pressures", true,
             "network, 3D: between flow steps advance the pore pressures every DEM step by the flow's implicit step "
             "linearised at the last flow step, so that the held forces follow the grains: where the fluid-grain "
@@ -236,6 +242,9 @@ void validate_scenario(const Config& cfg) {
   if (cfg.string("network.walls") == "on" && cfg.integer("dem.dim") != 3)
     cfg.fail("network.walls", "walls in the network are 3D (PFV's boundary spheres): dem.dim = 3, or network.walls = "
                               "\"auto\" / \"off\"");
+  if (cfg.string("network.preconditioner") == "amg" && cfg.integer("dem.dim") != 3)
+    cfg.fail("network.preconditioner", "amg is offered in 3D (the 2D network's checkpoint does not hold the multigrid, "
+                                       "so a resume would not be bit-for-bit): \"dic\"");
   if (cfg.string("injection.lbm_source") == "velocity_box" &&
       (cfg.string("injection.fluid") != "lbm" || cfg.string("injection.mode") != "rate"))
     cfg.fail("injection.lbm_source", "velocity_box is the LBM fluid's rate-mode source: it needs injection.fluid = \"lbm\" "

@@ -457,6 +457,11 @@ TEST(CouplingPorenet3D, CheckpointResumeAndThreadsBitIdentical) {
   prm.retriangulation_tolerance = 0.0015;
   test::expect_resume_and_threads_identical([](Real v) { return specimen(v, 1); }, prm, 120, 120, state_of,
                                             "ff_coupling_porenet3d_test.ckpt", "3D");
+  // The same with the multigrid-preconditioned flow: the checkpoint holds the values its aggregates were
+  // built from (porenet::PressureSystem::amg_state), so the resumed solves are the uninterrupted run's.
+  prm.fluid.preconditioner = porenet::Preconditioner::AMG;
+  test::expect_resume_and_threads_identical([](Real v) { return specimen(v, 1); }, prm, 120, 120, state_of,
+                                            "ff_coupling_porenet3d_amg.ckpt", "3D, AMG");
 }
 
 }  // namespace
