@@ -30,6 +30,26 @@ const Network2D& net3() {
   return net;
 }
 
+// A pressure matrix of one implicit step (single phase): storage V/K on the diagonal, the throats'
+// dt g (mu 1e-3, dt 1e-6 s), each times factor[c] when given.
+void fill_pressure_matrix(PressureSystem& sys, const Network2D& net, const std::vector<Real>* factor = nullptr) {
+  auto& A = sys.matrix();
+  Real* val = A.valuePtr();
+  const auto* outer = A.outerIndexPtr();
+  const auto* inner = A.innerIndexPtr();
+  for (Index i = 0; i < net.n_pores(); ++i) {
+    Real d = net.pore_void[i] / 2.2e9;
+    for (Index k = outer[i]; k < outer[i + 1]; ++k)
+      if (const Index c = sys.entry_channel()[k]; c >= 0) {
+        const Real g = 1e-6 * net.ch_cond[c] / 1e-3 * (factor ? (*factor)[static_cast<std::size_t>(c)] : 1.0);
+        val[k] = -g;
+        d += g;
+      }
+    for (Index k = outer[i]; k < outer[i + 1]; ++k)
+      if (inner[k] == i) val[k] = d;
+  }
+}
+
 struct SingleResult {
   std::vector<Real> p;
   int iterations = 0;
@@ -62,21 +82,11 @@ TEST(PorenetAmg, VCycleIsSymmetric) {
   const Network2D& net = net3();
   // A pressure matrix from one implicit step (single phase, Dirichlet inlet).
   PressureSystem sys(net);
-  auto& A = sys.matrix();
-  Real* val = A.valuePtr();
+  fill_pressure_matrix(sys, net);
+  const auto& A = sys.matrix();
+  const Real* val = A.valuePtr();
   const auto* outer = A.outerIndexPtr();
   const auto* inner = A.innerIndexPtr();
-  for (Index i = 0; i < net.n_pores(); ++i) {
-    Real d = net.pore_void[i] / 2.2e9;
-    for (Index k = outer[i]; k < outer[i + 1]; ++k)
-      if (sys.entry_channel()[k] >= 0) {
-        const Real g = 1e-6 * net.ch_cond[sys.entry_channel()[k]] / 1e-3;
-        val[k] = -g;
-        d += g;
-      }
-    for (Index k = outer[i]; k < outer[i + 1]; ++k)
-      if (inner[k] == i) val[k] = d;
-  }
   Amg amg;
   amg.setup({net.n_pores(), outer, inner, val});
   std::printf("AMG on %d pores: %d levels (coarsest %d), operator complexity %.3f\n", net.n_pores(), amg.n_levels(),
@@ -189,23 +199,7 @@ TEST(PorenetAmg, RestoredStateGivesTheSameSolves) {
   Rng rng(17);
   std::vector<Real> factor(static_cast<std::size_t>(net.n_channels()));
   for (auto& f : factor) f = std::pow(10.0, rng.uniform(-3, 3));
-  auto fill = [&](PressureSystem& sys, bool varied) {
-    auto& A = sys.matrix();
-    Real* val = A.valuePtr();
-    const auto* outer = A.outerIndexPtr();
-    const auto* inner = A.innerIndexPtr();
-    for (Index i = 0; i < net.n_pores(); ++i) {
-      Real d = net.pore_void[i] / 2.2e9;
-      for (Index k = outer[i]; k < outer[i + 1]; ++k)
-        if (const Index c = sys.entry_channel()[k]; c >= 0) {
-          const Real g = 1e-6 * net.ch_cond[c] / 1e-3 * (varied ? factor[static_cast<std::size_t>(c)] : 1.0);
-          val[k] = -g;
-          d += g;
-        }
-      for (Index k = outer[i]; k < outer[i + 1]; ++k)
-        if (inner[k] == i) val[k] = d;
-    }
-  };
+  auto fill = [&](PressureSystem& sys, bool varied) { fill_pressure_matrix(sys, net, varied ? &factor : nullptr); };
   const auto n = static_cast<std::size_t>(net.n_pores());
   std::vector<Real> b(n);
   for (auto& v : b) v = rng.uniform(-1e-12, 1e-12);
