@@ -294,6 +294,7 @@ TEST(Hydrofrac, CheckRefusesBadInputNamingTheKey) {
                         Case{"dfn.count=3 --set dfn.length_max=1e-3", "dfn.length_max"},
                         Case{"network.remap=\"volume\"", "network.remap"},
                         Case{"network.pressure_forces=\"arc\"", "network.pressure_forces"},
+                        Case{"network.preconditioner=\"amg\"", "network.preconditioner"},  // 3D only
                         // Stresses that crush the block (its contacts overlapping half a radius) and a pore
                         // pressure beyond round-off: NaN forces or a crushed block injected "anyway" before.
                         Case{"insitu.sigma_H=1e300", "insitu.sigma_H"}, Case{"sample.locked_in_stress=1e300", "sample.locked_in_stress"},
