@@ -98,10 +98,9 @@ void PressureSystem::restore_amg_state(std::span<const Real> state) {
   if (state.size() != 3 + nnz)
     throw InputError(fmt::format("porenet: an AMG state of {} values for a pressure system of {} entries", state.size(), nnz));
   amg_setup_values_.assign(state.begin() + 3, state.end());
-  std::vector<Real> current(A_.valuePtr(), A_.valuePtr() + nnz);
-  std::copy(amg_setup_values_.begin(), amg_setup_values_.end(), A_.valuePtr());
-  amg_.setup(CsrView{n_, A_.outerIndexPtr(), A_.innerIndexPtr(), A_.valuePtr()});
-  std::copy(current.begin(), current.end(), A_.valuePtr());
+  // The aggregates from the values they were built from (A's pattern); the next solve refreshes the
+  // hierarchy with A's values, as it would have without the checkpoint.
+  amg_.setup(CsrView{n_, A_.outerIndexPtr(), A_.innerIndexPtr(), amg_setup_values_.data()});
   amg_rebuild_ = state[0] != 0;
   amg_check_ = state[1] != 0;
   amg_setup_iters_ = static_cast<int>(state[2]);

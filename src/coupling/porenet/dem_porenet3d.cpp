@@ -477,14 +477,10 @@ void DemPorenet3D::load(CheckpointReader& r, const dem::DemSystem& sys, const Po
     pred_geom_age_ = static_cast<long>(dt[1]);
     // The multigrid's aggregates from the values they were built from, then the current values.
     const porenet::CsrView v = fill_prediction_matrix();
-    Real* val = pred_sys_->matrix().valuePtr();
-    std::vector<Real> current(val, val + pred_sys_->matrix().nonZeros());
     r.get("porenet3d.pred_setup_val", pred_setup_val_);
-    if (pred_setup_val_.size() != current.size())
+    if (pred_setup_val_.size() != static_cast<std::size_t>(pred_sys_->matrix().nonZeros()))
       throw InputError("checkpoint: porenet3d.pred_setup_val does not match the rebuilt network");
-    std::copy(pred_setup_val_.begin(), pred_setup_val_.end(), val);
-    pred_amg_.setup(v);
-    std::copy(current.begin(), current.end(), val);
+    pred_amg_.setup({v.n, v.ptr, v.col, pred_setup_val_.data()});
     pred_amg_.refresh(v);
   }
 }
