@@ -364,11 +364,12 @@ void DemPorenet3D::save(CheckpointWriter& w) const {
   w.put("porenet3d.fx", fx_);  // the forces held until the next flow step
   w.put("porenet3d.fy", fy_);
   w.put("porenet3d.fz", fz_);
-  // The flow step's positions (hold_displacement measures from them) and the early cycles' count.
+  // What ends a held cycle early: the flow step's positions (hold_displacement), and the early cycles'
+  // count, the last held step's strain (hold_strain) and the crack log's length at the flow step.
   w.put("porenet3d.flow_x", x_);
   w.put("porenet3d.flow_y", y_);
   w.put("porenet3d.flow_z", z_);
-  w.put("porenet3d.early_flow_steps",
+  w.put("porenet3d.hold",
         std::vector<Real>{static_cast<Real>(early_flow_steps_), pred_strain_, static_cast<Real>(cracks_at_flow_)});
   // The prediction of the current cycle (empty without held steps).
   for (const auto& [tag, member] : kPredSections) w.put(std::string("porenet3d.pred_") + tag, this->*member);
@@ -432,19 +433,20 @@ void DemPorenet3D::load(CheckpointReader& r, const dem::DemSystem& sys, const Po
   pred_strain_ = 0;
   cracks_at_flow_ = sys.cracks.events.size();
   if (r.has("porenet3d.flow_x")) {  // checkpoints before 2026-11-30: measured from the resume's positions
-    std::vector<Real> fx, fy, fz, early;
+    std::vector<Real> fx, fy, fz, hold;
     r.get("porenet3d.flow_x", fx);
     r.get("porenet3d.flow_y", fy);
     r.get("porenet3d.flow_z", fz);
-    r.get("porenet3d.early_flow_steps", early);
-    if (fx.size() != n || fy.size() != n || fz.size() != n || early.size() != 3)
-      throw InputError(fmt::format("checkpoint: porenet3d flow-step positions for {} spheres; the sample has {}", fx.size(), n));
+    r.get("porenet3d.hold", hold);
+    if (fx.size() != n || fy.size() != n || fz.size() != n || hold.size() != 3)
+      throw InputError(fmt::format("checkpoint: porenet3d flow-step positions for {} spheres and {} hold values; the "
+                                   "sample has {} spheres, the format 3 values", fx.size(), hold.size(), n));
     x_ = std::move(fx);
     y_ = std::move(fy);
     z_ = std::move(fz);
-    early_flow_steps_ = static_cast<long>(early[0]);
-    pred_strain_ = early[1];
-    cracks_at_flow_ = static_cast<std::size_t>(early[2]);
+    early_flow_steps_ = static_cast<long>(hold[0]);
+    pred_strain_ = hold[1];
+    cracks_at_flow_ = static_cast<std::size_t>(hold[2]);
   }
   r.get("porenet3d.fx", fx_);
   r.get("porenet3d.fy", fy_);
