@@ -17,4 +17,9 @@ struct InputError : Error {
 struct NumericalError : Error {
   using Error::Error;
 };
+// The DEM's positions or spins became NaN/inf. Its own message can only blame the DEM step; a
+// driver that adds other loads (a fluid's) catches this one and names their keys too.
+struct DemNotFiniteError : NumericalError {
+  using NumericalError::NumericalError;
+};
 }  // namespace ff

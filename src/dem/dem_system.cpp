@@ -431,7 +431,7 @@ void DemSystem::integrate_particles() {
     if (!std::isfinite(x[i].x() + x[i].y() + x[i].z() + w[i].x() + w[i].y() + w[i].z())) bad = 1;
   }
   if (bad)
-    throw NumericalError(fmt::format(
+    throw DemNotFiniteError(fmt::format(
         "DEM state became NaN/inf at step {} (t = {:.6g} s): the time step {:.3g} s is too large for the stiffness "
         "and mass of the sample; lower dem.time_step_safety (or dem.time_step), or enable mass scaling",
         step_count, time, dt));

@@ -191,8 +191,9 @@ void DemRun::check_finite(const DemRowReport& r) const {
   throw NumericalError(fmt::format(
       "the DEM run became unstable by step {} (t = {:.6g} s): {}. The last good checkpoint stays in {}/checkpoint and "
       "the failing state is saved in {}/checkpoint_failed. Check dem.gravity and the loading rate ({}), lower "
-      "dem.time_step_safety (or dem.time_step), or raise dem.local_damping",
-      sys.step_count, sys.time, what, opt.out_dir.string(), opt.out_dir.string(), spec.long_run_keys));
+      "dem.time_step_safety (or dem.time_step), or raise dem.local_damping{}",
+      sys.step_count, sys.time, what, opt.out_dir.string(), opt.out_dir.string(), spec.long_run_keys,
+      instability_advice().empty() ? "" : ". " + instability_advice()));
 }
 
 // A platen that moves a good part of a grain in one step is an impact, not a loading test, and
@@ -264,11 +265,13 @@ RunStatus DemRun::run() {
       if (control_.checkpoint_due() || (cp_every > 0 && (sys.step_count / every) % std::max(1L, cp_every / every) == 0))
         checkpoint();
     }
-  } catch (const NumericalError&) {
+  } catch (const NumericalError& e) {
     // Keep the last good checkpoint; save the failing state beside it for inspection.
     write_checkpoint(opt.out_dir / "checkpoint_failed");
     series_.close();
     close_files();
+    if (dynamic_cast<const DemNotFiniteError*>(&e) && !instability_advice().empty())
+      throw DemNotFiniteError(fmt::format("{}. {}", e.what(), instability_advice()));
     throw;
   }
   series_.close();

@@ -93,6 +93,9 @@ class DemRun {
   // After set-up or load: series columns, sample particles/groups, the driver's own files.
   virtual void ready() {}
   virtual std::string resume_note() const { return {}; }  // appended to "resuming at step ..."
+  // Keys of the loads a driver adds to the DEM (a pore fluid's) that can blow it up too: appended to
+  // the DEM's NaN error and to a non-finite measurement's, which name only the DEM's own keys.
+  virtual std::string instability_advice() const { return {}; }
   // Whether series.csv is being written (false before a driver's loading stage).
   virtual bool on_curve() const { return true; }
   virtual double planned_steps() const = 0;  // upper bound of the run's steps from step 0 (long-run notice)

@@ -16,7 +16,10 @@ void declare_dfn_params(ParamTable& t) {
   t.string("dfn.file", "",
            "CSV of natural fractures (relative to the scenario's folder), columns x_m,y_m,angle_deg,length_m (2D "
            "segments; 3D: vertical discs, z_m added, length = diameter); empty: the generator below");
-  t.integer("dfn.count", 0, "-", "number of generated natural fractures (0: none)").non_negative();
+  t.integer("dfn.count", 0, "-",
+            "number of generated natural fractures (0: none); at most 10,000 (each is tested against every bond)")
+      .non_negative()
+      .at_most(10000);
   t.integer("dfn.seed", 1, "-", "random seed of the generator").non_negative();
   t.string("dfn.positions", "random", "random (uniform in the block) or grid (dfn.spacing apart, rows along x)")
       .one_of({"random", "grid"});
@@ -80,6 +83,11 @@ std::vector<Joint> make_joints(const Config& cfg, const Vec3& lo, const Vec3& hi
   std::vector<Vec3> grid;
   std::vector<int> grid_row;
   if (positions == "grid") {
+    const double points = std::ceil((hi.x() - lo.x()) / spacing) * std::ceil((hi.y() - lo.y()) / spacing);
+    if (!(points <= 1e6))
+      cfg.fail("dfn.spacing", fmt::format("{} m puts {:.3g} grid positions in the {} x {} m block (at most 1e6): use a "
+                                          "larger spacing",
+                                          spacing, points, hi.x() - lo.x(), hi.y() - lo.y()));
     int row = 0;
     for (Real y = lo.y() + 0.5 * spacing; y < hi.y(); y += spacing, ++row)
       for (Real x = lo.x() + (row % 2 ? spacing : 0.5 * spacing); x < hi.x(); x += spacing) {

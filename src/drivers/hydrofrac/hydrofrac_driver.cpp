@@ -591,9 +591,17 @@ RunStatus HydrofracRun::run() {
       if (control_.checkpoint_due() || (cp_every > 0 && (sys.step_count / every) % std::max(1L, cp_every / every) == 0))
         checkpoint();
     }
-  } catch (const NumericalError&) {
+  } catch (const NumericalError& e) {
     save(opt.out_dir / "checkpoint_failed");
     series_.close();
+    // The DEM's own message blames its step; during injection the fluid's load is as likely.
+    if (dynamic_cast<const DemNotFiniteError*>(&e) && st_.stage == 1)
+      throw DemNotFiniteError(fmt::format(
+          "{}. The fluid loads the rock too (borehole pressure {:.4g} Pa): check injection.{}{}", e.what(),
+          fluid_ ? fluid_->state().pressure : 0.0, rate_mode ? "rate" : "ramp_rate and injection.initial_pressure",
+          net_   ? ", network.viscosity, network.pore_pressure and injection.fluid_bulk_modulus"
+          : lbm_ ? ", fluid.bulk_modulus (or fluid.sound_speed) and fluid.viscosity"
+                 : ""));
     throw;
   }
   series_.close();

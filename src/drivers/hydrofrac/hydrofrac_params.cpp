@@ -49,11 +49,17 @@ void declare_params(ParamTable& t) {
            "hole into the rock and its cracks, keys network.*)")
       .one_of({"sleeve", "lbm", "network"});
   // The pore network (injection.fluid = "network"; coupling/hydrofrac/network_load.hpp).
-  t.real("network.viscosity", 1e-3, "Pa s", "network: dynamic viscosity of the injected liquid").positive();
+  t.real("network.viscosity", 1e-3, "Pa s",
+         "network: dynamic viscosity of the injected liquid; at most 1e12 Pa s (the glass transition's viscosity: "
+         "beyond, no liquid)")
+      .positive()
+      .at_most(1e12);
   t.real("network.density", 1000, "kg/m^3", "network: liquid density at network.pore_pressure").positive();
   t.real("network.pore_pressure", 1e5, "Pa",
-         "network: the rock's initial (absolute) pore pressure, the zero of the reported pressure and of the grain forces")
-      .positive();
+         "network: the rock's initial (absolute) pore pressure, the zero of the reported pressure and of the grain "
+         "forces; at most 1 GPa (five times the highest reservoir pore pressures; water at 20 C freezes near 0.9 GPa)")
+      .positive()
+      .at_most(1e9);
   t.real("network.vapour_pressure", 2.34e3, "Pa", "network: a pore pulled below it cavitates (held there, its liquid mass kept)")
       .non_negative();
   t.real("network.aperture_h0", 1e-6, "m", "network, 2D: contact/bond channel aperture at zero normal stress (Eq. B1 h0)").positive();
@@ -239,6 +245,11 @@ void validate_scenario(const Config& cfg) {
              fmt::format("{} Pa is not below network.pore_pressure = {} Pa: every pore would start cavitated (water at "
                          "20 C: 2.34e3 Pa; 0 lets the liquid take any tension)",
                          cfg.real("network.vapour_pressure"), cfg.real("network.pore_pressure")));
+  if (!(cfg.real("injection.initial_pressure") < cfg.real("injection.max_pressure")))
+    cfg.fail("injection.initial_pressure",
+             fmt::format("{} Pa is not below injection.max_pressure = {} Pa, where the run stops: lower it (or raise "
+                         "injection.max_pressure)",
+                         cfg.real("injection.initial_pressure"), cfg.real("injection.max_pressure")));
   if (cfg.string("network.walls") == "on" && cfg.integer("dem.dim") != 3)
     cfg.fail("network.walls", "walls in the network are 3D (PFV's boundary spheres): dem.dim = 3, or network.walls = "
                               "\"auto\" / \"off\"");

@@ -43,8 +43,14 @@ void declare(ParamTable& t) {
            "smallest_pores_first (capillary equilibrium of a wetting liquid: the smallest pores full, the largest "
            "gas only; docs/saturated.md)")
       .one_of({"uniform", "smallest_pores_first"});
-  t.real("fluid.liquid_viscosity", 1e-3, "Pa s", "dynamic viscosity of the liquid (water: 1e-3)").positive();
-  t.real("fluid.gas_viscosity", 1.8e-5, "Pa s", "dynamic viscosity of the gas (air: 1.8e-5)").positive();
+  t.real("fluid.liquid_viscosity", 1e-3, "Pa s",
+         "dynamic viscosity of the liquid (water: 1e-3); at most 1e12 Pa s (the glass transition's viscosity: beyond, "
+         "no liquid)")
+      .positive()
+      .at_most(1e12);
+  t.real("fluid.gas_viscosity", 1.8e-5, "Pa s", "dynamic viscosity of the gas (air: 1.8e-5); at most 1 Pa s")
+      .positive()
+      .at_most(1.0);
   t.string("fluid.liquid_eos", "barotropic",
            "liquid equation of state: barotropic (constant bulk modulus) or peng_robinson (PR + Peneloux water, seed 004 "
            "B10-B22; ~3.3x stiffer than real water)")
@@ -52,7 +58,10 @@ void declare(ParamTable& t) {
   t.real("fluid.liquid_bulk_modulus", 2.2e9, "Pa", "bulk modulus of the barotropic liquid (water: 2.2e9)").positive();
   t.string("fluid.gas_eos", "ideal", "gas equation of state: ideal (air) or peng_robinson (PR air)")
       .one_of({"ideal", "peng_robinson"});
-  t.real("fluid.initial_pressure", 1e5, "Pa", "initial pore pressure, also the ambient pressure outside").positive();
+  t.real("fluid.initial_pressure", 1e5, "Pa",
+         "initial pore pressure, also the ambient pressure outside; at most 1 GPa (water at 20 C freezes near 0.9 GPa)")
+      .positive()
+      .at_most(1e9);
   t.string("fluid.drainage", "sides",
            "pores held at the ambient pressure: sides (hull pores at the free lateral faces; platens impermeable) or "
            "closed (undrained sample)")
@@ -429,6 +438,12 @@ class SaturatedUcsRun final : public UcsRun {
     if (use) dem::choose_time_step(cfg, sys, k);
   }
   void dem_step() override { fluid_.step(sys); }
+  std::string instability_advice() const override {
+    return fmt::format(
+        "The pore fluid pushes the grains too (largest pore pressure so far {:.4g} Pa): check "
+        "fluid.initial_pressure and fluid.liquid_bulk_modulus, keep fluid.stiffness_in_time_step = true{}",
+        ex_.max_pore_pressure, fluid_.dim3() ? ", lower fluid.hold_displacement and fluid.hold_strain" : "");
+  }
   void after_step() override {
     const Real pm = fluid_.max_pressure();
     if (pm > ex_.max_pore_pressure) ex_.max_pore_pressure = pm;

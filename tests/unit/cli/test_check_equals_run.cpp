@@ -165,6 +165,36 @@ std::vector<Bad> bad_scenarios() {
            "sample.shape = \"box\"\nsample.width = 6e-3\nsample.height = 6e-3\nsample.porosity = 0.25\n"
            "injection.fluid = \"network\"\nnetwork.vapour_pressure = 1e6\n",
        {"network.vapour_pressure", "not below network.pore_pressure"}},
+      // 2^31 generated fractures: the generator and the bond cut ran for hours (fuzzed 2026-11-30)
+      {"dfn_count_past_any_block",
+       "driver = \"hydrofrac\"\n" + kOutput + "dem.dim = 2\n" + kRock +
+           "sample.shape = \"box\"\nsample.width = 6e-3\nsample.height = 6e-3\nsample.porosity = 0.25\n"
+           "dfn.count = 2147483648\n",
+       {"dfn.count", "out of range"}},
+      // a grid spacing that never advanced x: an endless loop
+      {"dfn_grid_spacing_below_round_off",
+       "driver = \"hydrofrac\"\n" + kOutput + "dem.dim = 2\n" + kRock +
+           "sample.shape = \"box\"\nsample.width = 12e-3\nsample.height = 12e-3\nsample.porosity = 0.25\n"
+           "borehole.radius = 1.5e-3\ndfn.count = 5\ndfn.positions = \"grid\"\ndfn.spacing = 1e-12\n",
+       {"dfn.spacing", "grid positions"}},
+      // the run started at a pressure past its stop: NaN grains, blamed on the DEM step
+      {"injection_starting_past_its_stop",
+       "driver = \"hydrofrac\"\n" + kOutput + "dem.dim = 2\n" + kRock +
+           "sample.shape = \"box\"\nsample.width = 6e-3\nsample.height = 6e-3\nsample.porosity = 0.25\n"
+           "injection.initial_pressure = 1e300\n",
+       {"injection.initial_pressure", "not below injection.max_pressure"}},
+      // 1e300 Pa s: the throats' conductances underflowed and the pressures became NaN
+      {"network_viscosity_of_a_glass",
+       "driver = \"hydrofrac\"\n" + kOutput + "dem.dim = 2\n" + kRock +
+           "sample.shape = \"box\"\nsample.width = 6e-3\nsample.height = 6e-3\nsample.porosity = 0.25\n"
+           "injection.fluid = \"network\"\nnetwork.viscosity = 1e300\n",
+       {"network.viscosity", "out of range"}},
+      // 1e300 Pa of pore water ran through to a "successful" UCS
+      {"pore_pressure_past_liquid_water",
+       "driver = \"saturated_ucs\"\n" + kOutput + "dem.dim = 2\n" + kRock +
+           "sample.shape = \"box\"\nsample.width = 6e-3\nsample.height = 12e-3\nsample.porosity = 0.25\n"
+           "fluid.initial_pressure = 1e300\n",
+       {"fluid.initial_pressure", "out of range"}},
       // a side past an int wrapped into a negative size: "cannot create std::vector larger than max_size()"
       {"lattice_side_past_an_int", kCylinder + "channel.height = 1e9\n", {"channel.height", "2^30 cells"}},
       // a lattice past the machine's memory: std::bad_alloc, or gigabytes of masks first

@@ -258,6 +258,21 @@ TEST(Hydrofrac, GrainsThrownOutOfTheBlockStopTheRun) {
   EXPECT_TRUE(fs::exists(out / "checkpoint")) << r.output;
 }
 
+// A ramp of 1e300 Pa/s turns the grains NaN within a few steps of injection; the DEM's own message
+// blamed its time step alone (fuzzed 2026-11-30). During injection it names the fluid's keys and
+// the borehole pressure too.
+TEST(Hydrofrac, NaNGrainsDuringInjectionNameTheFluidKeys) {
+  Scratch s;
+  const fs::path file = s.write("block.toml", kBlock);
+  const fs::path out = s / "nan";
+  const auto r = fracflow("run " + file.string() + " --out " + out.string() + " -q -j1 --set injection.ramp_rate=1e300");
+  EXPECT_EQ(r.code, 3) << r.output;
+  EXPECT_NE(r.output.find("DEM state became NaN"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("borehole pressure"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("injection.ramp_rate"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(out / "checkpoint_failed")) << r.output;
+}
+
 // Natural fractures from the generator and from a file cut bonds; a joint through the hole's
 // axis at y = centre cuts the bonds along x and the fracture follows it at sH = sh.
 TEST(Hydrofrac, NaturalFracturesCutBonds) {

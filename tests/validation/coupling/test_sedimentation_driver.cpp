@@ -128,3 +128,19 @@ TEST(SedimentationDriver, BadInputNamesTheKey) {
   EXPECT_NE(message({"lbm.dx=7e-4"}).find("lbm.dx"), std::string::npos);
   EXPECT_NE(message({"dem.time_step=1e-3"}).find("dem.time_step"), std::string::npos);  // above the contact limit
 }
+
+// A grain driven far past the fluid's Mach limit stops the run, naming the keys. Before, a gravity
+// of 1e300 m/s^2 (the fluid's Mach check sampled the fluid, which the grain had left) ran to the
+// end with the grain at -1e298 m/s. Here the disks reach 10 m/s (g = 1e5, free fall over 1 ms),
+// 0.5 m/s sound speed: Mach ~35 within the first rows.
+TEST(SedimentationDriver, GrainPastTheMachLimitStopsTheRun) {
+  std::string what;
+  try {
+    run_flow_driver_status("sed_mach", kTwoDisks, {"box.gravity=1e5", "fluid.reference_velocity=0.1"});
+  } catch (const ff::NumericalError& e) {
+    what = e.what();
+  }
+  EXPECT_NE(what.find("Mach number"), std::string::npos) << what;
+  EXPECT_NE(what.find("box.gravity"), std::string::npos) << what;
+  EXPECT_TRUE(std::filesystem::exists(flow_test_dir("sed_mach") / "checkpoint_failed"));
+}
