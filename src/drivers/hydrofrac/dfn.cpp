@@ -41,7 +41,8 @@ Real segment_distance(const Vec3& p, const Joint& j) {  // x-y distance of p to 
 }
 }  // namespace
 
-std::vector<Joint> make_joints(const Config& cfg, const Vec3& lo, const Vec3& hi, const Vec3& centre, Real hole_radius, int dim) {
+std::vector<Joint> make_joints(const Config& cfg, const Vec3& lo, const Vec3& hi, const Vec3& centre, Real hole_radius, int dim,
+                               long* outside) {
   std::vector<Joint> out;
   const Real buffer = cfg.real("dfn.buffer");
   const std::string file = cfg.string("dfn.file");
@@ -55,6 +56,7 @@ std::vector<Joint> make_joints(const Config& cfg, const Vec3& lo, const Vec3& hi
       cfg.fail("dfn.file", fmt::format("{} (allowed: a CSV with columns x_m,y_m,{}angle_deg,length_m)", e.what(),
                                        dim == 3 ? "z_m," : ""));
     }
+    long n_outside = 0;
     std::vector<std::string> need = {"x_m", "y_m", "angle_deg", "length_m"};
     if (dim == 3) need.push_back("z_m");
     for (const auto& c : need)
@@ -67,8 +69,22 @@ std::vector<Joint> make_joints(const Config& cfg, const Vec3& lo, const Vec3& hi
       j.length = t.column("length_m")[r];
       if (!(j.length > 0) || !j.centre.allFinite() || !std::isfinite(j.angle))
         cfg.fail("dfn.file", fmt::format("'{}' row {}: lengths must be > 0 and every value a number", f.string(), r + 1));
+      bool inside = true;
+      for (int a = 0; a < dim; ++a) inside = inside && j.centre[a] >= lo[a] && j.centre[a] <= hi[a];
+      n_outside += !inside;
       out.push_back(j);
     }
+    if (out.empty())
+      cfg.fail("dfn.file", fmt::format("'{}' lists no fracture (a header alone); remove dfn.file for none", f.string()));
+    // Every centre outside the block: most likely another unit (mm) or origin, and nothing would be cut.
+    if (n_outside == static_cast<long>(out.size())) {
+      std::string box;
+      for (int a = 0; a < dim; ++a) box += fmt::format("{}[{}, {}]", a ? " x " : "", lo[a], hi[a]);
+      cfg.fail("dfn.file", fmt::format("'{}': every fracture's centre lies outside the block, {} m; coordinates are in "
+                                       "metres from the block's corner",
+                                       f.string(), box));
+    }
+    if (outside) *outside = n_outside;
     return out;
   }
   const long n = cfg.integer("dfn.count");

@@ -26,8 +26,11 @@ struct Joint {
 void declare_dfn_params(ParamTable& t);
 // The joints of the scenario (file or generator; none when dfn.count = 0 and no file) in a
 // block [lo, hi] around a hole of radius `hole_radius` centred at `centre`. Throws InputError
-// naming the key for a bad file or settings.
-std::vector<Joint> make_joints(const Config& cfg, const Vec3& lo, const Vec3& hi, const Vec3& centre, Real hole_radius, int dim);
+// naming the key for a bad file or settings, and for a file whose every joint is centred outside
+// the block (another unit or origin); `outside`, if given, counts the file's joints centred outside
+// (a DFN drawn over a larger region than the block).
+std::vector<Joint> make_joints(const Config& cfg, const Vec3& lo, const Vec3& hi, const Vec3& centre, Real hole_radius, int dim,
+                               long* outside = nullptr);
 // Removes every intact bond whose centre-to-centre segment crosses a joint; returns the pairs
 // (global ids, bond face area) for the fluid.
 std::vector<JointPair> cut_bonds(dem::DemSystem& sys, const std::vector<Joint>& joints);

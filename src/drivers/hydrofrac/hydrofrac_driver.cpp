@@ -171,7 +171,12 @@ void HydrofracRun::set_up() {
   }
   hole_.z_lo = dim == 3 ? lo.z() : 0;
   hole_.z_hi = dim == 3 ? hi.z() : 0;
-  const auto joints = hydrofrac::make_joints(cfg, lo, hi, hole_.centre, hole_.radius, dim);
+  long joints_outside = 0;
+  const auto joints = hydrofrac::make_joints(cfg, lo, hi, hole_.centre, hole_.radius, dim, &joints_outside);
+  if (joints_outside > 0)
+    log::warn("hydrofrac: {} of the {} fractures of dfn.file are centred outside the block (they cut only where they "
+              "reach into it)",
+              joints_outside, joints.size());
   joints_ = hydrofrac::cut_bonds(sys, joints);
   sys.walls.clear();
   const char* names[6] = {"x-", "x+", "y-", "y+", "z-", "z+"};

@@ -293,6 +293,16 @@ TEST(Hydrofrac, NaturalFracturesCutBonds) {
   r = fracflow("resume " + parts.string() + " -q -j1");
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_EQ(ff::test::read_json(parts / "summary.json")["borehole"], f["borehole"]);
+  // The same joint in millimetres lies outside the 24 mm block, and a header alone lists none: both
+  // were accepted and cut nothing (fuzzed 2026-11-30); now refused, naming the key.
+  s.write("mm.csv", "x_m,y_m,angle_deg,length_m\n4,16,45,4\n");
+  s.write("none.csv", "x_m,y_m,angle_deg,length_m\n");
+  for (const auto& [csv, why] : {std::pair{"mm.csv", "outside the block"}, std::pair{"none.csv", "lists no fracture"}}) {
+    r = fracflow("check " + file.string() + " --set dfn.file=\"" + csv + "\"");
+    EXPECT_EQ(r.code, 2) << r.output;
+    EXPECT_NE(r.output.find("dfn.file"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(why), std::string::npos) << r.output;
+  }
 }
 
 // `check` refuses what `run` refuses, naming the key.

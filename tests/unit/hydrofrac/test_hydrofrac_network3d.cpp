@@ -172,14 +172,19 @@ TEST(HydrofracNetwork, NaturalFractureDiscsCutBonds3D) {
   s.write("big.csv", "x_m,y_m,z_m,angle_deg,length_m\n0.006,0.0085,0.002,0,0.010\n");
   s.write("small.csv", "x_m,y_m,z_m,angle_deg,length_m\n0.006,0.0085,0.002,0,0.003\n");
   s.write("outside.csv", "x_m,y_m,z_m,angle_deg,length_m\n0.006,0.0085,0.020,0,0.003\n");
-  const long big = cut("big", " --set dfn.file=\"big.csv\""), small = cut("small", " --set dfn.file=\"small.csv\""),
-             outside = cut("outside", " --set dfn.file=\"outside.csv\"");
-  std::printf("3D natural fractures: %ld bonds cut by 4 generated discs; one disc at y = 8.5 mm: %ld (10 mm), %ld (3 mm), "
-              "%ld (outside the block)\n", generated, big, small, outside);
+  const long big = cut("big", " --set dfn.file=\"big.csv\""), small = cut("small", " --set dfn.file=\"small.csv\"");
+  std::printf("3D natural fractures: %ld bonds cut by 4 generated discs; one disc at y = 8.5 mm: %ld (10 mm), %ld (3 mm)\n",
+              generated, big, small);
   EXPECT_GT(generated, 0);
   EXPECT_GT(small, 0);
   EXPECT_GT(big, 2 * small);
-  EXPECT_EQ(outside, 0);
+  // A file whose every disc lies outside the block (another unit or origin) is refused, naming the key;
+  // with one inside too, the run goes on and the outside disc cuts nothing.
+  const auto refused = fracflow("check " + file.string() + sets + " --set dfn.file=\"outside.csv\"");
+  EXPECT_EQ(refused.code, 2) << refused.output;
+  EXPECT_NE(refused.output.find("every fracture's centre lies outside the block"), std::string::npos) << refused.output;
+  s.write("both.csv", "x_m,y_m,z_m,angle_deg,length_m\n0.006,0.0085,0.002,0,0.003\n0.006,0.0085,0.020,0,0.003\n");
+  EXPECT_EQ(cut("both", " --set dfn.file=\"both.csv\""), small);
 }
 
 // One and two threads give the same files, bit for bit, through the breakdown: a 16 x 16 x 4 mm block
