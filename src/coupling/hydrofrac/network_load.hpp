@@ -129,6 +129,8 @@ class NetworkLoad final : public FluidLoad {
   const NetworkInfo& info() const { return info_; }
   bool drained_faces() const { return s_.drained_faces; }
   bool walls() const { return s_.walls; }
+  bool crack_channels() const { return c3_ != nullptr && s_.crack_channels; }  // 3D only (the 2D cracks are channels)
+  bool amg() const { return s_.amg; }
   bool predicting() const { return predict_; }  // 3D: the held steps predict the pressures
   NetworkBudget budget() const;
   Real effective_radius() const { return st_.effective_radius; }

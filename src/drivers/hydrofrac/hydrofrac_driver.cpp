@@ -111,7 +111,8 @@ void HydrofracRun::make_fluid() {
     n.drained_faces = faces == "drained" || (faces == "auto" && sys.settings.dim == 3);
     n.walls = sys.settings.dim == 3 && cfg.string("network.walls") != "off";
     n.crack_channels = cfg.boolean("network.crack_channels");
-    n.amg = cfg.string("network.preconditioner") == "amg";
+    const std::string pre = cfg.string("network.preconditioner");
+    n.amg = pre == "amg" || (pre == "auto" && sys.settings.dim == 3);
     n.cell = s.cell;
     n.inflate = s.inflate;
     n.reach = s.reach;

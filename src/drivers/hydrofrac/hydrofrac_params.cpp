@@ -90,17 +90,16 @@ void declare_params(ParamTable& t) {
   t.integer("network.flow_every", 0, "steps",
             "network: DEM steps per implicit flow step (0: from the fluid-grain stiffness, see docs/hydrofrac.md)")
       .non_negative();
-  t.boolean("network.crack_channels", false,
+  t.boolean("network.crack_channels", true,
             "network, 3D: each throat beside a broken bond conducts the cubic law of the bond's opening w as well, "
             "w^3 r_bond / (12 mu L), not scaled by network.throat_factor (the 2D network's cracks are channels of their "
-            "own); false: a crack conducts only as its widened facets. Off by default: on the 30,000-sphere example its "
-            "pressure solves took up to ~600 CG iterations once cracks opened (1,035 s against 403 s without, "
-            "docs/hydrofrac.md)");
-  t.string("network.preconditioner", "dic",
+            "own); false: a crack conducts only as its widened facets (the fluid barely enters the cracks; cheaper: "
+            "the crack throats' conductance is 1e4-1e7 x the matrix's, docs/hydrofrac.md)");
+  t.string("network.preconditioner", "auto",
            "network: preconditioner of the implicit flow's conjugate gradients: dic (block diagonal incomplete "
-           "Cholesky) or amg (3D: algebraic multigrid, porenet/amg.hpp; fewer iterations where DIC needs hundreds, "
-           "e.g. with network.crack_channels; its aggregates are checkpointed, so a resume stays bit-for-bit)")
-      .one_of({"dic", "amg"});
+           "Cholesky), amg (3D: algebraic multigrid, porenet/amg.hpp; a few times fewer iterations than DIC with crack "
+           "channels; its aggregates are checkpointed, so a resume stays bit-for-bit) or auto (amg in 3D, dic in 2D)")
+      .one_of({"auto", "dic", "amg"});
   t.boolean("network.predict_pressures", true,
             "network, 3D: between flow steps advance the pore pressures every DEM step by the flow's implicit step "
             "linearised at the last flow step, so that the held forces follow the grains: where the fluid-grain "

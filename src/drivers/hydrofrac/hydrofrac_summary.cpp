@@ -178,7 +178,9 @@ void HydrofracRun::finish(const std::string& stop) {
                                      "hull pores exchanged with the far field); ramp mode: injected is defined as the "
                                      "change (residual 0)"}}},
                     {"faces", net_->drained_faces() ? "drained" : "closed"},
-                    {"walls", net_->walls()}};
+                    {"walls", net_->walls()},
+                    {"crack_channels", net_->crack_channels()},
+                    {"preconditioner", net_->amg() ? "amg" : "dic"}};
     log::info("hydrofrac: network mass budget over {} flow steps ({} retriangulations; kg{}): injected {:.6g}, pores "
               "{:.6g} -> {:.6g}, residual {:.3g}; wall time: network update {:.1f} s (retriangulations {:.1f} s in this "
               "session), flow {:.1f} s, forces {:.1f} s of {:.1f} s",
