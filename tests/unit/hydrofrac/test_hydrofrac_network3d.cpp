@@ -100,9 +100,9 @@ TEST(HydrofracNetwork, ThreeDimensionalDrainedFacesResumeBitForBit) {
 // its faces (measured 2026-11-30: breakdown 0.66 MPa, the first cracks 4.9-5.7 mm from the axis, 712
 // cracks; on the 30,000-sphere example 0.1-1.7 GPa in such pores, docs/hydrofrac.md); with the walls the
 // pores along the faces are the gaps between the grains and the walls, and the block holds until the
-// hole breaks (17.26 MPa, first cracks at 2.73-2.78 mm, the hole's effective radius 2.72 mm; the fracture
-// at 0.0 deg from sigma_H; with network.crack_channels = true 16.37 MPa, first cracks at 2.73-3.30 mm,
-// -0.8 deg). With drained faces the walls change little: 19.47 MPa (19.69 without; the
+// hole breaks (without crack channels 17.26 MPa, first cracks at 2.73-2.78 mm, the hole's effective radius
+// 2.72 mm; the fracture at 0.0 deg from sigma_H; with network.crack_channels = true, the default since
+// 2026-11-30: 16.37 MPa, first cracks at 2.73-3.30 mm, -0.8 deg). With drained faces the walls change little: 19.47 MPa (19.69 without; the
 // breakdown of closed faces is lower: the pore pressure the injection raises in the block stays).
 TEST(HydrofracNetwork, WallsLetClosedFacesHoldUntilTheHoleBreaks) {
   Scratch s;
@@ -130,8 +130,8 @@ TEST(HydrofracNetwork, WallsLetClosedFacesHoldUntilTheHoleBreaks) {
 // in the network): breakdown 19.69 MPa and initiation 18.14 MPa in both, 49 and 48 cracks, fracture
 // 10.1 and 9.6 mm at 0.3 and 1.2 deg from sigma_H; 11.5 s and 4.7 s (network update 5.6 -> 0.3 s, flow
 // 3.3 -> 0.3 s, forces and prediction 0.3 -> 1.9 s). With the walls (2026-11-30): breakdown 19.47 MPa in
-// both, initiation 17.48 / 17.70 MPa, 61 / 64 cracks; with network.crack_channels = true 18.80 MPa in
-// both, initiation 17.48 / 17.70 MPa, 45 / 45 cracks. Asserted: the pressures within 2 %, the cracks within 20 %.
+// both, initiation 17.48 / 17.70 MPa, 61 / 64 cracks; with network.crack_channels = true (the default
+// since 2026-11-30, AMG) 18.80 MPa in both, initiation 17.48 / 17.70 MPa, 45 / 47 cracks. Asserted: the pressures within 2 %, the cracks within 20 %.
 TEST(HydrofracNetwork, PressurePredictionKeepsTheBreakdownPressure) {
   Scratch s;
   const fs::path file = small_block(s);
