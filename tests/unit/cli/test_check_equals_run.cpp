@@ -50,6 +50,10 @@ const std::string kUcs3d = "driver = \"ucs\"\n" + kOutput + kRock + "sample.diam
 const std::string kTriaxial = "driver = \"triaxial\"\n" + kOutput + kRock + "sample.diameter = 5e-3\nsample.height = 10e-3\n";
 const std::string kCavity = "driver = \"flow/cavity\"\n" + kOutput + "lbm.resolution = 16\n";
 const std::string kCylinder = "driver = \"flow/cylinder\"\n" + kOutput;
+const std::string kHydrofrac2d = "driver = \"hydrofrac\"\n" + kOutput + "dem.dim = 2\n" + kRock +
+                                 "sample.shape = \"box\"\nsample.width = 6e-3\nsample.height = 6e-3\nsample.porosity = 0.25\n";
+const std::string kSaturated2d = "driver = \"saturated_ucs\"\n" + kOutput + "dem.dim = 2\n" + kRock +
+                                 "sample.shape = \"box\"\nsample.width = 6e-3\nsample.height = 12e-3\nsample.porosity = 0.25\n";
 
 struct Bad {
   std::string name;  // also the scenario file's name
@@ -156,20 +160,14 @@ std::vector<Bad> bad_scenarios() {
        {"run.inflow_ramp_time", "does not end before run.end_time"}},
       // every pore cavitated from the start and held there: NaN grains at the first step
       {"cavitation_above_the_initial_pressure",
-       "driver = \"saturated_ucs\"\n" + kOutput + "dem.dim = 2\n" + kRock +
-           "sample.shape = \"box\"\nsample.width = 6e-3\nsample.height = 12e-3\nsample.porosity = 0.25\n"
-           "fluid.cavitation_pressure = 1e300\n",
+       kSaturated2d + "fluid.cavitation_pressure = 1e300\n",
        {"fluid.cavitation_pressure", "not below fluid.initial_pressure"}},
       {"vapour_above_the_pore_pressure",
-       "driver = \"hydrofrac\"\n" + kOutput + "dem.dim = 2\n" + kRock +
-           "sample.shape = \"box\"\nsample.width = 6e-3\nsample.height = 6e-3\nsample.porosity = 0.25\n"
-           "injection.fluid = \"network\"\nnetwork.vapour_pressure = 1e6\n",
+       kHydrofrac2d + "injection.fluid = \"network\"\nnetwork.vapour_pressure = 1e6\n",
        {"network.vapour_pressure", "not below network.pore_pressure"}},
       // 2^31 generated fractures: the generator and the bond cut ran for hours (fuzzed 2026-11-30)
       {"dfn_count_past_any_block",
-       "driver = \"hydrofrac\"\n" + kOutput + "dem.dim = 2\n" + kRock +
-           "sample.shape = \"box\"\nsample.width = 6e-3\nsample.height = 6e-3\nsample.porosity = 0.25\n"
-           "dfn.count = 2147483648\n",
+       kHydrofrac2d + "dfn.count = 2147483648\n",
        {"dfn.count", "out of range"}},
       // a grid spacing that never advanced x: an endless loop
       {"dfn_grid_spacing_below_round_off",
@@ -179,21 +177,15 @@ std::vector<Bad> bad_scenarios() {
        {"dfn.spacing", "grid positions"}},
       // the run started at a pressure past its stop: NaN grains, blamed on the DEM step
       {"injection_starting_past_its_stop",
-       "driver = \"hydrofrac\"\n" + kOutput + "dem.dim = 2\n" + kRock +
-           "sample.shape = \"box\"\nsample.width = 6e-3\nsample.height = 6e-3\nsample.porosity = 0.25\n"
-           "injection.initial_pressure = 1e300\n",
+       kHydrofrac2d + "injection.initial_pressure = 1e300\n",
        {"injection.initial_pressure", "not below injection.max_pressure"}},
       // 1e300 Pa s: the throats' conductances underflowed and the pressures became NaN
       {"network_viscosity_of_a_glass",
-       "driver = \"hydrofrac\"\n" + kOutput + "dem.dim = 2\n" + kRock +
-           "sample.shape = \"box\"\nsample.width = 6e-3\nsample.height = 6e-3\nsample.porosity = 0.25\n"
-           "injection.fluid = \"network\"\nnetwork.viscosity = 1e300\n",
+       kHydrofrac2d + "injection.fluid = \"network\"\nnetwork.viscosity = 1e300\n",
        {"network.viscosity", "out of range"}},
       // 1e300 Pa of pore water ran through to a "successful" UCS
       {"pore_pressure_past_liquid_water",
-       "driver = \"saturated_ucs\"\n" + kOutput + "dem.dim = 2\n" + kRock +
-           "sample.shape = \"box\"\nsample.width = 6e-3\nsample.height = 12e-3\nsample.porosity = 0.25\n"
-           "fluid.initial_pressure = 1e300\n",
+       kSaturated2d + "fluid.initial_pressure = 1e300\n",
        {"fluid.initial_pressure", "out of range"}},
       // a side past an int wrapped into a negative size: "cannot create std::vector larger than max_size()"
       {"lattice_side_past_an_int", kCylinder + "channel.height = 1e9\n", {"channel.height", "2^30 cells"}},
