@@ -554,7 +554,10 @@ RunStatus HydrofracRun::run() {
           st_.peak_cracks = sys.cracks.total();
         }
         if (!st_.breakdown_found) {
-          const bool bd = rate_mode ? (st_.peak_pressure > 0 && p < (1 - peak_drop) * st_.peak_pressure) : extent_ >= bd_len;
+          // Rate mode: a drop counts once a crack has reached the hole; before, the pressure of the hole's
+          // pores also rises and falls as the rock settles (a "breakdown" of 35 kPa with no crack at all).
+          const bool bd = rate_mode ? (st_.peak_pressure > 0 && st_.initiation_found && p < (1 - peak_drop) * st_.peak_pressure)
+                                    : extent_ >= bd_len;
           if (bd) {
             st_.breakdown_found = 1;
             st_.breakdown_row = st_.rows - 1;

@@ -179,7 +179,9 @@ void declare_params(ParamTable& t) {
          "ramp mode: breakdown = pressure when the connected fracture first reaches this far beyond the hole's wall (0: one "
          "borehole radius)")
       .non_negative();
-  t.real("injection.peak_drop", 0.05, "-", "rate mode: breakdown = the first pressure peak followed by a drop of this fraction")
+  t.real("injection.peak_drop", 0.05, "-",
+         "rate mode: breakdown = the first pressure peak followed by a drop of this fraction once a crack has reached "
+         "the hole")
       .open_range(0, 1);
   t.real("injection.stop_fraction", 0.5, "-", "rate mode: stop when the pressure fell below this fraction of its peak").open_range(0, 1);
   t.real("injection.stop_extent", 0.8, "-",

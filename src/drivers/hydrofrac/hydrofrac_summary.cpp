@@ -65,7 +65,7 @@ void HydrofracRun::finish(const std::string& stop) {
                     {"start_time_s", st_.injection_time}};
   if (sys.settings.dim == 2) j["injection"]["note"] = "2D: volumes and rates per metre of thickness";
   nlohmann::json bd;
-  bd["definition"] = rate_mode ? "first pressure peak followed by a drop of injection.peak_drop"
+  bd["definition"] = rate_mode ? "first pressure peak followed by a drop of injection.peak_drop once a crack has reached the hole"
                                : fmt::format("pressure when the fracture connected to the hole first reached {} m beyond its wall "
                                              "(injection.breakdown_length)",
                                              cfg.real("injection.breakdown_length") > 0 ? cfg.real("injection.breakdown_length")
