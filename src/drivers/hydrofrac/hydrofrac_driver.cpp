@@ -634,7 +634,7 @@ namespace ff::drivers {
 
 Driver hydrofrac_driver() {
   return Driver{"hydrofrac",
-                "hydraulic fracturing from a borehole in a bonded block under servo-controlled in-situ stresses (sleeve pressure)",
+                "hydraulic fracturing from a borehole in a bonded block under servo-controlled in-situ stresses; the fluid a sleeve pressure, an LBM fluid or the pore network (injection.fluid)",
                 hydrofrac::declare_params, hydrofrac::run, hydrofrac::validate_scenario};
 }
 

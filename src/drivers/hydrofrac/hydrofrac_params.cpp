@@ -236,6 +236,12 @@ coupling::FluidSpec lbm_fluid_spec(const Config& cfg) {
 
 void validate_scenario(const Config& cfg) {
   dem::validate_dem_sample(cfg);
+  // x is the sigma_H direction by name: swapped stresses still run (the fracture is then expected along
+  // y), but the reported azimuths "from sigma_H" are from x.
+  if (cfg.real("insitu.sigma_H") < cfg.real("insitu.sigma_h"))
+    log::warn("insitu.sigma_H = {} Pa is below insitu.sigma_h = {} Pa: sigma_H acts along x, so the fracture should "
+              "run along y (azimuths are reported from x); swap them to keep the names",
+              cfg.real("insitu.sigma_H"), cfg.real("insitu.sigma_h"));
   for (const char* key : {"insitu.sigma_H", "insitu.sigma_h", "insitu.sigma_v"})
     if (cfg.integer("dem.dim") == 3 || std::string(key) != "insitu.sigma_v") dem::refuse_crushing_stress(cfg, key);
   if (cfg.string("sample.shape") != "box")
