@@ -59,17 +59,23 @@ FluidScales derive_scales(const FluidSpec& s) {
   r.mach = s.reference_velocity / r.sound_speed;
   r.density_variation = s.pressure_range / r.bulk_modulus;
   const double tau = r.units.tau();
+  // tau - 1/2 = 3 nu dt / dx^2, and with the step from the sound speed dt = dx / (sqrt(3) c_s): a finer
+  // lattice raises tau either way, a longer step (lower sound speed or bulk modulus) too.
+  const std::string dx_key = s.dx_key.empty() ? key("dx") : s.dx_key;
+  if (tau - 0.5 < kMinTauMinusHalf && std::string(set[0]) == "tau")
+    fail("tau", fmt::format("{} is too close to 1/2 (tau - 1/2 = {:.3g} < {}): the LBM is unstable there; raise it",
+                            tau, tau - 0.5, kMinTauMinusHalf));
   if (tau - 0.5 < kMinTauMinusHalf)
     fail(set[0], fmt::format("gives tau = {:.6g}, too close to 1/2 (tau - 1/2 = {:.3g} < {}): the LBM is unstable there. "
-                             "To fix it, {}",
-                             tau, tau - 0.5, kMinTauMinusHalf,
-                             fmt::format("raise the time step (a larger {} or a lower {}.sound_speed / bulk_modulus), "
-                                         "raise {} or use a coarser {} (tau - 1/2 = 3 nu dt / dx^2)",
-                                         r.fixed_by, s.prefix, key("viscosity"), key("dx"))));
+                             "To fix it, raise the time step (a larger {}, or a lower {} or {}), raise {} or use a finer "
+                             "{} (tau - 1/2 = 3 nu dt / dx^2)",
+                             tau, tau - 0.5, kMinTauMinusHalf, key("time_step"), key("sound_speed"), key("bulk_modulus"),
+                             key("viscosity"), dx_key));
   if (tau > kMaxTau)
     fail(set[0], fmt::format("gives tau = {:.6g} > {}: the partially saturated cells' drag error grows with tau "
-                             "(docs/lbm.md); use a shorter time step or a finer {}",
-                             tau, kMaxTau, key("dx")));
+                             "(docs/lbm.md); use a shorter time step (a smaller {}, or a higher {} or {}), a less viscous "
+                             "fluid or a coarser {}",
+                             tau, kMaxTau, key("time_step"), key("sound_speed"), key("bulk_modulus"), dx_key));
   if (tau - 0.5 < kWarnTauMinusHalf)
     r.warnings.push_back(fmt::format("tau = {:.5g} is close to 1/2: TRT stays stable there, but under-resolved flow may "
                                      "ring",

@@ -32,6 +32,7 @@ struct FluidSpec {
   double reference_velocity = 0;   // U [m/s] of the Mach number (0: no Mach check)
   double pressure_range = 0;       // largest |p - p0| expected [Pa] (0: no density-variation check)
   std::string prefix = "fluid";    // scenario table the keys live in (error messages name prefix.key)
+  std::string dx_key;              // the key(s) that set dx, for the advice (empty: prefix.dx)
 };
 
 // Limits of the checks (errors; warnings at the lower values).

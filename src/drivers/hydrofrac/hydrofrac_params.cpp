@@ -224,6 +224,7 @@ coupling::FluidSpec lbm_fluid_spec(const Config& cfg) {
   f.viscosity = cfg.real("fluid.viscosity");
   f.dynamic_viscosity = cfg.real("fluid.dynamic_viscosity");
   f.dx = cfg.real("fluid.dx") > 0 ? cfg.real("fluid.dx") : cfg.real("sample.radius_min") / cfg.real("fluid.cells_per_radius");
+  f.dx_key = "fluid.dx (when 0: sample.radius_min / fluid.cells_per_radius)";
   f.bulk_modulus = cfg.real("fluid.bulk_modulus");
   f.sound_speed = cfg.real("fluid.sound_speed");
   f.time_step = cfg.real("fluid.time_step");

@@ -97,6 +97,7 @@ coupling::FluidSpec fluid_spec(const Config& cfg) {
   s.dynamic_viscosity = cfg.real("fluid.dynamic_viscosity");
   const double nu = s.dynamic_viscosity > 0 ? s.dynamic_viscosity / s.density : s.viscosity;
   s.dx = cfg.real("lbm.dx");
+  s.dx_key = "lbm.dx";
   s.tau = cfg.real("fluid.tau");
   s.time_step = cfg.real("fluid.time_step");
   s.sound_speed = cfg.real("fluid.sound_speed");

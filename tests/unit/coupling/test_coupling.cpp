@@ -81,6 +81,20 @@ TEST(FluidScales, ErrorsNameTheKey) {
   const std::string m = message_of(w);
   EXPECT_NE(m.find("fluid.bulk_modulus"), std::string::npos) << m;
   EXPECT_NE(m.find("too close to 1/2"), std::string::npos) << m;
+  // The advice points the right way: tau - 1/2 = 3 nu dt / dx^2 grows on a finer lattice (also with the
+  // step from the sound speed, dt ~ dx) and with a longer step. It said "a coarser fluid.dx" and "a
+  // larger fluid.bulk_modulus" before (2026-11-30).
+  EXPECT_NE(m.find("a finer fluid.dx"), std::string::npos) << m;
+  EXPECT_NE(m.find("a lower fluid.sound_speed or fluid.bulk_modulus"), std::string::npos) << m;
+  EXPECT_EQ(m.find("coarser"), std::string::npos) << m;
+  FluidSpec fine = water(1e-7);  // 0.1 um cells at c_s = 2 m/s: tau - 1/2 = 3 nu / (sqrt(3) c_s dx) = 4.3
+  fine.sound_speed = 2;
+  const std::string mf = message_of(fine);
+  EXPECT_NE(mf.find("> 2"), std::string::npos) << mf;
+  EXPECT_NE(mf.find("a coarser fluid.dx"), std::string::npos) << mf;
+  FluidSpec t = water(1e-3);
+  t.tau = 0.501;
+  EXPECT_NE(message_of(t).find("fluid.tau: 0.501 is too close to 1/2"), std::string::npos) << message_of(t);
   // Mach: U = 1 m/s at c_s = 2 m/s.
   FluidSpec h = water(1e-3);
   h.viscosity = 1e-3;
