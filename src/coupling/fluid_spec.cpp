@@ -82,16 +82,18 @@ FluidScales derive_scales(const FluidSpec& s) {
                                      tau));
   if (r.mach > kMaxMach)
     fail(set[0], fmt::format("gives the sound speed {:.4g} m/s, and {} = {:.4g} m/s is Mach {:.3g} > {}: the LBM is "
-                             "then far from incompressible. Raise the sound speed (a shorter time step)",
-                             r.sound_speed, key("reference_velocity"), s.reference_velocity, r.mach, kMaxMach));
+                             "then far from incompressible. Raise the sound speed: a higher {} or {}, or a shorter "
+                             "step ({} or {} smaller)",
+                             r.sound_speed, key("reference_velocity"), s.reference_velocity, r.mach, kMaxMach,
+                             key("sound_speed"), key("bulk_modulus"), key("time_step"), key("tau")));
   if (r.mach > kWarnMach)
     r.warnings.push_back(fmt::format("Mach number {:.3g} > {}: compressibility error about Ma^2 = {:.2g}", r.mach,
                                      kWarnMach, r.mach * r.mach));
   if (r.density_variation > kMaxDensityVariation)
     fail(set[0], fmt::format("gives K_eff = {:.4g} Pa, and {} = {:.4g} Pa is a lattice density variation of {:.3g} > "
-                             "{}: raise the sound speed or bulk modulus",
+                             "{}: raise {} or {} (or shorten the step: a smaller {} or {})",
                              r.bulk_modulus, key("pressure_range"), s.pressure_range, r.density_variation,
-                             kMaxDensityVariation));
+                             kMaxDensityVariation, key("bulk_modulus"), key("sound_speed"), key("time_step"), key("tau")));
   if (r.density_variation > kWarnDensityVariation)
     r.warnings.push_back(fmt::format("pressure changes of {:.4g} Pa are lattice density changes of {:.3g}: the "
                                      "fluid is {:.3g} times as compressible as at K = 2.2 GPa (water)",
