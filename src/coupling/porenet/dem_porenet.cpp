@@ -268,7 +268,8 @@ void DemPorenetCoupling::step(dem::DemSystem& sys) {
     if (nsub + need > prm_.max_substeps)
       throw NumericalError(fmt::format(
           "coupling.porenet: the flow needs more than {} sub-steps of {:.3g} s per DEM step of {:.3g} s; "
-          "reduce the liquid bulk modulus or the DEM step, or raise the apertures",
+          "the explicit step shrinks with the channels' conductance and grows with the pores' compressibility: lower "
+          "the apertures or the liquid bulk modulus, shorten the DEM step, or let the flow go implicit",
           prm_.max_substeps, limit, dt));
     h = need == 1 ? left : left / static_cast<Real>(need);
     flow_->step_explicit(h);
