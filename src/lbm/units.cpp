@@ -99,7 +99,7 @@ StabilityCheck Units::check(double u, int resolution, const std::string& resolut
   if (!(tau_ > 0.5)) {
     const double dt_needed = (0.55 - 0.5) * dx_ * dx_ / (3 * nu_);
     r.error = fmt::format("relaxation time tau = {:.6g} must be above 1/2 (nu_lb = {:.3g} <= 0): set lbm.time_step = "
-                          "{:.4g} s or more (tau = 0.55), or lower {} (coarser cells)",
+                          "{:.4g} s or more (tau = 0.55), or raise {} (finer cells: tau - 1/2 = 3 nu dt / dx^2)",
                           tau_, nu_lb(), dt_needed, resolution_key);
     return r;
   }

@@ -473,8 +473,10 @@ RunStatus SedimentationRun<L, T>::run() {
     const double mach = fluid_->max_speed() * std::sqrt(3.0);
     if (!(mach == mach) || mach > coupling::kMaxMach) {
       write_checkpoint(opt_.out_dir / "checkpoint_failed");
-      throw NumericalError(fmt::format("the fluid became unstable at step {}: Mach number {:.3g} (limit {}); use a "
-                                       "larger fluid.sound_speed (shorter step) or a finer lbm.dx",
+      throw NumericalError(fmt::format("the fluid became unstable at step {}: Mach number {:.3g} (limit {}); take a "
+                                       "shorter LBM step (a higher fluid.sound_speed or fluid.bulk_modulus, a smaller "
+                                       "fluid.time_step or fluid.tau; with fluid.tau set, a finer lbm.dx also shortens "
+                                       "it)",
                                        t + 1, mach, coupling::kMaxMach));
     }
     row_.clear();
