@@ -296,8 +296,9 @@ void NetworkLoad::flow_step(const dem::DemSystem& sys) {
   } catch (const NumericalError& e) {  // the pore network's own words name no keys: add them
     throw NumericalError(fmt::format(
         "{}. The network fluid's inputs to check: network.aperture_h0, network.aperture_hinf, network.throat_factor "
-        "and network.max_conductance_ratio (the channels' conductance), injection.fluid_bulk_modulus (the liquid's "
-        "stiffness), network.pore_pressure, injection.ramp_rate / injection.rate",
+        "and network.max_conductance_ratio (the channels' conductance), network.viscosity and network.density, "
+        "injection.fluid_bulk_modulus (the liquid's stiffness), network.pore_pressure, injection.ramp_rate / "
+        "injection.rate",
         e.what()));
   }
 }

@@ -38,7 +38,11 @@ void declare(ParamTable& t) {
       .open_range(0, 1);
   t.real("direct_tension.max_strain", 0.01, "-", "stop at this axial strain (extension / free length) in any case")
       .positive();
-  t.integer("direct_tension.series_interval", 100, "steps", "steps between rows of series.csv").positive();
+  t.integer("direct_tension.series_interval", 100, "steps",
+            "steps between rows of series.csv; at most 100,000 (stops, signals, --max-steps and --max-wall are "
+            "honoured at rows)")
+      .positive()
+      .at_most(100000);
   t.real("direct_tension.vtk_strain_interval", 2e-4, "-", "axial strain between VTK snapshots").positive();
   t.integer("direct_tension.checkpoint_interval", 0, "steps",
             "steps between extra checkpoints (0: none; checkpoints come every output.checkpoint_wall_interval seconds, at "

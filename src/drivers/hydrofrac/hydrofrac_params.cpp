@@ -54,7 +54,10 @@ void declare_params(ParamTable& t) {
          "beyond, no liquid)")
       .positive()
       .at_most(1e12);
-  t.real("network.density", 1000, "kg/m^3", "network: liquid density at network.pore_pressure").positive();
+  t.real("network.density", 1000, "kg/m^3",
+         "network: liquid density at network.pore_pressure; at most 1e5 kg/m^3 (mercury: 13,546)")
+      .positive()
+      .at_most(1e5);
   t.real("network.pore_pressure", 1e5, "Pa",
          "network: the rock's initial (absolute) pore pressure, the zero of the reported pressure and of the grain "
          "forces; at most 1 GPa (five times the highest reservoir pore pressures; water at 20 C freezes near 0.9 GPa)")
@@ -198,7 +201,11 @@ void declare_params(ParamTable& t) {
   t.real("measure.pressure", 0, "Pa",
          "a second elastic-state snapshot when the borehole pressure first reaches this (0: only the in-situ snapshot)")
       .non_negative();
-  t.integer("hydrofrac.series_interval", 100, "steps", "steps between rows of series.csv (and stage checks)").positive();
+  t.integer("hydrofrac.series_interval", 100, "steps",
+            "steps between rows of series.csv (and stage checks); at most 100,000 (stops, signals, --max-steps and "
+            "--max-wall are honoured at rows)")
+      .positive()
+      .at_most(100000);
   t.integer("hydrofrac.vtk_interval", 0, "steps",
             "steps between VTK snapshots during injection (0: at the start of injection, at breakdown and at the end)")
       .non_negative();

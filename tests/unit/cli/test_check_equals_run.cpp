@@ -187,6 +187,8 @@ std::vector<Bad> bad_scenarios() {
       {"pore_pressure_past_liquid_water",
        kSaturated2d + "fluid.initial_pressure = 1e300\n",
        {"fluid.initial_pressure", "out of range"}},
+      // 2^31 steps between rows: --max-steps, --max-wall and SIGTERM wait for a row, so the run could not be stopped
+      {"series_interval_past_any_stop", kUcs2d + "ucs.series_interval = 2147483648\n", {"ucs.series_interval", "out of range"}},
       // a side past an int wrapped into a negative size: "cannot create std::vector larger than max_size()"
       {"lattice_side_past_an_int", kCylinder + "channel.height = 1e9\n", {"channel.height", "2^30 cells"}},
       // a lattice past the machine's memory: std::bad_alloc, or gigabytes of masks first
