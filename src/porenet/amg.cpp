@@ -110,6 +110,17 @@ void Amg::build_level_transfer(Level& f, Level& c, Real eps) {
 }
 
 void Amg::setup(const CsrView& A) {
+  setup_val_.assign(A.val, A.val + A.ptr[A.n]);
+  build(A);
+}
+
+void Amg::restore(const CsrView& A, std::span<const Real> values) {
+  std::vector<Real> v(values.begin(), values.end());  // (values may be setup_values() itself)
+  setup_val_.swap(v);
+  build({A.n, A.ptr, A.col, setup_val_.data()});
+}
+
+void Amg::build(const CsrView& A) {
   levels_.clear();
   levels_.reserve(static_cast<std::size_t>(prm_.max_levels));
   Level& L0 = levels_.emplace_back();

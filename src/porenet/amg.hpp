@@ -22,6 +22,7 @@
 // coarse correction: a symmetric cycle, as CG needs), couplings across blocks from the values
 // before the sweep (hybrid GS), blocks in parallel: the result does not depend on the thread count.
 #pragma once
+#include <span>
 #include <vector>
 
 #include "core/types.hpp"
@@ -50,8 +51,14 @@ class Amg {
  public:
   explicit Amg(const AmgParams& prm = {}) : prm_(prm) {}
 
-  // Aggregates and coarse patterns for A's pattern and values (allocates), then refresh(A).
+  // Aggregates and coarse patterns for A's pattern and values (allocates), then refresh(A). Keeps a
+  // copy of the values: the aggregates depend on them, and a checkpoint saves them (setup_values).
   void setup(const CsrView& A);
+  // The aggregates that setup() built from `values` (one per entry of A's pattern, as setup_values()
+  // gave them), on A's pattern (A.val unused): a resumed run preconditions as the uninterrupted one.
+  // The caller checks the count; refresh(A) then brings in the current values.
+  void restore(const CsrView& A, std::span<const Real> values);
+  const std::vector<Real>& setup_values() const { return setup_val_; }
   // New values on the pattern given to setup(): coarse matrices, pivots, Cholesky (no allocation).
   void refresh(const CsrView& A);
   // z = B r, B one symmetric V-cycle (an approximation of A^-1, symmetric positive definite).
@@ -76,6 +83,7 @@ class Amg {
     std::vector<Index> agg, agg_ptr, agg_rows, entry_map;
     std::vector<Real> x, b, r, snap;
   };
+  void build(const CsrView& A);  // setup() on given values
   void build_level_transfer(Level& f, Level& c, Real eps);
   void smooth(Level& L, bool forward, bool zero_start);
   void cycle(std::size_t l);
@@ -84,6 +92,7 @@ class Amg {
 
   AmgParams prm_;
   std::vector<Level> levels_;
+  std::vector<Real> setup_val_;  // the finest values the aggregates were built from
   std::vector<Real> chol_;  // dense lower Cholesky factor of the coarsest level, row-major
 };
 

@@ -60,7 +60,6 @@ void PressureSystem::setup_preconditioner(Preconditioner pc) {
     const CsrView v{n_, A_.outerIndexPtr(), inner, val};
     if (amg_rebuild_ || !amg_.ready()) {
       amg_.setup(v);
-      amg_setup_values_.assign(val, val + A_.nonZeros());
       amg_rebuild_ = false;
       amg_check_ = true;  // the next iteration count is the reference
       ++amg_setups_;
@@ -86,9 +85,9 @@ void PressureSystem::setup_preconditioner(Preconditioner pc) {
 }
 
 std::vector<Real> PressureSystem::amg_state() const {
-  if (amg_setup_values_.empty()) return {};
+  if (!amg_.ready()) return {};
   std::vector<Real> s{amg_rebuild_ ? 1.0 : 0.0, amg_check_ ? 1.0 : 0.0, static_cast<Real>(amg_setup_iters_)};
-  s.insert(s.end(), amg_setup_values_.begin(), amg_setup_values_.end());
+  s.insert(s.end(), amg_.setup_values().begin(), amg_.setup_values().end());
   return s;
 }
 
@@ -97,10 +96,9 @@ void PressureSystem::restore_amg_state(std::span<const Real> state) {
   const auto nnz = static_cast<std::size_t>(A_.nonZeros());
   if (state.size() != 3 + nnz)
     throw InputError(fmt::format("porenet: an AMG state of {} values for a pressure system of {} entries", state.size(), nnz));
-  amg_setup_values_.assign(state.begin() + 3, state.end());
   // The aggregates from the values they were built from (A's pattern); the next solve refreshes the
   // hierarchy with A's values, as it would have without the checkpoint.
-  amg_.setup(CsrView{n_, A_.outerIndexPtr(), A_.innerIndexPtr(), amg_setup_values_.data()});
+  amg_.restore(CsrView{n_, A_.outerIndexPtr(), A_.innerIndexPtr(), nullptr}, state.subspan(3));
   amg_rebuild_ = state[0] != 0;
   amg_check_ = state[1] != 0;
   amg_setup_iters_ = static_cast<int>(state[2]);

@@ -85,7 +85,6 @@ class PressureSystem {
   std::vector<Real> pivot_;  // inverse pivots (DIC) or inverse diagonal (Jacobi)
   std::vector<Real> r_, z_, d_, ad_, x0_, scratch_, row_abs_;
   Amg amg_;
-  std::vector<Real> amg_setup_values_;  // A's values at the last AMG setup (amg_state)
   bool amg_rebuild_ = true, amg_check_ = false;
   int amg_setup_iters_ = 0;
   long amg_setups_ = 0, floor_stops_ = 0, amg_fallbacks_ = 0, state_iterations_ = 0;

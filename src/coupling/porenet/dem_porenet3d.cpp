@@ -374,7 +374,7 @@ void DemPorenet3D::save(CheckpointWriter& w) const {
   // The prediction of the current cycle (empty without held steps).
   for (const auto& [tag, member] : kPredSections) w.put(std::string("porenet3d.pred_") + tag, this->*member);
   w.put("porenet3d.pred_dt", std::vector<Real>{pred_dt_, static_cast<Real>(pred_geom_age_)});
-  w.put("porenet3d.pred_setup_val", pred_g_.empty() ? std::vector<Real>{} : pred_setup_val_);
+  w.put("porenet3d.pred_setup_val", pred_g_.empty() ? std::vector<Real>{} : pred_amg_.setup_values());
 }
 
 void DemPorenet3D::load(CheckpointReader& r, const dem::DemSystem& sys, const Porenet3DParams& params) {
@@ -479,10 +479,11 @@ void DemPorenet3D::load(CheckpointReader& r, const dem::DemSystem& sys, const Po
     pred_geom_age_ = static_cast<long>(dt[1]);
     // The multigrid's aggregates from the values they were built from, then the current values.
     const porenet::CsrView v = fill_prediction_matrix();
-    r.get("porenet3d.pred_setup_val", pred_setup_val_);
-    if (pred_setup_val_.size() != static_cast<std::size_t>(pred_sys_->matrix().nonZeros()))
+    std::vector<Real> setup_val;
+    r.get("porenet3d.pred_setup_val", setup_val);
+    if (setup_val.size() != static_cast<std::size_t>(pred_sys_->matrix().nonZeros()))
       throw InputError("checkpoint: porenet3d.pred_setup_val does not match the rebuilt network");
-    pred_amg_.setup({v.n, v.ptr, v.col, pred_setup_val_.data()});
+    pred_amg_.restore(v, setup_val);
     pred_amg_.refresh(v);
   }
 }

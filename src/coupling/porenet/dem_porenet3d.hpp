@@ -265,7 +265,6 @@ class DemPorenet3D {
   // make the stationary iteration an A-norm contraction (with the factor 1.5, meant for CG, it diverged).
   porenet::Amg pred_amg_{porenet::AmgParams{.over_interp = 1.0}};
   Real pred_dt_ = 0;  // the DEM step of the prediction [s]
-  std::vector<Real> pred_setup_val_;  // the matrix values pred_amg_'s aggregates were built from
   long pred_geom_age_ = 0;  // DEM steps since pred_g_, pred_a_ were taken
   // The checkpointed per-pore/channel/entry arrays of the prediction (save and load).
   static constexpr std::pair<const char*, std::vector<Real> DemPorenet3D::*> kPredSections[] = {

@@ -60,12 +60,11 @@ void DemPorenet3D::linearise_pressures() {
       out -= flow_->bc_value(i) / flow_->liquid_density()[u];
     pred_q_[u] = out;
   }
-  // The multigrid: new aggregates with the geometry (the values they were built from are kept in
-  // pred_setup_val_ and checkpointed, so that a resume builds the same), refreshed coarse matrices at
-  // the other flow steps.
+  // The multigrid: new aggregates with the geometry (the values they were built from are checkpointed,
+  // Amg::setup_values, so that a resume builds the same), refreshed coarse matrices at the other flow
+  // steps.
   const porenet::CsrView v = fill_prediction_matrix();
   if (geometry) {
-    pred_setup_val_.assign(v.val, v.val + pred_sys_->matrix().nonZeros());
     pred_amg_.setup(v);
   } else {
     pred_amg_.refresh(v);
