@@ -60,6 +60,14 @@ void declare_common_params(ParamTable& t) {
       .non_negative();
 }
 
+void declare_series_interval(ParamTable& t, const std::string& table, const std::string& also) {
+  t.integer(table + ".series_interval", 100, "steps",
+            "steps between rows of series.csv" + also +
+                "; at most 100,000 (stops, signals, --max-steps and --max-wall are honoured at rows)")
+      .positive()
+      .at_most(100000);
+}
+
 ParamTable parameter_table(const Driver& d) {
   ParamTable t;
   declare_common_params(t);

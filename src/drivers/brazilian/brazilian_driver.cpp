@@ -16,6 +16,7 @@
 #include "dem/diagnostics.hpp"
 #include "dem/sample_builder.hpp"
 #include "drivers/brazilian/tensile_plots.hpp"
+#include "drivers/common_params.hpp"
 #include "drivers/dem_results.hpp"
 #include "drivers/dem_run_loop.hpp"
 
@@ -35,11 +36,7 @@ void declare(ParamTable& t) {
          "radius of the central circle (3D: cylinder through the thickness) where the stress is averaged, as a "
          "fraction of the disc radius")
       .open_range(0, 1);
-  t.integer("brazilian.series_interval", 100, "steps",
-            "steps between rows of series.csv; at most 100,000 (stops, signals, --max-steps and --max-wall are "
-            "honoured at rows)")
-      .positive()
-      .at_most(100000);
+  declare_series_interval(t, "brazilian");
   t.real("brazilian.vtk_strain_interval", 1e-3, "-", "diametral strain between VTK snapshots").positive();
   t.integer("brazilian.checkpoint_interval", 0, "steps",
             "steps between extra checkpoints (0: none; checkpoints come every output.checkpoint_wall_interval seconds, at "

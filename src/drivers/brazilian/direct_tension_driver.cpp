@@ -18,6 +18,7 @@
 #include "dem/sample_builder.hpp"
 #include "drivers/brazilian/brazilian_driver.hpp"
 #include "drivers/brazilian/tensile_plots.hpp"
+#include "drivers/common_params.hpp"
 #include "drivers/dem_results.hpp"
 #include "drivers/dem_run_loop.hpp"
 #include "drivers/ucs/ucs_measure.hpp"
@@ -38,11 +39,7 @@ void declare(ParamTable& t) {
       .open_range(0, 1);
   t.real("direct_tension.max_strain", 0.01, "-", "stop at this axial strain (extension / free length) in any case")
       .positive();
-  t.integer("direct_tension.series_interval", 100, "steps",
-            "steps between rows of series.csv; at most 100,000 (stops, signals, --max-steps and --max-wall are "
-            "honoured at rows)")
-      .positive()
-      .at_most(100000);
+  declare_series_interval(t, "direct_tension");
   t.real("direct_tension.vtk_strain_interval", 2e-4, "-", "axial strain between VTK snapshots").positive();
   t.integer("direct_tension.checkpoint_interval", 0, "steps",
             "steps between extra checkpoints (0: none; checkpoints come every output.checkpoint_wall_interval seconds, at "

@@ -12,6 +12,7 @@
 #include "core/log.hpp"
 #include "dem/dem_params.hpp"
 #include "dem/sample_builder.hpp"
+#include "drivers/common_params.hpp"
 #include "drivers/flow/flow_runner.hpp"
 #include "drivers/hydrofrac/dfn.hpp"
 #include "coupling/hydrofrac/lbm_load.hpp"
@@ -201,11 +202,7 @@ void declare_params(ParamTable& t) {
   t.real("measure.pressure", 0, "Pa",
          "a second elastic-state snapshot when the borehole pressure first reaches this (0: only the in-situ snapshot)")
       .non_negative();
-  t.integer("hydrofrac.series_interval", 100, "steps",
-            "steps between rows of series.csv (and stage checks); at most 100,000 (stops, signals, --max-steps and "
-            "--max-wall are honoured at rows)")
-      .positive()
-      .at_most(100000);
+  declare_series_interval(t, "hydrofrac", " (and stage checks)");
   t.integer("hydrofrac.vtk_interval", 0, "steps",
             "steps between VTK snapshots during injection (0: at the start of injection, at breakdown and at the end)")
       .non_negative();

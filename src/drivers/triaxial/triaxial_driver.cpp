@@ -12,6 +12,7 @@
 #include "core/log.hpp"
 #include "dem/dem_params.hpp"
 #include "dem/sample_builder.hpp"
+#include "drivers/common_params.hpp"
 #include "drivers/dem_results.hpp"
 #include "drivers/dem_run_loop.hpp"
 #include "drivers/triaxial/triaxial_boundary.hpp"
@@ -56,11 +57,7 @@ void declare(ParamTable& t) {
       .open_range(0, 1);
   t.real("triaxial.stop_fraction", 0.6, "-", "stop when the differential stress has fallen below this fraction of its quasi-static peak (the largest among rows with an unbalanced-force ratio below 0.1)").open_range(0, 1);
   t.real("triaxial.max_strain", 0.06, "-", "stop at this axial strain (deviatoric stage) in any case").positive();
-  t.integer("triaxial.series_interval", 100, "steps",
-            "steps between rows of series.csv; at most 100,000 (stops, signals, --max-steps and --max-wall are "
-            "honoured at rows)")
-      .positive()
-      .at_most(100000);
+  declare_series_interval(t, "triaxial");
   t.real("triaxial.vtk_strain_interval", 2e-3, "-", "axial strain between VTK snapshots").positive();
   t.integer("triaxial.checkpoint_interval", 0, "steps",
             "steps between extra checkpoints (0: none; checkpoints come every output.checkpoint_wall_interval seconds, at "

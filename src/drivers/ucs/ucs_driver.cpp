@@ -9,6 +9,7 @@
 #include "core/log.hpp"
 #include "dem/dem_params.hpp"
 #include "dem/sample_builder.hpp"
+#include "drivers/common_params.hpp"
 #include "drivers/dem_results.hpp"
 #include "drivers/dem_run_loop.hpp"
 #include "drivers/ucs/ucs_measure.hpp"
@@ -29,11 +30,7 @@ void declare_ucs_params(ParamTable& t) {
   t.real("ucs.platen_friction", 0.1, "-", "friction between platens and particles (seed 000: 0.1)").non_negative();
   t.real("ucs.stop_fraction", 0.6, "-", "stop when the axial stress has fallen below this fraction of its quasi-static peak (the largest among rows with an unbalanced-force ratio below 0.1)").open_range(0, 1);
   t.real("ucs.max_strain", 0.05, "-", "stop at this axial strain in any case").positive();
-  t.integer("ucs.series_interval", 100, "steps",
-            "steps between rows of series.csv; at most 100,000 (stops, signals, --max-steps and --max-wall are "
-            "honoured at rows)")
-      .positive()
-      .at_most(100000);
+  declare_series_interval(t, "ucs");
   t.real("ucs.vtk_strain_interval", 1e-3, "-", "axial strain between VTK snapshots").positive();
   t.integer("ucs.checkpoint_interval", 0, "steps",
             "steps between extra checkpoints (0: none; checkpoints come every output.checkpoint_wall_interval seconds, at "
