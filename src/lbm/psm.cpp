@@ -512,45 +512,49 @@ void Psm<L, T>::reduce(const Vec3& body_force) {
       build_runs();
       runs_built_ = true;
     }
-    for (const Run& run : runs_) {
-      if (run.particle < 0) {  // a boundary cell
-        cell_force(cells_[std::size_t(run.slot)]);
-        continue;
-      }
-      const std::size_t x0 = std::size_t(run.cell);
-      if (run.count == 1) {  // F_s = B_s (rho u - f_b)
-        const Vec3 j{double(cell_rho_[x0]) * double(cell_u_[0][x0]), double(cell_rho_[x0]) * double(cell_u_[1][x0]),
-                     L::D == 3 ? double(cell_rho_[x0]) * double(cell_u_[2][x0]) : 0.0};
-        const Vec3 Fk = double(run.Bs) * (j - fb);
-        take(run.particle);
-        F += Fk;
-        M += run.arm.cross(Fk);
-        continue;
-      }
-      // A run of n cells of one particle along x (B_s = B), k = 0 .. n-1, arms a_k = a_0 + k e_x:
-      // the cell forces F_k = B_k (rho_k u_k - f_b) sum to F = J0 - f_b B0, and
-      // sum_k k F_k = J1 - f_b B1 (J_m = sum k^m B rho u, B_m = sum k^m B); the torque
-      // sum_k a_k x F_k = a_0 x F + e_x x sum_k k F_k. A few contiguous sums per run instead of a
-      // force per cell: the cells' B, rho and u are read in order, nothing else per cell.
-      const T* Bp = cell_B_.data() + x0;
-      const T* rp = cell_rho_.data() + x0;
-      const T* up[3] = {cell_u_[0].data() + x0, cell_u_[1].data() + x0, L::D == 3 ? cell_u_[2].data() + x0 : nullptr};
-      double B0 = 0, B1 = 0, J0[3] = {0, 0, 0}, J1[3] = {0, 0, 0};
-      for (std::int32_t k = 0; k < run.count; ++k) {
-        const double b = double(Bp[k]), br = b * double(rp[k]), kk = double(k);
-        B0 += b;
-        B1 += kk * b;
-        for (int a = 0; a < L::D; ++a) {
-          const double j = br * double(up[a][k]);
-          J0[a] += j;
-          J1[a] += kk * j;
+    // The cells' forces B (rho u - f_b) as the fused kernel wrote them (psm_sweep.cpp).
+    const int nn[3] = {grid_.nx, grid_.ny, grid_.nz};
+    const std::int64_t nrows = std::int64_t(row_runs_.size()) - 1;
+    for (std::int64_t row = 0; row < nrows; ++row) {
+      const std::int64_t k0 = row_runs_[std::size_t(row)], k1 = row_runs_[std::size_t(row) + 1];
+      if (k0 == k1) continue;
+      const int cy = int(row % nn[1]), cz = int(row / nn[1]);
+      const CellIndex base = grid_.index(0, cy, cz);
+      for (std::int64_t k = k0; k < k1; ++k) {
+        const Run& run = runs_[std::size_t(k)];
+        const std::size_t x0 = std::size_t(base + run.x);
+        if (run.particle < 0) {  // a boundary cell
+          cell_force(cells_[std::size_t(slot_[x0])]);
+          continue;
         }
+        const Vec3& arm = run.arm;
+        if (run.count == 1) {  // F_s = (B_s / B) B (rho u - f_b)
+          const double sh = double(run.share);
+          const Vec3 Fk(sh * double(cell_u_[0][x0]), sh * double(cell_u_[1][x0]),
+                        L::D == 3 ? sh * double(cell_u_[2][x0]) : 0.0);
+          take(run.particle);
+          F += Fk;
+          M += arm.cross(Fk);
+          continue;
+        }
+        // A run of n cells of one particle along x (B_s = B), k = 0 .. n-1, arms a_k = a_0 + k e_x:
+        // the cell forces F_k sum to F, and sum_k a_k x F_k = a_0 x F + e_x x sum_k k F_k. Two
+        // contiguous sums per run instead of a force per cell.
+        const T* fp[3] = {cell_u_[0].data() + x0, cell_u_[1].data() + x0, L::D == 3 ? cell_u_[2].data() + x0 : nullptr};
+        double J0[3] = {0, 0, 0}, J1[3] = {0, 0, 0};
+        for (std::int32_t j = 0; j < run.count; ++j) {
+          const double kk = double(j);
+          for (int a = 0; a < L::D; ++a) {
+            const double f = double(fp[a][j]);
+            J0[a] += f;
+            J1[a] += kk * f;
+          }
+        }
+        const Vec3 Fr(J0[0], J0[1], J0[2]), F1(J1[0], J1[1], J1[2]);
+        take(run.particle);
+        F += Fr;
+        M += arm.cross(Fr) + Vec3(1, 0, 0).cross(F1);
       }
-      const Vec3 Fr = Vec3(J0[0], J0[1], J0[2]) - fb * B0;
-      const Vec3 F1 = Vec3(J1[0], J1[1], J1[2]) - fb * B1;
-      take(run.particle);
-      F += Fr;
-      M += run.arm.cross(Fr) + Vec3(1, 0, 0).cross(F1);
     }
   }
   if (cur >= 0) {
@@ -564,22 +568,29 @@ void Psm<L, T>::build_runs() {
   // Runs never cross a row: each row's items are counted, then written, in parallel (rows in
   // lattice order, the same items on any thread count).
   const std::int64_t nrows = std::int64_t(row_out_.size());
+  const int nn[3] = {grid_.nx, grid_.ny, grid_.nz};
+  // An item starting at `cell` (x = cell - row_base) with entry e.
+  auto item = [&](CellIndex cell, CellIndex row_base, const Entry& e, T share) {
+    return Run{int(cell - row_base), 1, e.particle, share, e.arm};
+  };
   auto row_items = [&](std::int64_t row, Run* out) {  // the row's item count; written where out is not null
     const RowOut& ro = row_out_[std::size_t(row)];
     std::int64_t n = 0;
     bool open = false;  // the last item is a run that the next cell may extend
     std::int32_t run_particle = -1;
     CellIndex run_next = -1;  // the cell that would extend it
+    const int cy = int(row % nn[1]), cz = int(row / nn[1]);
+    const CellIndex row_base = grid_.index(0, cy, cz);  // (x = cell - row_base)
     for (std::int64_t i = ro.cell_dest; i < ro.cell_dest + ro.cells; ++i) {
       const Cell& c = cells_[std::size_t(i)];
       if (c.boundary || c.count > 1) {
         if (c.boundary) {
-          if (out) out[n] = Run{i, c.cell, 1, -1, Vec3::Zero(), T(0)};
+          if (out) out[n] = Run{int(c.cell - row_base), 1, -1, T(0), Vec3::Zero()};
           ++n;
         } else {
           for (std::int32_t k = c.first; k < c.first + c.count; ++k, ++n) {
             const Entry& e = entries_[std::size_t(k)];
-            if (out) out[n] = Run{i, c.cell, 1, e.particle, e.arm, e.Bs};
+            if (out) out[n] = item(c.cell, row_base, e, c.B != T(0) ? T(double(e.Bs) / double(c.B)) : T(0));
           }
         }
         open = false;
@@ -593,7 +604,7 @@ void Psm<L, T>::build_runs() {
         ++run_next;
         continue;
       }
-      if (out) out[n] = Run{i, c.cell, 1, e.particle, e.arm, e.Bs};
+      if (out) out[n] = item(c.cell, row_base, e, T(1));
       ++n;
       open = true;
       run_particle = e.particle;

@@ -98,7 +98,9 @@ double psm_cell_fraction(int dim, const Vec3& d, double r);
 // and the sums over the covering particles s of B_s u_s (V) and of B_s u_s u_s^T (S: xx, xy, yy in 2D;
 // xx, xy, xz, yy, yz, zz in 3D), which give sum_s B_s Omega^s_q exactly, for any number of particles
 // (f^eq is quadratic in the velocity); written by the kernel, the cell's rho (1 if incompressible)
-// and u, the collision's moments, from which each particle's force follows (Psm::reduce).
+// and u, the collision's moments, from which each particle's force follows (Psm::reduce); with every
+// particle at rest (Psm::moving() false) rho is not written and u holds the cell's force
+// B (rho u - f_body) instead (lattice units; f_body the fluid's body force, Relax::force).
 // B = 0: not a covered bulk cell. Components beyond D (V, u) or beyond the 2D three (S) are null.
 template <class T>
 struct PsmCells {
@@ -250,12 +252,14 @@ class Psm {
   // particle alone (the same row, x ascending; B_s = B read per cell), one particle's entry of a bulk
   // cell (count 1, B_s here: cells of one particle alone and each particle of a shared cell), or a
   // boundary cell (particle -1: its entries' forces from apply()).
+  // Read once per step each (48 bytes with double): the lattice row is the one whose items these are
+  // (row_runs_).
   struct Run {
-    std::int64_t slot;       // its first cell in cells_
-    CellIndex cell;          // that cell's lattice index
-    std::int32_t count, particle;
-    Vec3 arm;                // the first cell's arm
-    T Bs;                    // count 1: B_s
+    std::int32_t x;             // the first cell's x in the row
+    std::int32_t count;         // cells in the run (1: a shared cell's entry or a boundary cell)
+    std::int32_t particle;      // -1: a boundary cell
+    T share;                    // B_s / B (1 but for a shared cell's entry)
+    Vec3 arm;                   // the first cell's arm
   };
   std::vector<Run> runs_;
   bool runs_built_ = false;  // runs_ belong to the current cells (built once a static set is reduced)

@@ -7,7 +7,8 @@
 // rho and u written to them (each particle's force follows from those, Psm::reduce). Cells with
 // B = 0 get g* unchanged. One pass per covered cell, whatever the number of particles on it. With
 // every particle at rest (quasi-static walls: the hydrofrac's default) V and S are zero and not read
-// (kMoving false): the pass then reads B alone besides the populations.
+// (kMoving false): the pass then reads B alone besides the populations and writes, instead of rho
+// and u, the cell's force B (rho u - f_body).
 // Compiled like the bulk kernel: one clone per vector width, -ffp-contract=off.
 #include "lbm/psm.hpp"
 #include "lbm/span_slots.hpp"
@@ -81,8 +82,14 @@ FF_LBM_INLINE void psm_cells(T* const* p, std::int64_t i0, std::int64_t i1, cons
       p[o][i] = covered ? fluid * g[q] + B * pre[q] + om_q : g[q];
       p[q][i] = covered ? fluid * g[o] + B * pre[o] + om_o : g[o];
     });
-    d.rho[i] = rho_u;
-    static_for<D>([&](auto a) FF_LBM_LAMBDA_INLINE { d.u[a][i] = u[a]; });
+    if constexpr (kMoving) {
+      d.rho[i] = rho_u;
+      static_for<D>([&](auto a) FF_LBM_LAMBDA_INLINE { d.u[a][i] = u[a]; });
+    } else {  // every particle at rest: the cell's force B (rho u - f_body) (Psm::reduce), one array less
+      static_for<D>([&](auto a) FF_LBM_LAMBDA_INLINE {
+        d.u[a][i] = B * (rho_u * u[a] - (kForce ? r.force[a] : T(0)));
+      });
+    }
     if constexpr (kMoments) {
       m.drho[i] = drho;
       m.u[0][i] = u[0];
