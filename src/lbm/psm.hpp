@@ -43,7 +43,8 @@
 // kernel reads B alone. Every cell owns its slots (AA pattern), so cells are independent; the
 // particles' forces are summed in one pass over the covered cells in lattice order (with every
 // particle at rest, a particle's consecutive cells along a row as one run: a few contiguous sums of
-// B, rho and u; Psm::reduce): results are the same on any thread count.
+// the cells' forces B (rho u - f_body), which the kernel writes instead of rho and u; Psm::reduce):
+// results are the same on any thread count.
 #pragma once
 #include <cstdint>
 #include <vector>
