@@ -455,8 +455,9 @@ void Psm<L, T>::apply(std::int32_t sl, const T* gpre, T* g, const Relax<T>& r, b
 template <class L, class T>
 void Psm<L, T>::reduce(const Vec3& body_force) {
   // One pass over the covered cells in lattice order (runs_: build_runs), each item adding to its
-  // particle: a fixed order, the same on any thread count (serial: per particle in parallel, the reads of the cells'
-  // moments scattered over the lattice cost 3-5 times this pass). Bulk cells:
+  // particle: a fixed order, the same on any thread count (per particle in parallel, the reads of the
+  // cells' moments scattered over the lattice cost 3-5 times this pass; with every particle at rest
+  // the pass runs in blocks of planes, the even blocks in parallel, then the odd ones). Bulk cells:
   // F_s = -B_s sum_q c_q Omega^s_q(u_s) = B_s (rho (u - u_s) - f_body), by the lattice's isotropy
   // (sum_q c_q f^eq_q(rho, w) = rho w; rho u = j + f_body / 2 with j the pre-collision momentum,
   // Guo's forcing), from the cell's moments written by the kernel; boundary cells: apply()'s forces.
@@ -465,28 +466,36 @@ void Psm<L, T>::reduce(const Vec3& body_force) {
   std::fill(torque_.begin(), torque_.end(), Vec3::Zero());
   std::fill(wall_force_.begin(), wall_force_.end(), Vec3::Zero());
   // A particle's entries come in runs: its sums are carried in registers over a run and stored at
-  // its end (a chain through memory per entry cost twice the arithmetic).
-  std::int32_t cur = -1;
-  Vec3 F = Vec3::Zero(), M = Vec3::Zero();
-  auto take = [&](std::int32_t s) FF_LBM_LAMBDA_INLINE {
-    if (s == cur) return;
-    if (cur >= 0) {
-      force_[std::size_t(cur)] = F;
-      torque_[std::size_t(cur)] = M;
-    }
-    cur = s;
-    F = force_[std::size_t(s)];
-    M = torque_[std::size_t(s)];
+  // its end (a chain through memory per entry cost twice the arithmetic). One accumulator per pass.
+  struct Acc {
+    std::int32_t cur = -1;
+    Vec3 F = Vec3::Zero(), M = Vec3::Zero();
   };
-  auto cell_force = [&](const Cell& c) FF_LBM_LAMBDA_INLINE {
+  auto take = [&](Acc& A, std::int32_t s) FF_LBM_LAMBDA_INLINE {
+    if (s == A.cur) return;
+    if (A.cur >= 0) {
+      force_[std::size_t(A.cur)] = A.F;
+      torque_[std::size_t(A.cur)] = A.M;
+    }
+    A.cur = s;
+    A.F = force_[std::size_t(s)];
+    A.M = torque_[std::size_t(s)];
+  };
+  auto flush = [&](Acc& A) {
+    if (A.cur >= 0) {
+      force_[std::size_t(A.cur)] = A.F;
+      torque_[std::size_t(A.cur)] = A.M;
+    }
+  };
+  auto cell_force = [&](Acc& A, const Cell& c) FF_LBM_LAMBDA_INLINE {
     if (c.boundary) {
       for (std::int32_t k = c.first; k < c.first + c.count; ++k) {
         const Entry& e = entries_[std::size_t(k)];
         const std::size_t kk = std::size_t(k);
         const Vec3 Fk(entry_force_[3 * kk], entry_force_[3 * kk + 1], entry_force_[3 * kk + 2]);
-        take(e.particle);
-        F += Fk;
-        M += e.arm.cross(Fk);
+        take(A, e.particle);
+        A.F += Fk;
+        A.M += e.arm.cross(Fk);
       }
       return;
     }
@@ -497,25 +506,29 @@ void Psm<L, T>::reduce(const Vec3& body_force) {
       const Entry& e = entries_[std::size_t(k)];
       const Kinematics& m = kin_[std::size_t(e.particle)];
       const Vec3 Fk = double(e.Bs) * (rho * (u - (m.v + m.w.cross(e.arm))) - fb);
-      take(e.particle);
-      F += Fk;
-      M += e.arm.cross(Fk);
+      take(A, e.particle);
+      A.F += Fk;
+      A.M += e.arm.cross(Fk);
     }
   };
   if (moving_) {
     // Moving walls hand a new set over every step: each cell's force from its entries (building the
     // runs below would cost more than they save).
-    for (const Cell& c : cells_) cell_force(c);
-  } else {
-    // Quasi-static walls (u_s = 0) keep a set for many steps: its runs, built once per set.
-    if (!runs_built_) {
-      build_runs();
-      runs_built_ = true;
-    }
-    // The cells' forces B (rho u - f_b) as the fused kernel wrote them (psm_sweep.cpp).
-    const int nn[3] = {grid_.nx, grid_.ny, grid_.nz};
-    const std::int64_t nrows = std::int64_t(row_runs_.size()) - 1;
-    for (std::int64_t row = 0; row < nrows; ++row) {
+    Acc A;
+    for (const Cell& c : cells_) cell_force(A, c);
+    flush(A);
+    return;
+  }
+  // Quasi-static walls (u_s = 0) keep a set for many steps: its runs, built once per set.
+  if (!runs_built_) {
+    build_runs();
+    runs_built_ = true;
+  }
+  // The cells' forces B (rho u - f_b) as the fused kernel wrote them (psm_sweep.cpp).
+  const int nn[3] = {grid_.nx, grid_.ny, grid_.nz};
+  auto rows = [&](std::int64_t r0, std::int64_t r1) {
+    Acc A;
+    for (std::int64_t row = r0; row < r1; ++row) {
       const std::int64_t k0 = row_runs_[std::size_t(row)], k1 = row_runs_[std::size_t(row) + 1];
       if (k0 == k1) continue;
       const int cy = int(row % nn[1]), cz = int(row / nn[1]);
@@ -524,7 +537,7 @@ void Psm<L, T>::reduce(const Vec3& body_force) {
         const Run& run = runs_[std::size_t(k)];
         const std::size_t x0 = std::size_t(base + run.x);
         if (run.particle < 0) {  // a boundary cell
-          cell_force(cells_[std::size_t(slot_[x0])]);
+          cell_force(A, cells_[std::size_t(slot_[x0])]);
           continue;
         }
         const Vec3& arm = run.arm;
@@ -532,9 +545,9 @@ void Psm<L, T>::reduce(const Vec3& body_force) {
           const double sh = double(run.share);
           const Vec3 Fk(sh * double(cell_u_[0][x0]), sh * double(cell_u_[1][x0]),
                         L::D == 3 ? sh * double(cell_u_[2][x0]) : 0.0);
-          take(run.particle);
-          F += Fk;
-          M += arm.cross(Fk);
+          take(A, run.particle);
+          A.F += Fk;
+          A.M += arm.cross(Fk);
           continue;
         }
         // A run of n cells of one particle along x (B_s = B), k = 0 .. n-1, arms a_k = a_0 + k e_x:
@@ -551,15 +564,24 @@ void Psm<L, T>::reduce(const Vec3& body_force) {
           }
         }
         const Vec3 Fr(J0[0], J0[1], J0[2]), F1(J1[0], J1[1], J1[2]);
-        take(run.particle);
-        F += Fr;
-        M += arm.cross(Fr) + Vec3(1, 0, 0).cross(F1);
+        take(A, run.particle);
+        A.F += Fr;
+        A.M += arm.cross(Fr) + Vec3(1, 0, 0).cross(F1);
       }
     }
+    flush(A);
+  };
+  // Blocks of rows (reduce_blocks_, build_runs) at least as tall as any particle: a particle's items
+  // lie in one block or two neighbours, so the even blocks run in parallel, then the odd ones. The
+  // blocks do not depend on the thread count, nor then does any particle's order of sums.
+  const std::int64_t nb = std::int64_t(reduce_blocks_.size()) - 1;
+  if (nb <= 2) {
+    rows(0, std::int64_t(row_runs_.size()) - 1);
+    return;
   }
-  if (cur >= 0) {
-    force_[std::size_t(cur)] = F;
-    torque_[std::size_t(cur)] = M;
+  for (std::int64_t parity = 0; parity < 2; ++parity) {
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t b = parity; b < nb; b += 2) rows(reduce_blocks_[std::size_t(b)], reduce_blocks_[std::size_t(b) + 1]);
   }
 }
 
@@ -620,6 +642,34 @@ void Psm<L, T>::build_runs() {
   runs_.resize(std::size_t(row_runs_[std::size_t(nrows)]));
 #pragma omp parallel for schedule(dynamic, 64) if (cells_.size() > 16384)
   for (std::int64_t row = 0; row < nrows; ++row) row_items(row, runs_.data() + row_runs_[std::size_t(row)]);
+  // reduce()'s blocks: whole planes (3D: rows y + ny z of one z; 2D: single rows), as many per block
+  // as the most any particle spans (its items' planes; a particle round a periodic edge spans them
+  // all: one block, a serial reduce), at least 4 blocks, and only on lattices worth a parallel pass.
+  reduce_blocks_.assign(1, 0);
+  const std::int64_t per_plane = L::D == 3 ? nn[1] : 1, nplanes = nrows / per_plane;
+  if (cells_.size() <= 16384) return;
+  plane_lo_.assign(force_.size(), INT_MAX);
+  plane_hi_.assign(force_.size(), -1);
+  auto seen = [&](std::int32_t s, std::int64_t plane) {
+    plane_lo_[std::size_t(s)] = std::min(plane_lo_[std::size_t(s)], std::int32_t(plane));
+    plane_hi_[std::size_t(s)] = std::max(plane_hi_[std::size_t(s)], std::int32_t(plane));
+  };
+  for (std::int64_t row = 0; row < nrows; ++row)
+    for (std::int64_t k = row_runs_[std::size_t(row)]; k < row_runs_[std::size_t(row) + 1]; ++k) {
+      const Run& run = runs_[std::size_t(k)];
+      if (run.particle >= 0) {
+        seen(run.particle, row / per_plane);
+        continue;
+      }
+      const Cell& c = cells_[std::size_t(slot_[std::size_t(grid_.index(0, int(row % nn[1]), int(row / nn[1])) + run.x)])];
+      for (std::int32_t e = c.first; e < c.first + c.count; ++e) seen(entries_[std::size_t(e)].particle, row / per_plane);
+    }
+  std::int64_t tall = 1;
+  for (std::size_t s = 0; s < plane_lo_.size(); ++s)
+    if (plane_hi_[s] >= 0) tall = std::max<std::int64_t>(tall, plane_hi_[s] - plane_lo_[s] + 1);
+  if (nplanes / tall < 4) return;
+  for (std::int64_t pl = tall; pl < nplanes; pl += tall) reduce_blocks_.push_back(pl * per_plane);
+  reduce_blocks_.push_back(nrows);
 }
 
 template <class L, class T>

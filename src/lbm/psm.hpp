@@ -43,8 +43,9 @@
 // kernel reads B alone. Every cell owns its slots (AA pattern), so cells are independent; the
 // particles' forces are summed in one pass over the covered cells in lattice order (with every
 // particle at rest, a particle's consecutive cells along a row as one run: a few contiguous sums of
-// the cells' forces B (rho u - f_body), which the kernel writes instead of rho and u; Psm::reduce):
-// results are the same on any thread count.
+// the cells' forces B (rho u - f_body), which the kernel writes instead of rho and u; in blocks of
+// lattice planes at least as tall as any particle, the even blocks in parallel, then the odd ones;
+// Psm::reduce): results are the same on any thread count.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -265,6 +266,10 @@ class Psm {
   std::vector<Run> runs_;
   bool runs_built_ = false;  // runs_ belong to the current cells (built once a static set is reduced)
   std::vector<std::int64_t> row_runs_;  // per lattice row, its first item in runs_ (build_runs)
+  // reduce()'s blocks of rows (first rows, then the end; a single block: a serial pass) and the
+  // planes each particle's items lie in (build_runs' scratch).
+  std::vector<std::int64_t> reduce_blocks_;
+  std::vector<std::int32_t> plane_lo_, plane_hi_;
   void build_runs();
   std::vector<Vec3> force_, torque_, wall_force_;
 };

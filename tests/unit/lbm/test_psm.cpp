@@ -494,3 +494,113 @@ TEST(Psm, RefreshKeepsTheFractionsAndResumesBitIdentical) {
     EXPECT_EQ(kept.particle_torques()[s], resumed.particle_torques()[s]);
   }
 }
+
+namespace {
+// A packed block of overlapping grains at rest (shared cells) in a periodic box driven by a body
+// force along x: the static path (Psm::reduce's run sums, in blocks of planes run in parallel).
+template <class L>
+ParticleSet resting_block() {
+  ParticleSet p;
+  const bool d3 = L::D == 3;
+  const double spacing = d3 ? 3.0 : 8.0, radius = d3 ? 1.6 : 4.2, R = d3 ? 20.0 : 90.0, c = d3 ? 24.0 : 120.0;
+  const int m = int(R / spacing) + 1;
+  for (int k = d3 ? -m : 0; k <= (d3 ? m : 0); ++k)
+    for (int j = -m; j <= m; ++j)
+      for (int i = -m; i <= m; ++i) {
+        // 2D: hexagonal rows; 3D: simple cubic. Slightly uneven radii and offsets.
+        const double x = (i + (d3 ? 0.0 : 0.5 * (j & 1))) * spacing, y = j * spacing * (d3 ? 1.0 : std::sqrt(0.75));
+        const Vec3 d(x, y, k * spacing);
+        if (d.norm() > R) continue;
+        const std::size_t s = p.size();
+        p.resize(s + 1);
+        p.id[s] = s;
+        p.position[s] = Vec3(c + 0.13 + d.x(), c + 0.37 + d.y(), d3 ? c + 0.21 + d.z() : 0.0);
+        p.radius[s] = radius * (1 + 0.02 * double(s % 5));
+      }
+  return p;
+}
+}  // namespace
+
+// Particles at rest: every particle's force and torque equal the sum over its cells of
+// B_s (rho u - f_b) and arm x that (psm.hpp: N&T's solid operator with u_s = 0, B_s = B eps_s / eps
+// in shared cells), summed here cell by cell from the covered fractions (psm_cell_fraction), the
+// weights (Psm::weight) and the step's sampled moments; to 1e-12 of the largest force (round-off of
+// the other summation order). And 1 and 2 threads give the same bits (the reduce runs its blocks of
+// planes in parallel: > 16,384 covered cells here).
+template <class L>
+void check_resting_reduce() {
+  const int n = L::D == 3 ? 48 : 240;
+  const Vec3 fb(2e-6, L::D == 3 ? -1e-6 : 5e-7, 0);
+  auto run = [&](int threads) {
+    omp_set_num_threads(threads);
+    Grid g(L::D, n, n, L::D == 3 ? n : 1, {true, true, true});
+    SolverSettings st;
+    st.tau = 0.7;
+    st.body_force = fb;
+    auto sol = std::make_unique<Solver<L, double>>(g, st);
+    sol->finalize();
+    sol->initialize([](int, int, int, double& rho, Vec3& u) {
+      rho = 1;
+      u = Vec3::Zero();
+    });
+    const ParticleSet p = resting_block<L>();
+    for (int t = 0; t < 6; ++t) {
+      sol->set_particles(p);
+      sol->step(t == 5);
+    }
+    return sol;
+  };
+  const int saved = omp_get_max_threads();
+  const auto a = run(1), b = run(2);
+  omp_set_num_threads(saved);
+  ASSERT_GT(a->psm()->num_cells(), 16384u);
+  ASSERT_FALSE(a->psm()->moving());
+  for (std::size_t s = 0; s < a->particle_forces().size(); ++s) {
+    ASSERT_EQ(a->particle_forces()[s], b->particle_forces()[s]) << "particle " << s;
+    ASSERT_EQ(a->particle_torques()[s], b->particle_torques()[s]) << "particle " << s;
+  }
+  // The cell-by-cell sum.
+  const ParticleSet p = resting_block<L>();
+  const Grid& g = a->grid();
+  const Vec3 f2 = L::D == 3 ? fb : Vec3(fb[0], fb[1], 0);
+  std::vector<double> eps_sum(std::size_t(g.padded_size()), 0.0);
+  // A particle's cells: those of its bounding box (a cell outside it is not covered, though the plane
+  // approximation may give a corner there a fraction of 1e-7).
+  auto for_cells = [&](std::size_t s, auto&& f) {
+    const Vec3& X = p.position[s];
+    const double r = p.radius[s];
+    auto lo = [&](int a) { return int(std::ceil(X[a] - r - 0.5)); };
+    auto hi = [&](int a) { return int(std::floor(X[a] + r + 0.5)); };
+    for (int z = L::D == 3 ? lo(2) : 0; z <= (L::D == 3 ? hi(2) : 0); ++z)
+      for (int y = lo(1); y <= hi(1); ++y)
+        for (int x = lo(0); x <= hi(0); ++x) {
+          const Vec3 arm(x - X.x(), y - X.y(), L::D == 3 ? z - X.z() : 0.0);
+          const double eps = psm_cell_fraction(L::D, arm, p.radius[s]);
+          if (eps > 0) f(x, y, z, g.index(x, y, z), eps, arm);
+        }
+  };
+  for (std::size_t s = 0; s < p.size(); ++s)
+    for_cells(s, [&](int, int, int, CellIndex i, double eps, const Vec3&) { eps_sum[std::size_t(i)] += eps; });
+  double scale = 0, worst_f = 0, worst_m = 0;
+  for (const Vec3& f : a->particle_forces()) scale = std::max(scale, f.norm());
+  for (std::size_t s = 0; s < p.size(); ++s) {
+    Vec3 F = Vec3::Zero(), M = Vec3::Zero();
+    for_cells(s, [&](int x, int y, int z, CellIndex i, double eps, const Vec3& arm) {
+      const double Bs = a->psm()->weight(i) * eps / eps_sum[std::size_t(i)];
+      const Vec3 u = a->velocity(x, y, z);
+      const Vec3 Fk = Bs * (a->density(x, y, z) * Vec3(u.x(), u.y(), L::D == 3 ? u.z() : 0.0) - f2);
+      F += Fk;
+      M += arm.cross(Fk);
+    });
+    worst_f = std::max(worst_f, (F - a->particle_forces()[s]).norm() / scale);
+    worst_m = std::max(worst_m, (M - a->particle_torques()[s]).norm() / (scale * p.radius[s]));
+  }
+  std::printf("%s: %zu grains at rest, %zu covered cells: force within %.2e, torque within %.2e of the cell sums\n",
+              std::string(L::name).c_str(), p.size(), a->psm()->num_cells(), worst_f, worst_m);
+  EXPECT_GT(scale, 0);
+  EXPECT_LT(worst_f, 1e-12);
+  EXPECT_LT(worst_m, 1e-12);
+}
+
+TEST(Psm, RestingGrainsForcesAreTheirCellSums2D) { check_resting_reduce<D2Q9>(); }
+TEST(Psm, RestingGrainsForcesAreTheirCellSums3D) { check_resting_reduce<D3Q19>(); }
