@@ -569,8 +569,8 @@ void check_resting_reduce() {
   auto for_cells = [&](std::size_t s, auto&& f) {
     const Vec3& X = p.position[s];
     const double r = p.radius[s];
-    auto lo = [&](int a) { return int(std::ceil(X[a] - r - 0.5)); };
-    auto hi = [&](int a) { return int(std::floor(X[a] + r + 0.5)); };
+    auto lo = [&](int axis) { return int(std::ceil(X[axis] - r - 0.5)); };
+    auto hi = [&](int axis) { return int(std::floor(X[axis] + r + 0.5)); };
     for (int z = L::D == 3 ? lo(2) : 0; z <= (L::D == 3 ? hi(2) : 0); ++z)
       for (int y = lo(1); y <= hi(1); ++y)
         for (int x = lo(0); x <= hi(0); ++x) {
