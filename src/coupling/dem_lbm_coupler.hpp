@@ -26,6 +26,7 @@
 #include <array>
 #include <vector>
 
+#include "coupling/dem_time_step.hpp"
 #include "coupling/fluid_spec.hpp"
 #include "dem/dem_system.hpp"
 #include "lbm/solver.hpp"
@@ -48,10 +49,6 @@ struct CouplerSettings {
   // fluid does with quasi-static walls; 0: every step (needed with moving walls: their velocities
   // change every step).
   double set_refresh = 0.0;
-};
-
-struct CouplerTimes {  // wall-clock seconds spent in each part of step()
-  double coupling = 0, lbm = 0, dem = 0;
 };
 
 template <class L, class T>
@@ -115,11 +112,6 @@ class DemLbmCoupler {
   std::vector<Vec3> qn_;
   std::vector<double> qw_;
 };
-
-// A DEM step for a coupled run: safety x the smaller of the engine's critical step (contacts and
-// bonds now) and the step of a contact that may form later (each particle against one like it,
-// overlap 1% of its radius) [s].
-double coupled_dem_time_step(const dem::DemSystem& dem, double safety);
 
 extern template class DemLbmCoupler<lbm::D2Q9, double>;
 extern template class DemLbmCoupler<lbm::D2Q9, float>;

@@ -65,4 +65,8 @@ FluidScales derive_scales(const FluidSpec& s);
 // DEM sub-steps per LBM step: n = ceil(dt_lbm / dt_dem); the DEM then steps dt_lbm / n.
 long sub_steps(double dt_lbm, double dt_dem);
 
+struct CouplerTimes {  // wall-clock seconds spent in each part of DemLbmCoupler::step()
+  double coupling = 0, lbm = 0, dem = 0;
+};
+
 }  // namespace ff::coupling

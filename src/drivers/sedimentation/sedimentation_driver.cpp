@@ -9,7 +9,8 @@
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/progress.hpp"
-#include "coupling/dem_lbm_coupler.hpp"
+#include "coupling/dem_time_step.hpp"
+#include "coupling/sedimentation/settling_fluid.hpp"
 #include "dem/dem_checkpoint.hpp"
 #include "dem/dem_output.hpp"
 #include "drivers/run_control.hpp"
@@ -23,7 +24,6 @@
 #include "io/plot.hpp"
 #include "io/pvd.hpp"
 #include "io/vtk.hpp"
-#include "lbm/lattice_budget.hpp"
 
 namespace fs = std::filesystem;
 
@@ -121,6 +121,15 @@ struct Geometry {
   std::vector<double> radius;
 };
 
+coupling::SettlingBox box_of(const Config& cfg, const Geometry& g) {
+  coupling::SettlingBox b;
+  b.dim = g.dim;
+  b.double_precision = cfg.string("lbm.precision") == "double";
+  b.cells = {g.n[0], g.n[1], g.dim == 3 ? g.n[2] : 1};
+  b.psm_refresh = cfg.real("lbm.psm_refresh");
+  return b;
+}
+
 // The checks `fracflow check` makes too.
 Geometry validate_geometry(const Config& cfg) {
   Geometry g;
@@ -132,7 +141,7 @@ Geometry validate_geometry(const Config& cfg) {
   const double dx = cfg.real("lbm.dx");
   for (int a = 0; a < g.dim; ++a) {
     const double c = L[std::size_t(a)] / dx;
-    if (!(c < lbm::kMaxLatticeSide))
+    if (!(c < coupling::max_lattice_side()))
       cfg.fail("box.size", fmt::format("box.size[{}] = {} m is {:.4g} cells of lbm.dx = {} m; a side needs fewer than 2^30 "
                                        "cells: a smaller box or a coarser lbm.dx",
                                        a, L[std::size_t(a)], c, dx));
@@ -142,8 +151,7 @@ Geometry validate_geometry(const Config& cfg) {
                                      "({:.6g})",
                                      dx, a, L[std::size_t(a)], c));
   }
-  lbm::check_lattice_memory(g.n[0], g.n[1], g.dim == 3 ? g.n[2] : 1, g.dim == 3 ? 19 : 9,
-                            cfg.string("lbm.precision") == "double" ? 8 : 4, "a smaller box.size or a coarser lbm.dx");
+  coupling::check_box_memory(box_of(cfg, g), "a smaller box.size or a coarser lbm.dx");
   const auto &x = cfg.real_list("particles.x"), &y = cfg.real_list("particles.y"), &z = cfg.real_list("particles.z");
   const auto& r = cfg.real_list("particles.radius");
   const std::size_t np = x.size();
@@ -240,7 +248,6 @@ template <> struct is_checkpoint_pod<drivers::State> : std::true_type {};
 namespace ff::drivers {
 namespace {
 
-template <class L, class T>
 class SedimentationRun {
  public:
   SedimentationRun(const Config& cfg, const RunOptions& opt)
@@ -254,90 +261,44 @@ class SedimentationRun {
   void write_vtk();
   void check_particle_speed(long step);
   void summary(double wall_s, long steps);
-  Vec3 up() const { return L::D == 3 ? Vec3::UnitZ() : Vec3::UnitY(); }
+  Vec3 up() const { return geo_.dim == 3 ? Vec3::UnitZ() : Vec3::UnitY(); }
 
   const Config& cfg_;
   const RunOptions& opt_;
   Geometry geo_;
   coupling::FluidScales sc_;
   dem::DemSystem dem_;
-  std::unique_ptr<lbm::Solver<L, T>> fluid_;
-  std::unique_ptr<coupling::DemLbmCoupler<L, T>> cpl_;
+  std::unique_ptr<coupling::SettlingFluid> fluid_;
   State st_;
   std::vector<std::string> columns_;
   std::vector<double> history_, row_;
   dem::DemVtkWriter dem_vtk_;
   PvdSeries fluid_pvd_;
-  std::vector<double> vtk_p_, vtk_eps_;
-  std::vector<Vec3> vtk_u_;
 };
 
-template <class L, class T>
-void SedimentationRun<L, T>::build() {
-  const int d = L::D;
+void SedimentationRun::build() {
   build_dem(cfg_, geo_, dem_);
-  lbm::Grid g(d, geo_.n[0], geo_.n[1], geo_.n[2], {false, false, d == 2});
-  lbm::SolverSettings s;
-  s.tau = sc_.units.tau();
-  s.psm_refresh = cfg_.real("lbm.psm_refresh");
-  fluid_ = std::make_unique<lbm::Solver<L, T>>(g, s);
-  for (int f = 0; f < 2 * d; ++f) fluid_->set_face(f, lbm::FaceCondition{});
-  fluid_->finalize();
-  fluid_->initialize([](int, int, int, double& rho, Vec3& u) {
-    rho = 1;
-    u = Vec3::Zero();
-  });
-  coupling::CouplerSettings cs;
-  cs.origin = Vec3::Constant(0.5 * sc_.units.dx());
-  if (d == 2) cs.origin.z() = 0;
-  cpl_ = std::make_unique<coupling::DemLbmCoupler<L, T>>(dem_, *fluid_, sc_, cs);
-  const std::size_t cells = std::size_t(g.nx) * g.ny * g.nz;
-  vtk_p_.assign(cells, 0.0);
-  vtk_eps_.assign(cells, 0.0);
-  vtk_u_.assign(cells, Vec3::Zero());
+  fluid_ = coupling::make_settling_fluid(box_of(cfg_, geo_), sc_, dem_);
 }
 
-template <class L, class T>
-void SedimentationRun<L, T>::write_checkpoint(const fs::path& dir) {
+void SedimentationRun::write_checkpoint(const fs::path& dir) {
   fs::create_directories(dir);
   CheckpointWriter w(dir / "state.ffcp", /*keep_previous=*/true);
-  w.put_string("sed.lattice", fmt::format("{} {} {}x{}x{}", L::name, sizeof(T) == 8 ? "double" : "float", geo_.n[0],
-                                          geo_.n[1], geo_.n[2]));
-  const auto& f = fluid_->populations();
-  w.put("lbm.populations", std::vector<T>(f.begin(), f.end()));
+  fluid_->save(w);
   st_.step = fluid_->time_step();
   st_.columns = std::int64_t(columns_.size());
   w.put_value("sed.state", st_);
   w.put("sed.history", history_);
   dem::save_dem(w, dem_);
-  // With lbm.psm_refresh the fractions come from where the particles were at the last rebuild.
-  const auto* psm = fluid_->psm();
-  w.put("sed.psm_positions", psm ? psm->geometry_positions() : std::vector<Vec3>{});
-  w.put("sed.psm_radii", psm ? psm->geometry_radii() : std::vector<double>{});
   w.commit();
 }
 
-template <class L, class T>
-void SedimentationRun<L, T>::read_checkpoint() {
+void SedimentationRun::read_checkpoint() {
   CheckpointReader r = open_checkpoint(opt_.out_dir / "checkpoint" / "state.ffcp");
-  const std::string want = fmt::format("{} {} {}x{}x{}", L::name, sizeof(T) == 8 ? "double" : "float", geo_.n[0],
-                                       geo_.n[1], geo_.n[2]);
-  if (r.get_string("sed.lattice") != want)
-    throw InputError(fmt::format("{}: the checkpoint holds a {} lattice but the scenario builds {}", r.path().string(),
-                                 r.get_string("sed.lattice"), want));
-  std::vector<T> f;
-  r.get("lbm.populations", f);
   st_ = r.get_value<State>("sed.state");
-  fluid_->restore(f, long(st_.step));
+  fluid_->load(r, long(st_.step));
   r.get("sed.history", history_);
   dem::load_dem(r, dem_);
-  std::vector<Vec3> pos;
-  std::vector<double> radii;
-  if (r.has("sed.psm_positions")) {  // absent in checkpoints before lbm.psm_refresh (rebuilt every step)
-    r.get("sed.psm_positions", pos);
-    r.get("sed.psm_radii", radii);
-  }
-  if (!pos.empty()) fluid_->restore_psm_geometry(pos, radii);
   if (std::size_t(st_.columns) != columns_.size())
     throw InputError(fmt::format("{}: the checkpoint's series has {} columns, this scenario writes {}",
                                  r.path().string(), st_.columns, columns_.size()));
@@ -346,8 +307,7 @@ void SedimentationRun<L, T>::read_checkpoint() {
 // A grain's surface speed is the fluid's there: past the Mach limit the fluid is no longer a weakly
 // compressible liquid. The fluid's own check (sampled rows) missed it: a grain driven by a huge
 // body force left the box at 1e298 m/s with the fluid at rest.
-template <class L, class T>
-void SedimentationRun<L, T>::check_particle_speed(long step) {
+void SedimentationRun::check_particle_speed(long step) {
   const auto& P = dem_.particles;
   double vmax = 0;
   std::size_t fastest = 0;
@@ -369,42 +329,24 @@ void SedimentationRun<L, T>::check_particle_speed(long step) {
       fastest, vmax, step, mach, coupling::kMaxMach));
 }
 
-template <class L, class T>
-void SedimentationRun<L, T>::write_vtk() {
-  const auto& g = fluid_->grid();
-  const auto* psm = fluid_->psm();
-  std::size_t k = 0;
-  for (int z = 0; z < g.nz; ++z)
-    for (int y = 0; y < g.ny; ++y)
-      for (int x = 0; x < g.nx; ++x, ++k) {
-        vtk_p_[k] = sc_.pressure(fluid_->density(x, y, z));
-        vtk_u_[k] = fluid_->velocity(x, y, z) * sc_.units.velocity_factor();
-        vtk_eps_[k] = psm ? psm->solid_fraction(g.index(x, y, z)) : 0.0;
-      }
-  const std::string tag = fmt::format("{:06d}", st_.vtk_index);
-  const std::string file = "fluid_" + tag + ".vti";
-  const double dx = sc_.units.dx();
-  const std::vector<VtkArray> arrays = {vtk_array("pressure_Pa", std::span<const double>(vtk_p_)),
-                                        vtk_array("velocity_m_per_s", std::span<const Vec3>(vtk_u_)),
-                                        vtk_array("solid_fraction", std::span<const double>(vtk_eps_))};
-  write_vti(opt_.out_dir / "vtk" / file, {g.nx, g.ny, g.nz}, Vec3::Zero(), Vec3(dx, dx, L::D == 3 ? dx : 1.0), arrays);
-  const double t = double(fluid_->time_step()) * sc_.dt();
-  fluid_pvd_.add(t, file);
+void SedimentationRun::write_vtk() {
+  const std::string file = fmt::format("fluid_{:06d}.vti", st_.vtk_index);
+  fluid_->write_vti(opt_.out_dir / "vtk" / file);
+  fluid_pvd_.add(double(fluid_->time_step()) * sc_.dt(), file);
   dem_vtk_.write(dem_, long(st_.vtk_index), 0.0);
   ++st_.vtk_index;
 }
 
-template <class L, class T>
-RunStatus SedimentationRun<L, T>::run() {
+RunStatus SedimentationRun::run() {
   RunControl control(cfg_, opt_);
   build();
   const std::size_t np = dem_.particles.size();
   log::info("lattice {} {} x {} x {} cells ({}), {} particles; DEM step {:.4g} s, {} DEM sub-steps per LBM step",
-            L::name, geo_.n[0], geo_.n[1], geo_.n[2], sizeof(T) == 8 ? "double" : "float", np, cpl_->dem_dt(),
-            cpl_->sub_steps());
+            fluid_->velocity_set(), geo_.n[0], geo_.n[1], geo_.n[2], cfg_.string("lbm.precision"), np,
+            fluid_->dem_dt(), fluid_->sub_steps());
   refuse_endless_run(cfg_.real("run.end_time") / sc_.dt(), "run.end_time, a larger lbm.dx or a shorter LBM step (fluid.time_step, fluid.sound_speed)");
   begin_output(opt_);  // (the fluid's warnings were logged by validate())
-  const char* ax = L::D == 3 ? "xyz" : "xy";
+  const char* ax = geo_.dim == 3 ? "xyz" : "xy";
   columns_ = {"step", "time_s", "max_mach"};
   for (std::size_t i = 0; i < np; ++i) {
     for (const char* a = ax; *a; ++a) columns_.push_back(fmt::format("p{}_{}_m", i, *a));
@@ -460,7 +402,7 @@ RunStatus SedimentationRun<L, T>::run() {
     const long t = fluid_->time_step();
     if ((t % 64 == 0 || t == opt_.max_steps) && stop_now(t)) break;
     const bool sample = (t + 1) % sample_every == 0 || t + 1 == steps_total;
-    cpl_->step(sample);
+    fluid_->step(sample);
     check_particle_speed(t + 1);
     if (!sample) {
       if (control.checkpoint_due()) {
@@ -484,9 +426,9 @@ RunStatus SedimentationRun<L, T>::run() {
     row_.push_back(dem_.time);
     row_.push_back(mach);
     for (std::size_t i = 0; i < np; ++i) {
-      for (int a = 0; a < L::D; ++a) row_.push_back(P.pos[i][a]);
-      for (int a = 0; a < L::D; ++a) row_.push_back(P.vel[i][a]);
-      for (int a = 0; a < L::D; ++a) row_.push_back(cpl_->hydro_force()[i][a]);
+      for (int a = 0; a < geo_.dim; ++a) row_.push_back(P.pos[i][a]);
+      for (int a = 0; a < geo_.dim; ++a) row_.push_back(P.vel[i][a]);
+      for (int a = 0; a < geo_.dim; ++a) row_.push_back(fluid_->hydro_force()[i][a]);
       row_.push_back(P.omega[i].z());
     }
     series.row(row_);
@@ -509,10 +451,9 @@ RunStatus SedimentationRun<L, T>::run() {
   return status;
 }
 
-template <class L, class T>
-void SedimentationRun<L, T>::summary(double wall_s, long steps) {
+void SedimentationRun::summary(double wall_s, long steps) {
   const std::size_t nc = columns_.size(), rows = history_.size() / nc, np = dem_.particles.size();
-  const int D = L::D;
+  const int D = geo_.dim;
   auto at = [&](std::size_t r, std::size_t c) { return history_[r * nc + c]; };
   auto col = [&](std::size_t i, int what, int a) { return 3 + i * std::size_t(3 * D + 1) + std::size_t(what * D + a); };
   nlohmann::json j;
@@ -521,23 +462,23 @@ void SedimentationRun<L, T>::summary(double wall_s, long steps) {
   j["title"] = cfg_.string("title");
   j["units"] = {{"dx_m", sc_.units.dx()},
                 {"lbm_dt_s", sc_.dt()},
-                {"dem_dt_s", cpl_->dem_dt()},
-                {"dem_sub_steps", cpl_->sub_steps()},
+                {"dem_dt_s", fluid_->dem_dt()},
+                {"dem_sub_steps", fluid_->sub_steps()},
                 {"tau", sc_.units.tau()},
                 {"sound_speed_m_per_s", sc_.sound_speed},
                 {"effective_bulk_modulus_Pa", sc_.bulk_modulus},
                 {"mach_reference", sc_.mach},
                 {"background_pressure_Pa", sc_.background_pressure},
                 {"fixed_by", sc_.fixed_by}};
-  j["lattice"] = {{"velocity_set", L::name}, {"cells", {geo_.n[0], geo_.n[1], geo_.n[2]}}};
+  j["lattice"] = {{"velocity_set", fluid_->velocity_set()}, {"cells", {geo_.n[0], geo_.n[1], geo_.n[2]}}};
   j["steps"] = fluid_->time_step();
   j["simulated_time_s"] = dem_.time;
   j["wall_time_s"] = wall_s;
   j["threads"] = opt_.threads;
   // Where the wall time went (machine-dependent; keys ending in _seconds).
-  j["coupling_seconds"] = cpl_->times.coupling;
-  j["lbm_seconds"] = cpl_->times.lbm;
-  j["dem_seconds"] = cpl_->times.dem;
+  j["coupling_seconds"] = fluid_->times().coupling;
+  j["lbm_seconds"] = fluid_->times().lbm;
+  j["dem_seconds"] = fluid_->times().dem;
   j["mlups"] = wall_s > 0 ? double(geo_.n[0]) * geo_.n[1] * geo_.n[2] * double(steps) / wall_s * 1e-6 : 0.0;
   nlohmann::json res = nlohmann::json::object(), parts = nlohmann::json::array();
   const int g_axis = D - 1;  // gravity along -y (2D) or -z (3D)
@@ -635,17 +576,10 @@ void SedimentationRun<L, T>::summary(double wall_s, long steps) {
   plot_series(jobs);
 }
 
-template <class L, class T>
-RunStatus run_typed(const Config& cfg, const RunOptions& opt) {
-  SedimentationRun<L, T> r(cfg, opt);
-  return r.run();
-}
-
 RunStatus run(const Config& cfg, const RunOptions& opt) {
   validate(cfg);
-  const bool dbl = cfg.string("lbm.precision") == "double";
-  if (dim_of(cfg) == 3) return dbl ? run_typed<lbm::D3Q19, double>(cfg, opt) : run_typed<lbm::D3Q19, float>(cfg, opt);
-  return dbl ? run_typed<lbm::D2Q9, double>(cfg, opt) : run_typed<lbm::D2Q9, float>(cfg, opt);
+  SedimentationRun r(cfg, opt);
+  return r.run();
 }
 
 }  // namespace
