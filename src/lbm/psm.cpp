@@ -641,31 +641,20 @@ void Psm<L, T>::build_runs() {
   runs_.resize(std::size_t(row_runs_[std::size_t(nrows)]));
 #pragma omp parallel for schedule(dynamic, 64) if (cells_.size() > 16384)
   for (std::int64_t row = 0; row < nrows; ++row) row_items(row, runs_.data() + row_runs_[std::size_t(row)]);
-  // reduce()'s blocks: whole planes (3D: rows y + ny z of one z; 2D: single rows), as many per block
-  // as the most any particle spans (its items' planes; a particle round a periodic edge spans them
-  // all: one block, a serial reduce), at least 4 blocks, and only on lattices worth a parallel pass.
+  // reduce()'s blocks: whole planes (3D: the rows y + ny z of one z; 2D: single rows), as many per
+  // block as the tallest particle's bounding box spans (build() visits no cell outside it), at least 4
+  // blocks, and only on lattices worth a parallel pass; a box across a periodic edge: one block.
   reduce_blocks_.assign(1, 0);
-  const std::int64_t per_plane = L::D == 3 ? nn[1] : 1, nplanes = nrows / per_plane;
   if (cells_.size() <= 16384) return;
-  plane_lo_.assign(force_.size(), INT_MAX);
-  plane_hi_.assign(force_.size(), -1);
-  auto seen = [&](std::int32_t s, std::int64_t plane) {
-    plane_lo_[std::size_t(s)] = std::min(plane_lo_[std::size_t(s)], std::int32_t(plane));
-    plane_hi_[std::size_t(s)] = std::max(plane_hi_[std::size_t(s)], std::int32_t(plane));
-  };
-  for (std::int64_t row = 0; row < nrows; ++row)
-    for (std::int64_t k = row_runs_[std::size_t(row)]; k < row_runs_[std::size_t(row) + 1]; ++k) {
-      const Run& run = runs_[std::size_t(k)];
-      if (run.particle >= 0) {
-        seen(run.particle, row / per_plane);
-        continue;
-      }
-      const Cell& c = cells_[std::size_t(slot_[std::size_t(grid_.index(0, int(row % nn[1]), int(row / nn[1])) + run.x)])];
-      for (std::int32_t e = c.first; e < c.first + c.count; ++e) seen(entries_[std::size_t(e)].particle, row / per_plane);
-    }
+  const int axis = L::D == 3 ? 2 : 1;
+  const std::int64_t per_plane = L::D == 3 ? nn[1] : 1, nplanes = nn[axis];
   std::int64_t tall = 1;
-  for (std::size_t s = 0; s < plane_lo_.size(); ++s)
-    if (plane_hi_[s] >= 0) tall = std::max<std::int64_t>(tall, plane_hi_[s] - plane_lo_[s] + 1);
+  for (std::size_t s = 0; s < ref_pos_.size(); ++s) {
+    const double X = ref_pos_[s][axis], r = ref_radius_[s];
+    const std::int64_t lo = std::int64_t(std::ceil(X - r - 0.5)), hi = std::int64_t(std::floor(X + r + 0.5));
+    if (grid_.periodic[axis] && (lo < 0 || hi >= nplanes)) return;
+    tall = std::max(tall, hi - lo + 1);
+  }
   if (nplanes / tall < 4) return;
   for (std::int64_t pl = tall; pl < nplanes; pl += tall) reduce_blocks_.push_back(pl * per_plane);
   reduce_blocks_.push_back(nrows);

@@ -251,11 +251,10 @@ class Psm {
   std::vector<double> entry_force_;  // 3 per entry of a boundary cell
   // The covered cells in lattice order as reduce() visits them, each item self-contained (read in
   // order, no look-up of cells_ and entries_): a run of `count` consecutive bulk cells of one
-  // particle alone (the same row, x ascending; B_s = B read per cell), one particle's entry of a bulk
-  // cell (count 1, B_s here: cells of one particle alone and each particle of a shared cell), or a
-  // boundary cell (particle -1: its entries' forces from apply()).
-  // Read once per step each (48 bytes with double): the lattice row is the one whose items these are
-  // (row_runs_).
+  // particle alone (the same row, x ascending; their forces as the kernel wrote them), one particle's
+  // entry of a shared bulk cell (count 1, its share B_s / B of the cell's force), or a boundary cell
+  // (particle -1: its entries' forces from apply()). Read once per step each (48 bytes with double);
+  // the lattice row is the one whose items these are (row_runs_).
   struct Run {
     std::int32_t x;             // the first cell's x in the row
     std::int32_t count;         // cells in the run (1: a shared cell's entry or a boundary cell)
@@ -266,10 +265,8 @@ class Psm {
   std::vector<Run> runs_;
   bool runs_built_ = false;  // runs_ belong to the current cells (built once a static set is reduced)
   std::vector<std::int64_t> row_runs_;  // per lattice row, its first item in runs_ (build_runs)
-  // reduce()'s blocks of rows (first rows, then the end; a single block: a serial pass) and the
-  // planes each particle's items lie in (build_runs' scratch).
+  // reduce()'s blocks of rows (first rows, then the end; a single block: a serial pass).
   std::vector<std::int64_t> reduce_blocks_;
-  std::vector<std::int32_t> plane_lo_, plane_hi_;
   void build_runs();
   std::vector<Vec3> force_, torque_, wall_force_;
 };

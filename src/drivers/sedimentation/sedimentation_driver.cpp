@@ -23,7 +23,6 @@
 #include "io/json_out.hpp"
 #include "io/plot.hpp"
 #include "io/pvd.hpp"
-#include "io/vtk.hpp"
 
 namespace fs = std::filesystem;
 
