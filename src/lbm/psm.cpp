@@ -6,7 +6,6 @@
 #include <omp.h>
 
 #include <algorithm>
-#include <climits>
 #include <cmath>
 
 #include "core/error.hpp"
@@ -41,6 +40,13 @@ double box_below_plane(const double* m, int k, double a) {
   }
   return std::clamp(acc / (fact * prod), 0.0, 1.0);
 }
+
+// Along one axis, the cells a particle (centre X, radius r) can cover: those whose centre lies within
+// r + 1/2 of X. build() visits no cell outside this box, and reduce()'s blocks are sized by it.
+struct AxisRange {
+  int lo, hi;
+};
+AxisRange covered_range(double X, double r) { return {int(std::ceil(X - r - 0.5)), int(std::floor(X + r + 0.5))}; }
 
 }  // namespace
 
@@ -218,8 +224,8 @@ void Psm<L, T>::build(const ParticleSet& p) {
   auto for_each_row = [&](std::size_t s, auto&& f) {
     const Vec3& X = p.position[s];
     const double r = p.radius[s], reach2 = (r + half_diag) * (r + half_diag);
-    const int lo1 = int(std::ceil(X[1] - r - 0.5)), hi1 = int(std::floor(X[1] + r + 0.5));
-    const int lo2 = D == 3 ? int(std::ceil(X[2] - r - 0.5)) : 0, hi2 = D == 3 ? int(std::floor(X[2] + r + 0.5)) : 0;
+    const AxisRange ry = covered_range(X[1], r), rz = D == 3 ? covered_range(X[2], r) : AxisRange{0, 0};
+    const int lo1 = ry.lo, hi1 = ry.hi, lo2 = rz.lo, hi2 = rz.hi;
     for (int z = lo2; z <= hi2; ++z)
       for (int y = lo1; y <= hi1; ++y) {
         const double dy = y - X[1], dz = D == 3 ? z - X[2] : 0.0;
@@ -271,7 +277,8 @@ void Psm<L, T>::build(const ParticleSet& p) {
         // Along x only the cells within r + half a cell diagonal of the centre can be covered
         // (psm_cell_fraction() is 0 beyond): the row visits that range, not the whole box.
         const double half = std::sqrt(std::max(reach2 - dy * dy - dz * dz, 0.0)) + 1e-9;
-        const int lo0 = int(std::ceil(X[0] - r - 0.5)), hi0 = int(std::floor(X[0] + r + 0.5));
+        const AxisRange rx = covered_range(X[0], r);
+        const int lo0 = rx.lo, hi0 = rx.hi;
         const int x0 = std::max(lo0, int(std::floor(X[0] - half))), x1 = std::min(hi0, int(std::ceil(X[0] + half)));
         // Cells whose farthest corner is well inside (squared distances, a margin of 1e-12 so that
         // psm_cell_fraction's own test would say 1 too) skip its square root and corner sums.
@@ -651,7 +658,8 @@ void Psm<L, T>::build_runs() {
   std::int64_t tall = 1;
   for (std::size_t s = 0; s < ref_pos_.size(); ++s) {
     const double X = ref_pos_[s][axis], r = ref_radius_[s];
-    const std::int64_t lo = std::int64_t(std::ceil(X - r - 0.5)), hi = std::int64_t(std::floor(X + r + 0.5));
+    const AxisRange box = covered_range(X, r);
+    const std::int64_t lo = box.lo, hi = box.hi;
     if (grid_.periodic[axis] && (lo < 0 || hi >= nplanes)) return;
     tall = std::max(tall, hi - lo + 1);
   }
