@@ -456,7 +456,7 @@ int main(int argc, char** argv) {
   const Real dt_wet = dt_dry * dem::critical_time_step(d3->sys, cpl.fluid_stiffness(!cp.implicit)) /
                       dem::critical_time_step(d3->sys);
   d3->sys.settings.dt = std::min(dt_dry, dt_wet);
-  const int nc = flow_every == 0 ? 40 : S == 1.0 ? 10 * reps(1) : 3;
+  const int nc = flow_every == 0 ? 400 : S == 1.0 ? 10 * reps(1) : 3;
   const auto tc = std::chrono::steady_clock::now();
   try {
     cpl.run(d3->sys, nc);
@@ -473,10 +473,10 @@ int main(int argc, char** argv) {
   const double steps_between = cp.retriangulation_tolerance * 0.5e-3 / (v * d3->sys.settings.dt);
   const double t_tri = st.t_triangulation;  // the initial build (+ any retriangulation)
   std::printf("coupled 3D (%d pores, implicit, S %.1f, max_halvings %d, flow every %ld DEM steps): %d steps in %.2f s: "
-              "%.1f ms per step = DEM + update %.1f ms + flow %.1f ms + forces %.1f ms; triangulation + remap %.0f ms "
-              "(%ld retriangulations)\n",
+              "%.1f ms per step = DEM + update %.1f ms + flow %.1f ms + forces %.1f ms (of which held-step prediction %.2f ms); "
+              "triangulation + remap %.0f ms (%ld retriangulations)\n",
               cpl.network().n_pores(), S, halvings, st.flow_every, nc, t_run, 1e3 * per_step, 1e3 * st.t_update / nc,
-              1e3 * st.t_flow / nc, 1e3 * st.t_forces / nc, 1e3 * t_tri, st.retriangulations);
+              1e3 * st.t_flow / nc, 1e3 * st.t_forces / nc, 1e3 * st.t_predict / nc, 1e3 * t_tri, st.retriangulations);
   std::printf("  last step: %d CG iterations (%s), %ld flow sub-steps; max pore pressure %.4e Pa\n",
               cpl.flow().last_cg_iterations(), cp.fluid.preconditioner == Preconditioner::AMG ? "AMG" : "DIC",
               st.last_substeps, cpl.max_pressure());

@@ -157,10 +157,24 @@ void Amg::build(const CsrView& A) {
   for (auto& L : levels_) {
     const auto n = static_cast<std::size_t>(L.n);
     L.inv_diag.assign(n, 0);
-    L.x.assign(n, 0);
+    L.x.assign(2 * n, 0);
     L.b.assign(n, 0);
     L.r.assign(n, 0);
-    L.snap.assign(n, 0);
+    // The smoother's rows (blocks of kAmgBlock rows; couplings across blocks read the second half of x).
+    L.off_ptr.assign(n + 1, 0);
+    L.off_slot.clear();
+    L.off_src.clear();
+    for (Index i = 0; i < L.n; ++i) {
+      const Index lo = i / kAmgBlock * kAmgBlock, hi = std::min(L.n, lo + kAmgBlock);
+      for (Index k = L.ptr[i]; k < L.ptr[i + 1]; ++k) {
+        const Index j = L.col[k];
+        if (j == i) continue;
+        L.off_slot.push_back(j >= lo && j < hi ? j : L.n + j);
+        L.off_src.push_back(k);
+      }
+      L.off_ptr[static_cast<std::size_t>(i) + 1] = static_cast<Index>(L.off_slot.size());
+    }
+    L.off_val.assign(L.off_src.size(), 0);
   }
   const Index nc = levels_.back().n;
   chol_.assign(nc <= 2048 ? static_cast<std::size_t>(nc) * static_cast<std::size_t>(nc) : 0, 0);
@@ -173,7 +187,10 @@ void Amg::refresh(const CsrView& A) {
   for (std::size_t l = 0; l < levels_.size(); ++l) {
     Level& L = levels_[l];
 #pragma omp parallel for schedule(static) if (L.n > kParallelMin)
-    for (Index i = 0; i < L.n; ++i) L.inv_diag[i] = 1 / L.val[L.diag[i]];
+    for (Index i = 0; i < L.n; ++i) {
+      L.inv_diag[i] = 1 / L.val[L.diag[i]];
+      for (Index e = L.off_ptr[i]; e < L.off_ptr[i + 1]; ++e) L.off_val[e] = L.val[L.off_src[e]];
+    }
     if (l + 1 == levels_.size()) break;
     Level& C = levels_[l + 1];
     // Coarse row a gathers the rows of aggregate a in ascending order: no race, a fixed order.
@@ -241,16 +258,15 @@ void Amg::solve_coarsest(Level& L) {
 void Amg::smooth(Level& L, bool forward, bool zero_start) {
   const Index n = L.n;
   const Index nb = (n + kAmgBlock - 1) / kAmgBlock;
-  if (nb > 1 && !zero_start) {
-#pragma omp parallel for schedule(static) if (n > kParallelMin)
-    for (Index i = 0; i < n; ++i) L.snap[i] = L.x[i];
-  }
-  const Index* ptr = L.ptr;
-  const Index* col = L.col;
-  const Real* val = L.val;
   Real* x = L.x.data();
+  if (nb > 1) {  // the rows outside each block as the sweep begins (zero_start: zero)
+#pragma omp parallel for schedule(static) if (n > kParallelMin)
+    for (Index i = 0; i < n; ++i) x[n + i] = zero_start ? 0.0 : x[i];
+  }
+  const Index* ptr = L.off_ptr.data();
+  const Index* slot = L.off_slot.data();
+  const Real* val = L.off_val.data();
   const Real* b = L.b.data();
-  const Real* snap = L.snap.data();
   const Real* inv = L.inv_diag.data();
 #pragma omp parallel for schedule(static) if (nb > 1)
   for (Index blk = 0; blk < nb; ++blk) {
@@ -259,12 +275,7 @@ void Amg::smooth(Level& L, bool forward, bool zero_start) {
       for (Index i = lo; i < hi; ++i) x[i] = 0;
     auto row = [&](Index i) {
       Real s = b[i];
-      for (Index k = ptr[i]; k < ptr[i + 1]; ++k) {
-        const Index j = col[k];
-        if (j == i) continue;
-        const Real xj = (j >= lo && j < hi) ? x[j] : (zero_start ? 0.0 : snap[j]);
-        s -= val[k] * xj;
-      }
+      for (Index e = ptr[i]; e < ptr[i + 1]; ++e) s -= val[e] * x[slot[e]];
       x[i] = s * inv[i];
     };
     if (forward)

@@ -81,7 +81,12 @@ class Amg {
     // transfer to the next level: aggregate of each row (-1: none), rows of each aggregate (CSR),
     // the coarse entry of each stored entry (-1: not carried)
     std::vector<Index> agg, agg_ptr, agg_rows, entry_map;
-    std::vector<Real> x, b, r, snap;
+    // x holds 2n values: the iterate, then (smooth()) the values of the rows outside a row's block
+    // as the sweep began. The smoother's rows without their diagonal, in the stored order: each
+    // entry's slot in x (j inside the row's block, n + j outside) and value (from the entry off_src).
+    std::vector<Index> off_ptr, off_slot, off_src;
+    std::vector<Real> off_val;
+    std::vector<Real> x, b, r;
   };
   void build(const CsrView& A);  // setup() on given values
   void build_level_transfer(Level& f, Level& c, Real eps);

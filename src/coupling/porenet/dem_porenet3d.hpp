@@ -132,6 +132,7 @@ struct Porenet3DStats {
   long last_substeps = 0;
   Real max_displacement = 0;  // since the last triangulation [m]
   double t_triangulation = 0, t_update = 0, t_flow = 0, t_forces = 0;  // cumulative wall seconds
+  double t_predict = 0;  // of t_forces: the held steps' pressure prediction (add_predicted_forces)
   long flow_every = 1;   // N of the current cycle
   long cycle_left = 0;   // DEM steps left before the next flow step
   long flow_steps = 0;   // flow steps so far
