@@ -69,6 +69,21 @@ TEST(Cli, FrictionBelowZeroAndPorosityOutsideUnitIntervalAreRejected) {
   fs::remove(f);
 }
 
+// A porosity looser than a dense random packing leaves the grains apart: the bonds make no rock.
+// At 0.9 a 2D hydrofrac block had 115 floaters of 116 disks and ran on without a word (fuzzed
+// 2026-11-30); check and run now warn with the keys to change. The default sample (porosity 0.40,
+// 9 floaters of 1,727) does not warn.
+TEST(Cli, LoosePackingWarnsThatTheBondsMakeNoRock) {
+  const auto ok = run("check");
+  EXPECT_EQ(ok.code, 0) << ok.output;
+  EXPECT_EQ(ok.output.find("held by fewer than"), std::string::npos) << ok.output;
+  const auto r = run("check --set sample.porosity=0.6");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("held by fewer than 3 bonds"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("sample.porosity"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("sample.bond_gap"), std::string::npos) << r.output;
+}
+
 TEST(Cli, UnknownKeyGetsASuggestion) {
   const auto f = write("unk", "driver = \"ucs\"\n[ucs]\nplaten_velocty = 0.1\n");
   const auto r = run("check " + f.string());
