@@ -42,7 +42,7 @@ Real segment_distance(const Vec3& p, const Joint& j) {  // x-y distance of p to 
 }  // namespace
 
 std::vector<Joint> make_joints(const Config& cfg, const Vec3& lo, const Vec3& hi, const Vec3& centre, Real hole_radius, int dim,
-                               long* outside) {
+                               long* outside, std::string* shortfall) {
   std::vector<Joint> out;
   const Real buffer = cfg.real("dfn.buffer");
   const std::string file = cfg.string("dfn.file");
@@ -112,7 +112,7 @@ std::vector<Joint> make_joints(const Config& cfg, const Vec3& lo, const Vec3& hi
       }
   }
   const long tries_max = 100 * n + 1000;
-  long tries = 0;
+  long tries = 0, near_hole = 0;  // candidates, and those within the buffer
   for (std::size_t g = 0; static_cast<long>(out.size()) < n && tries < tries_max; ++tries) {
     Joint j;
     int row = 0;
@@ -126,8 +126,26 @@ std::vector<Joint> make_joints(const Config& cfg, const Vec3& lo, const Vec3& hi
     }
     j.length = uniform(lmin, lmax);
     j.angle = angles == "fixed" ? angle : angles == "staggered" ? (row % 2 ? -angle : angle) : uniform(0, kPi);
-    if (segment_distance(centre, j) < hole_radius + buffer) continue;
+    if (segment_distance(centre, j) < hole_radius + buffer) {
+      ++near_hole;
+      continue;
+    }
     out.push_back(j);
+  }
+  // Fewer than asked: say so and why (a buffer wider than the block, or a grid coarser than it, used
+  // to leave no fracture without a word). None at all: refused, naming the key to change.
+  if (static_cast<long>(out.size()) < n) {
+    const std::string why =
+        positions == "grid"
+            ? fmt::format("the grid (dfn.spacing = {:g} m) has {} positions in the block, {} of them within dfn.buffer "
+                          "= {:g} m of the borehole wall",
+                          spacing, grid.size(), near_hole, buffer)
+            : fmt::format("{} of {} random candidates came within dfn.buffer = {:g} m of the borehole wall", near_hole,
+                          tries, buffer);
+    const char* key = positions == "grid" && near_hole == 0 ? "dfn.spacing" : "dfn.buffer";
+    if (out.empty())
+      cfg.fail(key, fmt::format("no natural fracture could be placed (dfn.count = {}): {}; use a smaller {}", n, why, key));
+    if (shortfall) *shortfall = fmt::format("dfn: {} of dfn.count = {} natural fractures placed: {}", out.size(), n, why);
   }
   return out;
 }

@@ -28,9 +28,10 @@ void declare_dfn_params(ParamTable& t);
 // block [lo, hi] around a hole of radius `hole_radius` centred at `centre`. Throws InputError
 // naming the key for a bad file or settings, and for a file whose every joint is centred outside
 // the block (another unit or origin); `outside`, if given, counts the file's joints centred outside
-// (a DFN drawn over a larger region than the block).
+// (a DFN drawn over a larger region than the block). The generator refuses a count of which it can
+// place none (naming dfn.buffer or dfn.spacing); `shortfall`, if given, says why it placed fewer.
 std::vector<Joint> make_joints(const Config& cfg, const Vec3& lo, const Vec3& hi, const Vec3& centre, Real hole_radius, int dim,
-                               long* outside = nullptr);
+                               long* outside = nullptr, std::string* shortfall = nullptr);
 // Removes every intact bond whose centre-to-centre segment crosses a joint; returns the pairs
 // (global ids, bond face area) for the fluid.
 std::vector<JointPair> cut_bonds(dem::DemSystem& sys, const std::vector<Joint>& joints);

@@ -173,7 +173,9 @@ void HydrofracRun::set_up() {
   hole_.z_lo = dim == 3 ? lo.z() : 0;
   hole_.z_hi = dim == 3 ? hi.z() : 0;
   long joints_outside = 0;
-  const auto joints = hydrofrac::make_joints(cfg, lo, hi, hole_.centre, hole_.radius, dim, &joints_outside);
+  std::string joints_short;
+  const auto joints = hydrofrac::make_joints(cfg, lo, hi, hole_.centre, hole_.radius, dim, &joints_outside, &joints_short);
+  if (!joints_short.empty()) log::warn("{}", joints_short);
   if (joints_outside > 0)
     log::warn("hydrofrac: {} of the {} fractures of dfn.file are centred outside the block (they cut only where they "
               "reach into it)",

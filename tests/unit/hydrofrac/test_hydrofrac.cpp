@@ -333,6 +333,10 @@ TEST(Hydrofrac, CheckRefusesBadInputNamingTheKey) {
                         Case{"borehole.perforation_length=8e-3", "borehole.perforation_length"},
                         Case{"dfn.file=\"missing.csv\"", "dfn.file"},
                         Case{"dfn.count=3 --set dfn.length_max=1e-3", "dfn.length_max"},
+                        // A generator that can place no fracture (a buffer wider than the block, a grid
+                        // coarser than it) made none without a word (fuzzed 2026-11-30).
+                        Case{"dfn.count=3 --set dfn.buffer=1", "dfn.buffer"},
+                        Case{"dfn.count=3 --set dfn.positions=\"grid\" --set dfn.spacing=1", "dfn.spacing"},
                         Case{"network.remap=\"volume\"", "network.remap"},
                         Case{"network.pressure_forces=\"arc\"", "network.pressure_forces"},
                         Case{"network.preconditioner=\"amg\"", "network.preconditioner"},  // 3D only
@@ -346,6 +350,11 @@ TEST(Hydrofrac, CheckRefusesBadInputNamingTheKey) {
     EXPECT_NE(r.output.find(c.key), std::string::npos) << c.set << "\n" << r.output;
   }
   EXPECT_EQ(fracflow("check " + file.string()).code, 0);
+  // Fewer placed than asked (a 24 mm block holds 6 grid positions 10 mm apart): a warning that says why.
+  const auto few = fracflow("check " + file.string() + " --set dfn.count=50 --set dfn.positions=\"grid\" --set dfn.spacing=0.01");
+  EXPECT_EQ(few.code, 0) << few.output;
+  EXPECT_NE(few.output.find("of dfn.count = 50 natural fractures placed"), std::string::npos) << few.output;
+  EXPECT_NE(few.output.find("dfn.spacing = 0.01 m"), std::string::npos) << few.output;
   // Walls that end the in-situ stage far from their targets stop the run (after a checkpoint)
   // instead of injecting into a block at a fraction of its stress.
   const fs::path out = s / "short";
