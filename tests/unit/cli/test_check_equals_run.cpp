@@ -175,6 +175,18 @@ std::vector<Bad> bad_scenarios() {
            "sample.shape = \"box\"\nsample.width = 12e-3\nsample.height = 12e-3\nsample.porosity = 0.25\n"
            "borehole.radius = 1.5e-3\ndfn.count = 5\ndfn.positions = \"grid\"\ndfn.spacing = 1e-12\n",
        {"dfn.spacing", "grid positions"}},
+      // a buffer past the block placed no fracture of the five asked for, without a word (fuzzed 2026-11-30)
+      {"dfn_buffer_past_the_block",
+       "driver = \"hydrofrac\"\n" + kOutput + "dem.dim = 2\n" + kRock +
+           "sample.shape = \"box\"\nsample.width = 12e-3\nsample.height = 12e-3\nsample.porosity = 0.25\n"
+           "borehole.radius = 1.5e-3\ndfn.count = 5\ndfn.buffer = 1\n",
+       {"dfn.buffer", "no natural fracture could be placed"}},
+      // Eq. B1 with h_inf above h0 opened the contact channels as they were squeezed (fuzzed 2026-11-30)
+      {"b1_aperture_widening_under_stress", kSaturated2d + "fluid.aperture_hinf = 1e-3\n",
+       {"fluid.aperture_hinf", "above fluid.aperture_h0"}},
+      {"network_b1_aperture_widening_under_stress",
+       kHydrofrac2d + "injection.fluid = \"network\"\nnetwork.aperture_hinf = 1e-3\n",
+       {"network.aperture_hinf", "above network.aperture_h0"}},
       // the run started at a pressure past its stop: NaN grains, blamed on the DEM step
       {"injection_starting_past_its_stop",
        kHydrofrac2d + "injection.initial_pressure = 1e300\n",
