@@ -187,6 +187,12 @@ std::vector<Bad> bad_scenarios() {
            "sample.shape = \"box\"\nsample.width = 12e-3\nsample.height = 12e-3\nsample.porosity = 0.25\n"
            "borehole.radius = 1.5e-3\ninsitu.servo_velocity = 1e6\n",
        {"insitu.servo_velocity", "in one time step"}},
+      // a breakdown length beyond where the run stops: the breakdown pressure stayed null for ever
+      {"breakdown_length_past_the_stop",
+       "driver = \"hydrofrac\"\n" + kOutput + "dem.dim = 2\n" + kRock +
+           "sample.shape = \"box\"\nsample.width = 12e-3\nsample.height = 12e-3\nsample.porosity = 0.25\n"
+           "borehole.radius = 1.5e-3\ninjection.breakdown_length = 1\n",
+       {"injection.breakdown_length", "could never reach it"}},
       // Eq. B1 with h_inf above h0 opened the contact channels as they were squeezed (fuzzed 2026-11-30)
       {"b1_aperture_widening_under_stress", kSaturated2d + "fluid.aperture_hinf = 1e-3\n",
        {"fluid.aperture_hinf", "above fluid.aperture_h0"}},
