@@ -3,6 +3,7 @@
 // (coupling::DemPorenet3D), and on the 2D example for its checkpoint.
 #include <gtest/gtest.h>
 
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <string>
@@ -377,6 +378,55 @@ progress_interval = 0
 }  // namespace
 
 namespace {
+
+// Unstable numerics stop the run with advice that names real keys, after a last checkpoint
+// (untested for this driver before 2026-11-30: the model is robust to every time-step input tried).
+// Throats or channels absurdly wide (3D fluid.pfv_factor 1e20; 2D a 1 m B1 aperture) with water-full
+// pores: the pressure solve goes unstable within the first steps (a pore stretched past the
+// spinodal, or CG without convergence). The run keeps its start-up checkpoint and saves the failing
+// state beside it, writes no summary, and every key its message names exists.
+void expect_stop_with_keys(const std::string& text, const std::vector<std::string>& sets, const std::string& name,
+                           const std::string& conductance_key) {
+  const auto out = test::scratch(name);
+  try {
+    test::run_scenario(text, sets, out, 1);
+    ADD_FAILURE() << name << ": the run did not stop";
+  } catch (const NumericalError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find(conductance_key), std::string::npos) << msg;
+    EXPECT_NE(msg.find("fluid.liquid_bulk_modulus"), std::string::npos) << msg;
+    const ParamTable table = parameter_table(find_driver("saturated_ucs"));
+    std::size_t named = 0;
+    for (std::size_t at = msg.find("fluid."); at != std::string::npos; at = msg.find("fluid.", at + 1)) {
+      std::size_t end = at + 6;
+      auto in_key = [](char c) {
+        return std::islower(static_cast<unsigned char>(c)) || std::isdigit(static_cast<unsigned char>(c)) || c == '_';
+      };
+      while (end < msg.size() && in_key(msg[end])) ++end;
+      const std::string key = msg.substr(at, end - at);
+      EXPECT_NE(table.find(key), nullptr) << name << ": the advice names '" << key << "', which is not a key:\n"
+                                          << msg;
+      ++named;
+    }
+    EXPECT_GE(named, 3u) << msg;
+  }
+  EXPECT_TRUE(std::filesystem::exists(out / "checkpoint" / "state.ffcp")) << name << ": the last good checkpoint stays";
+  EXPECT_TRUE(std::filesystem::exists(out / "checkpoint_failed" / "state.ffcp")) << name << ": the failing state is kept";
+  EXPECT_FALSE(std::filesystem::exists(out / "summary.json")) << name << ": no result from a broken run";
+  std::filesystem::remove_all(out);
+}
+
+TEST(SaturatedUcs, UnstablePoreFluidStopsWithRealKeysAfterACheckpoint) {
+  expect_stop_with_keys(scenario_3d("saturation = 1.0\nliquid_eos = \"peng_robinson\"\npfv_factor = 1e20\n"), {},
+                        "sat_unstable_3d", "fluid.pfv_factor");
+  std::ifstream f(std::string(FRACFLOW_SOURCE_DIR) + "/examples/saturated_ucs_2d.toml");
+  std::stringstream ss;
+  ss << f.rdbuf();
+  expect_stop_with_keys(ss.str(),
+                        {"fluid.saturation=1", "fluid.liquid_eos=\"peng_robinson\"", "fluid.aperture_h0=1",
+                         "output.vtk=false", "output.plots=false", "output.progress_interval=0"},
+                        "sat_unstable_2d", "fluid.aperture_h0");
+}
 
 // A key of the other dimension is an error naming it (not silently ignored), as in `fracflow check`.
 TEST(SaturatedUcs, KeysOfTheOtherDimensionAreRefused) {
