@@ -560,9 +560,10 @@ void TwoPhaseFlow::throw_unstable_state(Index i) const {
   const bool liquid = mq_[k] > 0 && !(prm_.liquid.bulk_modulus(rq_[k]) > 0);
   throw NumericalError(fmt::format(
       "porenet: pore {} at {:.4g} Pa: its {} ({:.6g} kg/m^3) lies in the equation of state's unstable region "
-      "(dp/drho <= 0{}): the pore pressures have gone unstable. In a coupled run the DEM time step is likely above the "
-      "critical step with the pore fluid's stiffness: keep that stiffness in the time step (saturated_ucs: "
-      "fluid.stiffness_in_time_step = true) or lower dem.time_step / dem.time_step_safety",
+      "(dp/drho <= 0{}): the pore pressures have gone unstable. In a coupled run either the DEM time step is above "
+      "the critical step with the pore fluid's stiffness (keep that stiffness in the time step, saturated_ucs: "
+      "fluid.stiffness_in_time_step = true, or lower dem.time_step / dem.time_step_safety), or the throats conduct "
+      "so much more than the pores store that the pressure solve cannot resolve the storage (lower the conductance)",
       i, p_[k], liquid ? "liquid" : "gas", liquid ? rq_[k] : rp_[k],
       liquid ? ": stretched past the spinodal; cavitation is not modelled" : ""));
 }
