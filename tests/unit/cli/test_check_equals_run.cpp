@@ -52,6 +52,10 @@ const std::string kCavity = "driver = \"flow/cavity\"\n" + kOutput + "lbm.resolu
 const std::string kCylinder = "driver = \"flow/cylinder\"\n" + kOutput;
 const std::string kHydrofrac2d = "driver = \"hydrofrac\"\n" + kOutput + "dem.dim = 2\n" + kRock +
                                  "sample.shape = \"box\"\nsample.width = 6e-3\nsample.height = 6e-3\nsample.porosity = 0.25\n";
+// A 12 mm block with a hole that fits it: for the checks made once the sample exists.
+const std::string kHydrofracBlock2d = kHydrofrac2d.substr(0, kHydrofrac2d.find("sample.width")) +
+                                      "sample.width = 12e-3\nsample.height = 12e-3\nsample.porosity = 0.25\n"
+                                      "borehole.radius = 1.5e-3\n";
 const std::string kSaturated2d = "driver = \"saturated_ucs\"\n" + kOutput + "dem.dim = 2\n" + kRock +
                                  "sample.shape = \"box\"\nsample.width = 6e-3\nsample.height = 12e-3\nsample.porosity = 0.25\n";
 
@@ -171,27 +175,19 @@ std::vector<Bad> bad_scenarios() {
        {"dfn.count", "out of range"}},
       // a grid spacing that never advanced x: an endless loop
       {"dfn_grid_spacing_below_round_off",
-       "driver = \"hydrofrac\"\n" + kOutput + "dem.dim = 2\n" + kRock +
-           "sample.shape = \"box\"\nsample.width = 12e-3\nsample.height = 12e-3\nsample.porosity = 0.25\n"
-           "borehole.radius = 1.5e-3\ndfn.count = 5\ndfn.positions = \"grid\"\ndfn.spacing = 1e-12\n",
+       kHydrofracBlock2d + "dfn.count = 5\ndfn.positions = \"grid\"\ndfn.spacing = 1e-12\n",
        {"dfn.spacing", "grid positions"}},
       // a buffer past the block placed no fracture of the five asked for, without a word (fuzzed 2026-11-30)
       {"dfn_buffer_past_the_block",
-       "driver = \"hydrofrac\"\n" + kOutput + "dem.dim = 2\n" + kRock +
-           "sample.shape = \"box\"\nsample.width = 12e-3\nsample.height = 12e-3\nsample.porosity = 0.25\n"
-           "borehole.radius = 1.5e-3\ndfn.count = 5\ndfn.buffer = 1\n",
+       kHydrofracBlock2d + "dfn.count = 5\ndfn.buffer = 1\n",
        {"dfn.buffer", "no natural fracture could be placed"}},
       // servo walls jumping 0.4 of a grain per step: 0 MPa after insitu.max_steps, blamed on too few steps
       {"servo_walls_jumping_grains",
-       "driver = \"hydrofrac\"\n" + kOutput + "dem.dim = 2\n" + kRock +
-           "sample.shape = \"box\"\nsample.width = 12e-3\nsample.height = 12e-3\nsample.porosity = 0.25\n"
-           "borehole.radius = 1.5e-3\ninsitu.servo_velocity = 1e6\n",
+       kHydrofracBlock2d + "insitu.servo_velocity = 1e6\n",
        {"insitu.servo_velocity", "in one time step"}},
       // a breakdown length beyond where the run stops: the breakdown pressure stayed null for ever
       {"breakdown_length_past_the_stop",
-       "driver = \"hydrofrac\"\n" + kOutput + "dem.dim = 2\n" + kRock +
-           "sample.shape = \"box\"\nsample.width = 12e-3\nsample.height = 12e-3\nsample.porosity = 0.25\n"
-           "borehole.radius = 1.5e-3\ninjection.breakdown_length = 1\n",
+       kHydrofracBlock2d + "injection.breakdown_length = 1\n",
        {"injection.breakdown_length", "could never reach it"}},
       // Eq. B1 with h_inf above h0 opened the contact channels as they were squeezed (fuzzed 2026-11-30)
       {"b1_aperture_widening_under_stress", kSaturated2d + "fluid.aperture_hinf = 1e-3\n",
