@@ -282,8 +282,20 @@ class PoreFluid {
     dim3_ = info.dim == 3;
     if (dim3_) band_ = drain_band(sys, info.axis);
     setup(cfg, info);
-    if (dim3_) c3_.init(sys, params_3d(cfg));
-    else c2_.init(sys, coupling_params(cfg));
+    if (dim3_) {
+      const auto prm = params_3d(cfg);
+      // A fixed stride past the automatic one's cap: one flow step in a whole run at 1e6 (fuzzed 2026-11-30),
+      // the held forces (and their linear prediction) carrying the fluid; cycles of a fixed N never end early.
+      if (const long cap = coupling::Porenet3DParams{}.max_flow_every; prm.flow_every > cap)
+        log::warn("fluid.flow_every = {} holds the pore forces (and, with fluid.predict_pressures, their linear "
+                  "prediction) for {} DEM steps between flow steps, past the automatic stride's cap of {}, the range "
+                  "checked against a flow step every DEM step; a fixed stride is never cut short (fluid.hold_strain, "
+                  "fluid.hold_displacement and new cracks end only automatic cycles). 0 chooses it",
+                  prm.flow_every, prm.flow_every, cap);
+      c3_.init(sys, prm);
+    } else {
+      c2_.init(sys, coupling_params(cfg));
+    }
     start_session();
   }
   void load(CheckpointReader& r, dem::DemSystem& sys, const Config& cfg, const dem::SampleInfo& info) {

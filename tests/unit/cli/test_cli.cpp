@@ -84,6 +84,21 @@ TEST(Cli, LoosePackingWarnsThatTheBondsMakeNoRock) {
   EXPECT_NE(r.output.find("sample.bond_gap"), std::string::npos) << r.output;
 }
 
+// A fixed 3D stride past the automatic one's cap (20) is beyond what was checked, and never cut short:
+// at 1e6 a whole run made one flow step without a word (fuzzed 2026-11-30). Warned once; 20 is not.
+TEST(Cli, FixedStrideBeyondTheCheckedRangeWarns) {
+  const std::string example = std::string(FRACFLOW_SOURCE_DIR) + "/examples/saturated_ucs_3d.toml";
+  const auto ok = run("check " + example + " --set fluid.flow_every=20");
+  EXPECT_EQ(ok.code, 0) << ok.output;
+  EXPECT_EQ(ok.output.find("holds the pore forces"), std::string::npos) << ok.output;
+  const auto r = run("check " + example + " --set fluid.flow_every=1000000");
+  EXPECT_EQ(r.code, 0) << r.output;
+  const std::string warning = "fluid.flow_every = 1000000 holds the pore forces";
+  const auto at = r.output.find(warning);
+  EXPECT_NE(at, std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find(warning, at + 1), std::string::npos) << "warned more than once:\n" << r.output;
+}
+
 TEST(Cli, UnknownKeyGetsASuggestion) {
   const auto f = write("unk", "driver = \"ucs\"\n[ucs]\nplaten_velocty = 0.1\n");
   const auto r = run("check " + f.string());
