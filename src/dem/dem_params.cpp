@@ -199,4 +199,15 @@ void choose_time_step(const Config& cfg, DemSystem& sys, std::span<const Real> e
             cfg.boolean("dem.mass_scaling") && dt_user > 0 ? ", inertial masses scaled" : "");
 }
 
+void refuse_wall_jump(const Config& cfg, const std::string& key, const DemSystem& sys, std::string_view wall,
+                      std::string_view usual) {
+  const auto& r = sys.particles.radius;
+  if (r.empty()) return;
+  const Real v = cfg.real(key), dt = sys.settings.dt, r_min = *std::min_element(r.begin(), r.end());
+  if (v * dt > kMaxWallStep * r_min)
+    cfg.fail(key, fmt::format("{:.4g} m/s moves the {} {:.3g} m in one time step ({:.4g} s), {:.3g} of the smallest "
+                              "particle radius ({:.4g} m); the limit is {}: {}",
+                              v, wall, v * dt, dt, v * dt / r_min, r_min, kMaxWallStep, usual));
+}
+
 }  // namespace ff::dem

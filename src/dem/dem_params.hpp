@@ -2,6 +2,8 @@
 // [dem.bond.<a>-<b>]) and their conversion to Materials and DemSettings.
 #pragma once
 #include <span>
+#include <string>
+#include <string_view>
 
 #include "dem/dem_system.hpp"
 #include "io/params.hpp"
@@ -18,5 +20,12 @@ DemSettings build_settings(const Config& cfg);
 // on, which then scales inertial masses), else dem.time_step_safety x critical. The critical step
 // counts `extra_stiffness` (critical_time_step's: what a coupled physics module adds per particle).
 void choose_time_step(const Config& cfg, DemSystem& sys, std::span<const Real> extra_stiffness = {});
+// A boundary (platen, grip, servo wall) that moves a good part of a grain in one step is an impact:
+// its contacts jump through each other. Largest travel per time step, as a fraction of the smallest radius.
+constexpr double kMaxWallStep = 0.05;
+// Refuses (InputError naming `key`) the speed cfg.real(key) [m/s] when it moves `wall` by more than
+// kMaxWallStep x the smallest radius in one of sys's time steps; `usual` ends the message (what is usual).
+void refuse_wall_jump(const Config& cfg, const std::string& key, const DemSystem& sys, std::string_view wall,
+                      std::string_view usual);
 
 }  // namespace ff::dem

@@ -64,7 +64,7 @@ struct DemRunSpec {
   // strain is 0).
   std::string strain_column = "axial_strain", lateral_column = "lateral_strain", strain_name = "axial strain";
   // The loading speed's key [m/s] (each platen or grip): refused when it moves a platen by more
-  // than kMaxLoadingStep x the smallest radius in one time step. Empty: not checked.
+  // than dem::kMaxWallStep x the smallest radius in one time step. Empty: not checked.
   std::string rate_key;
 };
 
@@ -75,8 +75,6 @@ class DemRun {
   DemRun(const DemRun&) = delete;
   DemRun& operator=(const DemRun&) = delete;
   RunStatus run();  // the loop
-  // Largest platen or grip travel per time step, as a fraction of the smallest radius.
-  static constexpr double kMaxLoadingStep = 0.05;
 
  protected:
   // --- hooks ---

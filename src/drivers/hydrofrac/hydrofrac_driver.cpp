@@ -196,17 +196,10 @@ void HydrofracRun::set_up() {
     }
   sys.initialise();
   dem::choose_time_step(cfg, sys);
-  {  // A servo that may move a wall by a good part of a grain in one step jumps through the block (1e6 m/s:
-     // the walls ended at 0 MPa after insitu.max_steps, blamed on too few steps). The UCS platens' limit.
-    constexpr Real kMaxWallStep = 0.05;  // of the smallest radius (DemRun::kMaxLoadingStep)
-    const Real r_min = *std::min_element(P.radius.begin(), P.radius.end()), jump = servo_v_ * sys.settings.dt;
-    if (jump > kMaxWallStep * r_min)
-      cfg.fail("insitu.servo_velocity",
-               fmt::format("{:.4g} m/s lets a wall move {:.3g} m in one time step ({:.4g} s), {:.3g} of the smallest "
-                           "particle radius ({:.4g} m); the limit is {}: the servos need many steps per grain (the "
-                           "default is 0.5 m/s)",
-                           servo_v_, jump, sys.settings.dt, jump / r_min, r_min, kMaxWallStep));
-  }
+  // Servos that move a wall by a good part of a grain in one step (1e6 m/s: the walls jumped through the
+  // block and ended at 0 MPa after insitu.max_steps, blamed on too few steps).
+  dem::refuse_wall_jump(cfg, "insitu.servo_velocity", sys, "servo walls",
+                        "the servos need many steps per grain (the default is 0.5 m/s)");
   log::info("hydrofrac: {} particles, {} bonds; borehole radius {:.4g} m ({} particles removed){}; {} natural fractures "
             "cutting {} bonds; time step {:.3g} s",
             P.size(), intact_bonds(sys), hole_.radius, removed,
