@@ -68,6 +68,15 @@ void declare_series_interval(ParamTable& t, const std::string& table, const std:
       .at_most(100000);
 }
 
+void refuse_widening_aperture(const Config& cfg, const std::string& table) {
+  const double h0 = cfg.real(table + ".aperture_h0"), hinf = cfg.real(table + ".aperture_hinf");
+  if (hinf > h0)
+    cfg.fail(table + ".aperture_hinf",
+             fmt::format("{} m is above {}.aperture_h0 = {} m: Eq. B1's aperture would widen as the contact is "
+                         "squeezed; the aperture at infinite stress must be at most the one at zero stress",
+                         hinf, table, h0));
+}
+
 ParamTable parameter_table(const Driver& d) {
   ParamTable t;
   declare_common_params(t);

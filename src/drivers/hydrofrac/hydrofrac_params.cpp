@@ -257,12 +257,8 @@ void validate_scenario(const Config& cfg) {
              fmt::format("{} Pa is not below network.pore_pressure = {} Pa: every pore would start cavitated (water at "
                          "20 C: 2.34e3 Pa; 0 lets the liquid take any tension)",
                          cfg.real("network.vapour_pressure"), cfg.real("network.pore_pressure")));
-  if (cfg.string("injection.fluid") == "network" && cfg.integer("dem.dim") == 2 &&
-      cfg.real("network.aperture_hinf") > cfg.real("network.aperture_h0"))
-    cfg.fail("network.aperture_hinf",
-             fmt::format("{} m is above network.aperture_h0 = {} m: Eq. B1's aperture would widen as the contact is "
-                         "squeezed; the aperture at infinite stress must be at most the one at zero stress",
-                         cfg.real("network.aperture_hinf"), cfg.real("network.aperture_h0")));
+  if (cfg.string("injection.fluid") == "network" && cfg.integer("dem.dim") == 2)
+    refuse_widening_aperture(cfg, "network");
   if (!(cfg.real("injection.initial_pressure") < cfg.real("injection.max_pressure")))
     cfg.fail("injection.initial_pressure",
              fmt::format("{} Pa is not below injection.max_pressure = {} Pa, where the run stops: lower it (or raise "

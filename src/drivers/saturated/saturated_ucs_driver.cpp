@@ -20,6 +20,7 @@
 #include "core/log.hpp"
 #include "coupling/porenet/dem_porenet.hpp"
 #include "coupling/porenet/dem_porenet3d.hpp"
+#include "drivers/common_params.hpp"
 #include "dem/dem_params.hpp"
 #include "dem/diagnostics.hpp"
 #include "dem/sample_builder.hpp"
@@ -635,12 +636,7 @@ void validate(const Config& cfg) {
              fmt::format("{} Pa is not below fluid.initial_pressure = {} Pa: every pore would start cavitated (water's "
                          "vapour pressure at 20 C is 2.34e3 Pa; 0 lets the liquid take any tension)",
                          cfg.real("fluid.cavitation_pressure"), cfg.real("fluid.initial_pressure")));
-  // Eq. B1 closes a channel under normal stress, from h0 towards h_inf: the reverse opens it as it is squeezed.
-  if (!dim3 && cfg.real("fluid.aperture_hinf") > cfg.real("fluid.aperture_h0"))
-    cfg.fail("fluid.aperture_hinf",
-             fmt::format("{} m is above fluid.aperture_h0 = {} m: Eq. B1's aperture would widen as the contact is "
-                         "squeezed; the aperture at infinite stress must be at most the one at zero stress",
-                         cfg.real("fluid.aperture_hinf"), cfg.real("fluid.aperture_h0")));
+  if (!dim3) refuse_widening_aperture(cfg, "fluid");
 }
 
 RunStatus run(const Config& cfg, const RunOptions& opt) {
