@@ -479,7 +479,7 @@ int main(int argc, char** argv) {
               "%.1f ms per step = DEM + update %.1f ms + flow %.1f ms + forces %.1f ms (of which held-step prediction %.2f ms); "
               "triangulation + remap %.0f ms (%ld retriangulations)\n",
               cpl.network().n_pores(), S, halvings, st.flow_every, nc, t_run, 1e3 * per_step, 1e3 * st.t_update / nc,
-              1e3 * st.t_flow / nc, 1e3 * st.t_forces / nc, 1e3 * st.t_predict / nc, 1e3 * t_tri, st.retriangulations);
+              1e3 * st.t_flow / nc, 1e3 * st.t_forces / nc, 1e3 * cpl.prediction_seconds() / nc, 1e3 * t_tri, st.retriangulations);
   std::printf("  last step: %d CG iterations (%s), %ld flow sub-steps; max pore pressure %.4e Pa\n",
               cpl.flow().last_cg_iterations(), cp.fluid.preconditioner == Preconditioner::AMG ? "AMG" : "DIC",
               st.last_substeps, cpl.max_pressure());

@@ -321,7 +321,7 @@ void DemPorenet3D::step(dem::DemSystem& sys) {
     add_predicted_forces(sys);
     const double t = seconds_since(t1);
     stats_.t_forces += t;
-    stats_.t_predict += t;
+    t_predict_ += t;
   }
   sys.integrate();
 }

@@ -132,7 +132,6 @@ struct Porenet3DStats {
   long last_substeps = 0;
   Real max_displacement = 0;  // since the last triangulation [m]
   double t_triangulation = 0, t_update = 0, t_flow = 0, t_forces = 0;  // cumulative wall seconds
-  double t_predict = 0;  // of t_forces: the held steps' pressure prediction (add_predicted_forces)
   long flow_every = 1;   // N of the current cycle
   long cycle_left = 0;   // DEM steps left before the next flow step
   long flow_steps = 0;   // flow steps so far
@@ -215,6 +214,9 @@ class DemPorenet3D {
   }
   void stop_prediction() { pred_g_.clear(); }
   bool predicting() const { return !pred_g_.empty(); }
+  // Of stats().t_forces: this process's wall seconds in step()'s held-step predictions (not in the
+  // checkpoint, whose stats keep their layout).
+  double prediction_seconds() const { return t_predict_; }
   void add_predicted_forces(dem::DemSystem& sys, Real p_floor = -std::numeric_limits<Real>::infinity());
 
   // Called after every (re)build of the network, before the state is carried over: boundary conditions.
@@ -247,6 +249,7 @@ class DemPorenet3D {
   std::vector<Real> x_, y_, z_, r_, ref_x_, ref_y_, ref_z_, fx_, fy_, fz_, pg_;
   long early_flow_steps_ = 0;  // cycles hold_displacement / hold_strain ended early (checkpointed)
   Real pred_strain_ = 0;       // the last held step's largest |V - V0| / V0 (checkpointed)
+  double t_predict_ = 0;  // prediction_seconds()
   std::size_t cracks_at_flow_ = 0;  // the DEM's crack log's length at the last flow step (checkpointed)
   Real mean_radius_ = 0;
   Porenet3DStats stats_;
