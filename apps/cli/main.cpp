@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <charconv>
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 
 #include <unistd.h>
@@ -91,6 +93,30 @@ std::string command_line(int argc, char** argv) {
   return s;
 }
 
+// Keys the user set that the set-up never read: valid keys of another shape, dimension, fluid or
+// mode, which would otherwise be ignored without a word (check and run warn alike).
+void warn_unread_keys(const Config& cfg) {
+  for (const auto& k : cfg.unread_keys())
+    log::warn("{}: key '{}' is set but this scenario does not use it (it belongs to another shape, dimension, "
+              "fluid or mode of driver '{}'): it has no effect",
+              cfg.origin(k), k, cfg.string("driver"));
+  cfg.mark_set_up_done();
+}
+
+// Keys first read after the set-up (that warn_unread_keys() would have named wrongly, being
+// missing from read_by_every_run()): with FRACFLOW_CHECK_LATE_READS set, as the tests run the
+// command line, each is an error and the command fails.
+bool late_reads_refused(const Config& cfg) {
+  const char* on = std::getenv("FRACFLOW_CHECK_LATE_READS");
+  if (!on || !*on) return false;
+  const auto late = cfg.late_reads();
+  for (const auto& k : late)
+    log::error("internal: key '{}' was first read after the set-up: read it in the set-up, or add it to "
+               "read_by_every_run() (io/params.cpp) if every run of driver '{}' reads it",
+               k, cfg.string("driver"));
+  return !late.empty();
+}
+
 // Why a driver returned RunStatus::Interrupted.
 std::string stop_reason(const RunOptions& opt, double elapsed_s) {
   if (stop_requested()) return stop_signal_name();
@@ -106,6 +132,7 @@ int execute(const batch::LoadedScenario& l, RunOptions opt, NewRunFolder* folder
   const auto start = std::chrono::steady_clock::now();
   try {
     const RunStatus st = l.driver->run(l.config, opt);
+    if (late_reads_refused(l.config)) return 70;
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const std::string dir = opt.out_dir.string();
     // How to continue is printed even with --quiet: a stopped run must never look finished.
@@ -135,6 +162,7 @@ int execute(const batch::LoadedScenario& l, RunOptions opt, NewRunFolder* folder
 // never created: a driver writes nothing before begin_output.
 struct SetUpPassed {};
 
+
 void check_set_up(const batch::LoadedScenario& l) {
   RunOptions opt;
   opt.threads = omp_get_max_threads();
@@ -144,6 +172,7 @@ void check_set_up(const batch::LoadedScenario& l) {
   try {
     (void)l.driver->run(l.config, opt);
   } catch (const SetUpPassed&) {
+    warn_unread_keys(l.config);
     return;
   }
   throw Error(fmt::format("check: driver '{}' finished its set-up without reaching its output stage", l.driver->name));
@@ -283,7 +312,8 @@ int main(int argc, char** argv) {
       NewRunFolder folder(out_dir, overwrite, scenario);
       opt.out_dir = out_dir;
       opt.progress_interval_s = quiet ? 0 : l->config.real("output.progress_interval");
-      opt.begin_output = [&folder, resolved = l->config.resolved_toml(), cmd = command_line(argc, argv)] {
+      opt.begin_output = [&folder, &cfg = l->config, resolved = l->config.resolved_toml(), cmd = command_line(argc, argv)] {
+        warn_unread_keys(cfg);
         // Until now a signal ends the process at once (nothing is written yet, an old run is
         // untouched); from here on it asks the driver for a checkpoint.
         install_stop_signal_handlers();

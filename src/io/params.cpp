@@ -221,7 +221,41 @@ const ParamSpec& Config::spec(const std::string& key) const {
   return *s;
 }
 
+void Config::note_read(const std::string& key) const {
+#pragma omp critical(ff_config_reads)
+  {
+    if (reads_->keys.insert(key).second && reads_->set_up_done) reads_->late.insert(key);
+  }
+}
+
+bool read_by_every_run(const std::string& key) {
+  static const std::unordered_set<std::string> kLate = {
+      "driver",          "title",          "measure.pressure",    "measure.angles",
+      "insitu.tolerance", "injection.stop_fraction", "injection.peak_drop", "injection.stop_extent",
+      "dem.energy_tracking", "run.steady_tolerance", "reference.terminal_velocity",
+      "triaxial.measurement_sphere_radius"};
+  auto ends = [&](std::string_view s) { return key.size() >= s.size() && key.compare(key.size() - s.size(), s.size(), s) == 0; };
+  return kLate.count(key) || key.rfind("output.", 0) == 0 || ends(".series_interval") || ends(".checkpoint_interval") ||
+         ends(".vtk_interval");
+}
+
+std::vector<std::string> Config::unread_keys() const {
+  std::vector<std::string> out;
+  for (const auto& [k, v] : values_)
+    if (v.second.kind != ParamOrigin::Default && !reads_->keys.count(k) && !read_by_every_run(k)) out.push_back(k);
+  return out;
+}
+
+std::vector<std::string> Config::late_reads() const {
+  std::vector<std::string> out;
+  for (const auto& k : reads_->late)
+    if (!read_by_every_run(k)) out.push_back(k);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 const ParamValue& Config::value(const std::string& key, ParamType t) const {
+  note_read(key);
   const ParamSpec& s = spec(key);
   if (s.type != t) throw Error("internal: parameter '" + key + "' is a " + to_string(s.type) + ", read as " + to_string(t));
   auto it = values_.find(key);
@@ -241,7 +275,10 @@ const std::vector<double>& Config::real_list(const std::string& k) const {
 const std::vector<std::string>& Config::string_list(const std::string& k) const {
   return std::get<std::vector<std::string>>(value(k, ParamType::StringList));
 }
-bool Config::has(const std::string& key) const { return values_.count(key) > 0; }
+bool Config::has(const std::string& key) const {
+  note_read(key);
+  return values_.count(key) > 0;
+}
 
 std::vector<std::string> Config::names(const std::string& prefix) const {
   // Keys with the prefix are contiguous in the sorted map; a set keeps the scan linear.

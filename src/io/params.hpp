@@ -5,9 +5,11 @@
 #pragma once
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 #include <variant>
 #include <vector>
 
@@ -87,6 +89,10 @@ struct ParamOrigin {
 };
 
 // The resolved parameters of one run: scenario file + --set overrides + defaults, validated.
+// Keys every run of a driver that declares them reads, some only after the set-up (intervals,
+// summary fields): never reported as unused.
+bool read_by_every_run(const std::string& key);
+
 class Config {
  public:
   Config() = default;
@@ -118,6 +124,15 @@ class Config {
   std::vector<std::pair<std::string, ParamValue>> resolved_values() const;
   // Table for `fracflow check`: key, value, unit, default, source.
   std::string describe() const;
+  // Keys set explicitly (file or --set) that nothing has read (a getter or has()) so far: keys of
+  // another shape, dimension or mode, which the run ignores. Copies of a Config share the record.
+  // Keys that every run of their driver reads, some only after the set-up (read_by_every_run:
+  // driver, title, output.*, the intervals, summary-only keys), are never named.
+  std::vector<std::string> unread_keys() const;
+  // From here on a first read of a key is recorded as late: unread_keys() at the end of the set-up
+  // would have named it wrongly unless read_by_every_run() lists it. Tests fail on any.
+  void mark_set_up_done() const { reads_->set_up_done = true; }
+  std::vector<std::string> late_reads() const;
 
  private:
   const ParamSpec& spec(const std::string& key) const;
@@ -126,6 +141,12 @@ class Config {
   const ParamTable* table_ = nullptr;
   std::string name_;
   std::map<std::string, std::pair<ParamValue, ParamOrigin>> values_;
+  struct Reads {
+    std::unordered_set<std::string> keys, late;
+    bool set_up_done = false;
+  };
+  void note_read(const std::string& key) const;
+  std::shared_ptr<Reads> reads_ = std::make_shared<Reads>();
 };
 
 }  // namespace ff
