@@ -182,6 +182,13 @@ void choose_time_step(const Config& cfg, DemSystem& sys, std::span<const Real> e
   const Real dt_user = cfg.real("dem.time_step");
   const Real crit = critical_time_step(sys, extra_stiffness);
   const char* with = extra_stiffness.empty() ? "" : " with the coupled fluid's stiffness";
+  if (!(crit > 0))
+    throw InputError(fmt::format(
+        "{}: the critical time step is 0: the sample's contact or bond stiffness is not finite (a modulus, or a "
+        "parallel bond's section, so large that k = E A / L overflows) or a particle's mass is 0; check "
+        "dem.contact.*.emod, dem.bond.*.emod, dem.bond.*.radius_multiplier, dem.bond.*.youngs_modulus and "
+        "dem.group.*.density{}",
+        cfg.scenario_name(), extra_stiffness.empty() ? "" : ", and the coupled fluid's stiffness"));
   if (dt_user <= 0) {
     sys.settings.dt = safety * crit;
   } else if (cfg.boolean("dem.mass_scaling")) {

@@ -203,8 +203,12 @@ Real critical_time_step(const DemSystem& s, std::span<const Real> extra_stiffnes
   for (std::size_t i = 0; i < n; ++i) {
     // A particle with no contact yet still meets one like itself (free particles otherwise
     // give no bound at all).
+    // A stiffness that overflowed (a modulus or bond radius multiplier of 1e300: inf, or NaN from
+    // 0 x inf) allows no step; the fallback below and std::min would skip the NaN.
+    if (!std::isfinite(kt[i]) || !std::isfinite(kr[i])) return 0;
     const Real k = kt[i] > 0 ? kt[i] : pair_stiffness(s, materials.pair(grp[i], grp[i]), r[i], r[i], 0.01 * r[i]);
     const Real kk = kr[i] > 0 ? kr[i] : k * r[i] * r[i];
+    if (!std::isfinite(k) || !std::isfinite(kk)) return 0;
     dt = std::min({dt, std::sqrt(1.0 / (particles.inv_mass[i] * k)), std::sqrt(1.0 / (particles.inv_inertia[i] * kk))});
   }
   return dt;

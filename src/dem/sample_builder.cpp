@@ -48,7 +48,9 @@ void declare_sample_params(ParamTable& t) {
   t.real_list("sample.region.*.axis", {0, 0, 1}, "m", "cylinder axis direction (normalised)").size(3);
   t.real("sample.region.*.length", 1e-3, "m", "cylinder length along its axis").positive();
   t.real_list("sample.region.*.semi_axes", {1e-3, 1e-3, 1e-3}, "m", "ellipsoid semi-axes").size(3).positive();
-  t.real_list("sample.region.*.rotation", {0, 0, 0}, "deg", "ellipsoid rotation: angles about x, then y, then z").size(3);
+  t.real_list("sample.region.*.rotation", {0, 0, 0}, "deg", "ellipsoid rotation: angles about x, then y, then z")
+      .size(3)
+      .range(-360, 360);
   t.string("sample.region.*.file", "", "closed STL surface (relative paths from the scenario file's folder)");
   // Voxel image (applied after the regions: a voxel window wins over every region).
   t.string("sample.voxels.folder", "",

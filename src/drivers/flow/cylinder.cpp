@@ -54,7 +54,7 @@ void declare(ParamTable& t) {
       .one_of({"halfway", "bouzidi", "yu"});
   t.real("cylinder.initial_perturbation", 0.05, "-",
          "transverse velocity kick behind the cylinder at t = 0, as a fraction of U (starts vortex shedding)")
-      .non_negative();
+      .range(0, 1);
   t.string("obstacles.image", "",
            "optional PGM image (P2/P5) stretched over the channel: dark pixels become extra solid cells (half-way "
            "bounce-back), e.g. grains or a rough wall");

@@ -26,7 +26,7 @@ void declare_dfn_params(ParamTable& t) {
   t.real("dfn.spacing", 5e-3, "m", "grid positions: centre-to-centre distance").positive();
   t.string("dfn.angles", "fixed", "fixed (dfn.angle), staggered (+-dfn.angle alternating by grid row) or random")
       .one_of({"fixed", "staggered", "random"});
-  t.real("dfn.angle", 60, "deg", "trace direction from x (the sigma_H direction)");
+  t.real("dfn.angle", 60, "deg", "trace direction from x (the sigma_H direction)").range(-360, 360);
   t.real("dfn.length_min", 2e-3, "m", "shortest fracture (segment length, disc diameter)").positive();
   t.real("dfn.length_max", 4e-3, "m", "longest fracture (uniform between min and max)").positive();
   t.real("dfn.buffer", 2e-3, "m", "no fracture comes closer than this to the borehole wall").non_negative();

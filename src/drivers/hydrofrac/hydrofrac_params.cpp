@@ -32,7 +32,8 @@ void declare_params(ParamTable& t) {
       .positive();
   t.real("borehole.perforation_length", 0, "m", "length of each perforation slot beyond the wall (0: none)").non_negative();
   t.real("borehole.perforation_width", 0, "m", "width of the perforation slots (0: 2 sample.radius_max)").non_negative();
-  t.real("borehole.perforation_azimuth", 0, "deg", "direction of the perforation from x (the sigma_H direction)");
+  t.real("borehole.perforation_azimuth", 0, "deg", "direction of the perforation from x (the sigma_H direction)")
+      .range(-360, 360);
   t.integer("borehole.perforation_sides", 2, "-", "1: one slot; 2: two opposite slots").range(1, 2);
   t.real("insitu.sigma_H", 5e6, "Pa", "maximum horizontal stress, applied along x by servo walls (compression > 0)").positive();
   t.real("insitu.sigma_h", 5e6, "Pa", "minimum horizontal stress, along y").positive();
@@ -197,7 +198,8 @@ void declare_params(ParamTable& t) {
   t.real_list("measure.radii", {1.8, 2.5, 3.5}, "-",
               "distances of the measurement circles (spheres) from the hole's axis, in borehole radii (Kirsch comparison)")
       .positive();
-  t.real_list("measure.angles", {0, 45, 90}, "deg", "azimuths of the measurement circles from x (sigma_H)");
+  t.real_list("measure.angles", {0, 45, 90}, "deg", "azimuths of the measurement circles from x (sigma_H)")
+      .range(-360, 360);
   t.real("measure.circle_radius", 0.4, "-", "radius of each measurement circle (sphere), in borehole radii").positive();
   t.real("measure.pressure", 0, "Pa",
          "a second elastic-state snapshot when the borehole pressure first reaches this (0: only the in-situ snapshot)")

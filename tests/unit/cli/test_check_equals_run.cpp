@@ -189,6 +189,19 @@ std::vector<Bad> bad_scenarios() {
       {"breakdown_length_past_the_stop",
        kHydrofracBlock2d + "injection.breakdown_length = 1\n",
        {"injection.breakdown_length", "could never reach it"}},
+      // a bond section that overflows (k = E A / L = NaN): the critical step skipped it, the run turned NaN at
+      // step 0 and blamed the time step's safety factor (fuzzed 2026-11-30, session 47)
+      {"bond_stiffness_overflowing", kUcs3d + "dem.bond.rock-rock.radius_multiplier = 1e300\n",
+       {"dem.bond.*.radius_multiplier", "critical time step is 0"}},
+      {"bond_stiffness_overflowing_2d", kUcs2d + "dem.bond.rock-rock.emod = 1e308\ndem.bond.rock-rock.radius_multiplier = 1e10\n",
+       {"dem.bond.*.emod", "not finite"}},
+      // angles of 1e300 degrees (a direction of nothing in particular) were taken
+      {"dfn_angle_beyond_a_turn", kHydrofracBlock2d + "dfn.count = 2\ndfn.angle = 1e300\n", {"dfn.angle", "[-360, 360]"}},
+      {"perforation_azimuth_beyond_a_turn", kHydrofracBlock2d + "borehole.perforation_azimuth = 400\n",
+       {"borehole.perforation_azimuth", "[-360, 360]"}},
+      // a kick 1e300 times the inflow: NaN at step 103, blamed on the resolution
+      {"cylinder_kick_above_the_inflow", kCylinder + "cylinder.initial_perturbation = 2\n",
+       {"cylinder.initial_perturbation", "[0, 1]"}},
       // Eq. B1 with h_inf above h0 opened the contact channels as they were squeezed (fuzzed 2026-11-30)
       {"b1_aperture_widening_under_stress", kSaturated2d + "fluid.aperture_hinf = 1e-3\n",
        {"fluid.aperture_hinf", "above fluid.aperture_h0"}},
