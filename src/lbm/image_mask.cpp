@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cctype>
+#include <charconv>
 #include <fstream>
 #include <iterator>
 #include <string>
@@ -51,6 +52,14 @@ GreyImage read_pgm(const std::filesystem::path& path) {
   const std::size_t n = std::size_t(img.width) * std::size_t(img.height);
   img.pixels.resize(n);
   auto scale = [maxval](long v) { return std::uint8_t(std::min(255L, v * 255 / maxval)); };
+  // A value outside 0 .. maxval (a P2 file edited by hand, a 16-bit P5 with a wrong maxval) has no
+  // grey level: it used to wrap round (-5 became light, 999 dark).
+  auto check_pixel = [&](std::size_t k, long v) {
+    if (v < 0 || v > maxval)
+      throw InputError(fmt::format("'{}': pixel {} (row {}, column {}) is {}, outside 0 to the maxval {} of the header",
+                                   path.string(), k + 1, k / std::size_t(img.width) + 1, k % std::size_t(img.width) + 1, v,
+                                   maxval));
+  };
   if (magic == "P5") {
     ++i;  // the single white-space character after maxval
     const std::size_t bytes = maxval > 255 ? 2 : 1;
@@ -60,13 +69,22 @@ GreyImage read_pgm(const std::filesystem::path& path) {
     for (std::size_t k = 0; k < n; ++k) {
       const long v = bytes == 1 ? static_cast<unsigned char>(s[i + k])
                                 : 256L * static_cast<unsigned char>(s[i + 2 * k]) + static_cast<unsigned char>(s[i + 2 * k + 1]);
+      check_pixel(k, v);
       img.pixels[k] = scale(v);
     }
   } else {
     for (std::size_t k = 0; k < n; ++k) {
       const std::string t = token(s, i);
       if (t.empty()) throw InputError(fmt::format("'{}': the image has fewer than {} pixels", path.string(), n));
-      img.pixels[k] = scale(std::stol(t));
+      long v = -1;
+      const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+      if (ec != std::errc() || end != t.data() + t.size())
+        throw InputError(fmt::format("'{}': pixel {} (row {}, column {}) is '{}', not a whole number from 0 to the "
+                                     "maxval {}",
+                                     path.string(), k + 1, k / std::size_t(img.width) + 1, k % std::size_t(img.width) + 1, t,
+                                     maxval));
+      check_pixel(k, v);
+      img.pixels[k] = scale(v);
     }
   }
   return img;

@@ -218,8 +218,20 @@ class CylinderCase : public FlowCase {
       for (int y = 0; y < d.ny; ++y)
         for (int x = 0; x < d.nx; ++x)
           mask[std::size_t(x) + std::size_t(d.nx) * (std::size_t(y) + std::size_t(d.ny) * z)] = solid(x, y) ? 1 : 0;
-    front_ = probe_stencil(Vec3(c.x() - r, c.y(), zc), d.nx, d.ny, planes, mask);
-    back_ = probe_stencil(Vec3(c.x() + r, c.y(), zc), d.nx, d.ny, planes, mask);
+    try {
+      front_ = probe_stencil(Vec3(c.x() - r, c.y(), zc), d.nx, d.ny, planes, mask);
+      back_ = probe_stencil(Vec3(c.x() + r, c.y(), zc), d.nx, d.ny, planes, mask);
+    } catch (const InputError& e) {
+      // Only solid around the cylinder's front or back point: the obstacles image covers it.
+      throw InputError(fmt::format("the pressure-difference probes at the cylinder's front and back points: {}{}",
+                                   e.what(),
+                                   image_solid.empty()
+                                       ? std::string()
+                                       : fmt::format("; obstacles.image '{}' (dark pixels below obstacles.threshold) "
+                                                     "covers the cylinder's surroundings: lighten that part of the "
+                                                     "image or lower obstacles.threshold",
+                                                     image_)));
+    }
     const double kick = kick_ * u.to_lattice_velocity(u_ref());
     d.init = [this, dx, c, r, kick, box](int x, int y, int z, double&, Vec3& v) {
       v = ramp_ ? Vec3::Zero() : Vec3(units_.to_lattice_velocity(inflow((y + 0.5) * dx, box ? (z + 0.5) * dx : -1)), 0, 0);

@@ -62,6 +62,31 @@ TEST(LbmImageMask, RejectsBadFiles) {
   EXPECT_THROW(read_pgm(scratch("short.pgm")), InputError);
 }
 
+// Pixels outside 0 .. maxval, or not numbers (fuzzed 2026-11-30): -5 wrapped round to a light grey and
+// 999 to a dark one without a word, and a word ended the program with "error: stol". Each is now an
+// input error that names the pixel and its value; 16-bit P5 values above the maxval too.
+TEST(LbmImageMask, PixelsOutsideTheMaxvalAreNamed) {
+  auto message = [](const std::string& name, const std::string& text) {
+    {
+      std::ofstream f(scratch(name), std::ios::binary);
+      f << text;
+    }
+    try {
+      (void)read_pgm(scratch(name));
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(message("neg.pgm", "P2 3 1 255\n0 -5 0\n").find("pixel 2 (row 1, column 2) is -5"), std::string::npos);
+  EXPECT_NE(message("over.pgm", "P2 2 2 15\n0 0\n16 0\n").find("pixel 3 (row 2, column 1) is 16"), std::string::npos);
+  EXPECT_NE(message("word.pgm", "P2 2 1 255\n0 grey\n").find("is 'grey', not a whole number"), std::string::npos);
+  EXPECT_NE(message("frac.pgm", "P2 2 1 255\n0 2.5\n").find("is '2.5'"), std::string::npos);
+  // 16-bit binary: 0x01 0x2C = 300 above maxval 299.
+  EXPECT_NE(message("p5.pgm", std::string("P5 1 1 299\n") + char(0x01) + char(0x2C)).find("is 300"), std::string::npos);
+  EXPECT_EQ(message("ok.pgm", "P2 2 1 255\n0 255\n"), "accepted");
+}
+
 TEST(LbmImageMask, ImageCellsAreSolid) {
   GreyImage img;
   img.width = img.height = 2;
