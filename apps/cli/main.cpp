@@ -162,7 +162,6 @@ int execute(const batch::LoadedScenario& l, RunOptions opt, NewRunFolder* folder
 // never created: a driver writes nothing before begin_output.
 struct SetUpPassed {};
 
-
 void check_set_up(const batch::LoadedScenario& l) {
   RunOptions opt;
   opt.threads = omp_get_max_threads();

@@ -88,11 +88,11 @@ struct ParamOrigin {
   long line = 0;
 };
 
-// The resolved parameters of one run: scenario file + --set overrides + defaults, validated.
 // Keys every run of a driver that declares them reads, some only after the set-up (intervals,
 // summary fields): never reported as unused.
 bool read_by_every_run(const std::string& key);
 
+// The resolved parameters of one run: scenario file + --set overrides + defaults, validated.
 class Config {
  public:
   Config() = default;
