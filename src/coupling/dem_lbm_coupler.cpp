@@ -50,6 +50,13 @@ double coupled_dem_time_step(const dem::DemSystem& s, double safety) {
   for (std::size_t i = 0; i < p.size(); ++i) {
     const int pt = s.materials.pair(p.group[i], p.group[i]);
     const double k = dem::pair_stiffness(s, pt, p.radius[i], p.radius[i], 0.01 * p.radius[i]);
+    // A modulus that overflows gives inf or NaN (0 x inf), which `k > 0` and std::min would skip: the
+    // run then took the LBM step as its DEM step and the grains flew off at the first contact.
+    if (!std::isfinite(k))
+      throw InputError(fmt::format("coupling: the contact stiffness of particle {} is not finite (a contact modulus so "
+                                   "large that it overflows): lower dem.contact_modulus (sedimentation) or "
+                                   "dem.contact.*.emod",
+                                   i));
     if (k > 0 && p.inv_mass[i] > 0) dt = std::min(dt, std::sqrt(1.0 / (p.inv_mass[i] * k)));
   }
   if (!std::isfinite(dt) || !(dt > 0))

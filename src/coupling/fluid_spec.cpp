@@ -112,6 +112,15 @@ std::string FluidScales::describe() const {
 long sub_steps(double dt_lbm, double dt_dem) {
   if (!(dt_dem > 0) || !(dt_lbm > 0)) throw InputError("coupling: the LBM and DEM time steps must be positive");
   const double q = dt_lbm / dt_dem;
+  // Beyond this the count overflowed `long` (a contact modulus of 1e300: one sub-step, and the grains
+  // flew off at their first contact); long before it a run would never end.
+  constexpr double kMaxSubSteps = 1e8;
+  if (!(q <= kMaxSubSteps))
+    throw InputError(fmt::format("coupling: the DEM step {:.4g} s is {:.3g} times shorter than the LBM step {:.4g} s "
+                                 "(at most {:g} DEM sub-steps per LBM step): the contact stiffness is far too high for "
+                                 "the particles' mass (lower dem.contact_modulus in sedimentation, dem.contact.*.emod "
+                                 "elsewhere) or the LBM step far too long",
+                                 dt_dem, q, dt_lbm, kMaxSubSteps));
   long n = long(std::ceil(q));
   // dt_lbm an exact multiple of dt_dem up to round-off: no extra sub-step.
   if (n > 1 && double(n - 1) >= q * (1 - 1e-12)) --n;

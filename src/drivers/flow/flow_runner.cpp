@@ -39,8 +39,11 @@ void declare_lbm_params(ParamTable& t, const LbmDefaults& d) {
            "so a pressure drop no longer raises the density and dynamic viscosity; removes the O(Ma^2) drag error of "
            "steady flows, docs/lbm.md)")
       .one_of({"compressible", "incompressible"});
-  t.real("lbm.trt_magic", 3.0 / 16.0, "-", "TRT magic parameter Lambda (3/16 puts bounce-back walls exactly mid-link)")
-      .positive();
+  t.real("lbm.trt_magic", 3.0 / 16.0, "-",
+         "TRT magic parameter Lambda (3/16 puts bounce-back walls exactly mid-link; 1/4 the most stable; 1/12, 1/6 "
+         "cancel other errors)")
+      .positive()
+      .at_most(1);
   t.real("lbm.tau", d.tau, "-",
          "relaxation time: dt = (tau - 1/2) dx^2 / (3 nu); used when none of lbm.time_step, lbm.mach and "
          "lbm.target_error is set (set at most one of the four)")

@@ -202,6 +202,13 @@ std::vector<Bad> bad_scenarios() {
       // a kick 1e300 times the inflow: NaN at step 103, blamed on the resolution
       {"cylinder_kick_above_the_inflow", kCylinder + "cylinder.initial_perturbation = 2\n",
        {"cylinder.initial_perturbation", "[0, 1]"}},
+      // a contact modulus that overflows: the coupled DEM step skipped its NaN stiffness, took the LBM step and
+      // the disks flew off at their first contact ("moves at inf m/s", blamed on gravity)
+      {"sedimentation_contact_modulus_overflowing",
+       "driver = \"sedimentation\"\n" + kOutput + "fluid.sound_speed = 1.0\ndem.contact_modulus = 1e300\n",
+       {"dem.contact_modulus", "DEM sub-steps per LBM step"}},
+      // a TRT magic parameter of 1e300: LBM unstable at step 13,152, blamed on the resolution
+      {"trt_magic_above_one", kCavity + "lbm.trt_magic = 1e300\n", {"lbm.trt_magic", "(0, 1]"}},
       // Eq. B1 with h_inf above h0 opened the contact channels as they were squeezed (fuzzed 2026-11-30)
       {"b1_aperture_widening_under_stress", kSaturated2d + "fluid.aperture_hinf = 1e-3\n",
        {"fluid.aperture_hinf", "above fluid.aperture_h0"}},
