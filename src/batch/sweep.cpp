@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <mutex>
@@ -52,6 +53,22 @@ SweepAxis parse_vary(const std::string& option) {
     current += ch;
   }
   push();
+  // A value given twice (as written, or the same number: 0.4 and 4e-1) ran the same case twice
+  // under two names, without a word.
+  auto number = [](const std::string& v, double& x) {
+    const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), x);
+    return ec == std::errc() && end == v.data() + v.size();
+  };
+  for (std::size_t i = 0; i < axis.values.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j) {
+      double a = 0, b = 0;
+      const std::string& vi = axis.values[i];
+      const std::string& vj = axis.values[j];
+      if (vi == vj || (number(vi, a) && number(vj, b) && a == b))
+        throw InputError(fmt::format("--vary '{}': values {} and {} ('{}', '{}') are the same: each case would run "
+                                     "twice; give each value once",
+                                     option, j + 1, i + 1, vj, vi));
+    }
   return axis;
 }
 

@@ -22,7 +22,9 @@ TEST(SweepOptions, CommasInsideListsBelongToTheValue) {
 }
 
 TEST(SweepOptions, BadVaryOptionsNameTheOption) {
-  for (const char* bad : {"nokey", "=1,2", "ucs.platen_velocity=", "ucs.platen_velocity=0.1,,0.2"}) {
+  // The last two: a value given twice ran the same case twice under two names (fuzzed 2026-11-30).
+  for (const char* bad : {"nokey", "=1,2", "ucs.platen_velocity=", "ucs.platen_velocity=0.1,,0.2",
+                          "sample.porosity=0.4,0.4", "ucs.platen_velocity=0.1,0.2,1e-1"}) {
     try {
       parse_vary(bad);
       FAIL() << bad;
