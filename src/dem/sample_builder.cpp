@@ -529,7 +529,17 @@ SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
   rmean /= static_cast<Real>(P.size());
   sys.settings.skin = cfg.real("sample.genesis_tolerance") > 0 ? cfg.real("dem.skin_ratio") * rmean : 0;
   sys.initialise();
-  sys.settings.dt = 0.8 * critical_time_step(sys);
+  // A density so small that the masses underflow (1e-300 kg/m^3), or a contact modulus that
+  // overflows, gives no step: the packing went NaN at step 0, advised to lower the time step.
+  auto genesis_step = [&] {
+    const Real dt = 0.8 * critical_time_step(sys);
+    if (!(dt > 0) || !std::isfinite(dt))
+      throw InputError(fmt::format("{}: the genesis's time step is {:g}: a particle's mass is 0 or its contact "
+                                   "stiffness is not finite; check dem.group.*.density and dem.contact.*.emod",
+                                   cfg.scenario_name(), dt));
+    return dt;
+  };
+  sys.settings.dt = genesis_step();
   const Real tol = cfg.real("sample.genesis_tolerance");
   const long max_steps = cfg.integer("sample.genesis_max_steps");
   const Real target = cfg.real("sample.locked_in_stress");
@@ -552,7 +562,7 @@ SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
         P.set_mass_from_density(i, sys.materials.density[P.group[i]], dim);
       }
       sys.rebuild_neighbors();
-      sys.settings.dt = 0.8 * critical_time_step(sys);
+      sys.settings.dt = genesis_step();
     }
     steps += equilibrate(sys, tol, max_steps, floor, ratio, progress);
     p = mean_stress(sys, info.volume, dim);

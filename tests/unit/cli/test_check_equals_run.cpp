@@ -202,6 +202,11 @@ std::vector<Bad> bad_scenarios() {
       // a kick 1e300 times the inflow: NaN at step 103, blamed on the resolution
       {"cylinder_kick_above_the_inflow", kCylinder + "cylinder.initial_perturbation = 2\n",
        {"cylinder.initial_perturbation", "[0, 1]"}},
+      // masses that underflow: the packing went NaN at step 0 with "the time step 0 s is too large"
+      {"density_underflowing_the_masses",
+       "driver = \"ucs\"\n" + kOutput + "dem.group.rock.density = 1e-300\n" + kRock.substr(kRock.find('\n') + 1) +
+           "sample.diameter = 5e-3\nsample.height = 10e-3\n",
+       {"dem.group.*.density", "genesis's time step is 0"}},
       // a contact modulus that overflows: the coupled DEM step skipped its NaN stiffness, took the LBM step and
       // the disks flew off at their first contact ("moves at inf m/s", blamed on gravity)
       {"sedimentation_contact_modulus_overflowing",
