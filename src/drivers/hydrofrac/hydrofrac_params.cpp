@@ -306,6 +306,13 @@ void validate_scenario(const Config& cfg) {
              fmt::format("the hole and its perforations reach {} m from the axis; keep that below 0.35 x the block's smaller "
                          "side ({} m) so that the block is much larger than the hole",
                          reach, lmin));
+  // A slot wider than the hole it starts from (2e9 m was taken): a cut through the block, not a
+  // perforation.
+  if (cfg.real("borehole.perforation_length") > 0 && cfg.real("borehole.perforation_width") > 2 * R)
+    cfg.fail("borehole.perforation_width",
+             fmt::format("{} m is wider than the hole (diameter {} m): a perforation is a slot narrower than the "
+                         "borehole; 0 gives 2 sample.radius_max",
+                         cfg.real("borehole.perforation_width"), 2 * R));
   // Ramp mode: a breakdown length the fracture cannot reach before the run stops at stop_extent of the
   // way to the faces left the breakdown pressure null for ever (1 m in a 38 mm block).
   const Real gap = 0.5 * lmin - R, bd = cfg.real("injection.breakdown_length") > 0 ? cfg.real("injection.breakdown_length") : R;

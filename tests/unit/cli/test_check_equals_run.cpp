@@ -202,6 +202,10 @@ std::vector<Bad> bad_scenarios() {
       // a kick 1e300 times the inflow: NaN at step 103, blamed on the resolution
       {"cylinder_kick_above_the_inflow", kCylinder + "cylinder.initial_perturbation = 2\n",
        {"cylinder.initial_perturbation", "[0, 1]"}},
+      // a perforation slot 2e9 m wide (fuzzed 2026-11-30)
+      {"perforation_wider_than_the_hole",
+       kHydrofracBlock2d + "borehole.perforation_length = 1e-3\nborehole.perforation_width = 2147483648\n",
+       {"borehole.perforation_width", "wider than the hole"}},
       // masses that underflow: the packing went NaN at step 0 with "the time step 0 s is too large"
       {"density_underflowing_the_masses",
        "driver = \"ucs\"\n" + kOutput + "dem.group.rock.density = 1e-300\n" + kRock.substr(kRock.find('\n') + 1) +
