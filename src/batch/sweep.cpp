@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <mutex>
@@ -15,6 +14,7 @@
 #include "core/error.hpp"
 #include "core/interrupt.hpp"
 #include "core/log.hpp"
+#include "io/csv.hpp"
 #include "io/json_out.hpp"
 #include "io/plot.hpp"
 #include "io/run_folder.hpp"
@@ -55,16 +55,11 @@ SweepAxis parse_vary(const std::string& option) {
   push();
   // A value given twice (as written, or the same number: 0.4 and 4e-1) ran the same case twice
   // under two names, without a word.
-  auto number = [](const std::string& v, double& x) {
-    const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), x);
-    return ec == std::errc() && end == v.data() + v.size();
-  };
   for (std::size_t i = 0; i < axis.values.size(); ++i)
     for (std::size_t j = 0; j < i; ++j) {
-      double a = 0, b = 0;
       const std::string& vi = axis.values[i];
       const std::string& vj = axis.values[j];
-      if (vi == vj || (number(vi, a) && number(vj, b) && a == b))
+      if (vi == vj || to_number(vi) == to_number(vj))  // NaN (not a number) equals nothing
         throw InputError(fmt::format("--vary '{}': values {} and {} ('{}', '{}') are the same: each case would run "
                                      "twice; give each value once",
                                      option, j + 1, i + 1, vj, vi));

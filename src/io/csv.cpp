@@ -48,14 +48,6 @@ std::vector<std::string_view> split(std::string_view line) {
   }
 }
 
-double to_number(std::string_view cell) {
-  if (!cell.empty() && cell.front() == '+') cell.remove_prefix(1);  // from_chars rejects a leading '+'
-  double v = std::numeric_limits<double>::quiet_NaN();
-  auto [end, ec] = std::from_chars(cell.data(), cell.data() + cell.size(), v);
-  if (ec != std::errc() || end != cell.data() + cell.size()) return std::numeric_limits<double>::quiet_NaN();
-  return v;
-}
-
 bool skipped(std::string_view line) {
   const auto t = trim(line);
   return t.empty() || t.front() == '#';
@@ -70,6 +62,14 @@ std::string slurp(const std::filesystem::path& path) {
 }
 
 }  // namespace
+
+double to_number(std::string_view cell) {
+  if (!cell.empty() && cell.front() == '+') cell.remove_prefix(1);  // from_chars rejects a leading '+'
+  double v = std::numeric_limits<double>::quiet_NaN();
+  auto [end, ec] = std::from_chars(cell.data(), cell.data() + cell.size(), v);
+  if (ec != std::errc() || end != cell.data() + cell.size()) return std::numeric_limits<double>::quiet_NaN();
+  return v;
+}
 
 // ---------------------------------------------------------------- CsvWriter
 

@@ -63,5 +63,7 @@ struct CsvTable {
 CsvTable read_csv(const std::filesystem::path& path);
 // Same, from text already in memory; `source` names it in errors.
 CsvTable parse_csv(std::string_view text, const std::string& source);
+// The whole of `cell` as a number (a leading '+' allowed); NaN when it is not one.
+double to_number(std::string_view cell);
 
 }  // namespace ff
