@@ -177,18 +177,23 @@ DemSettings build_settings(const Config& cfg) {
   return s;
 }
 
+Real checked_critical_time_step(const Config& cfg, const DemSystem& sys, std::string_view what,
+                                std::span<const Real> extra_stiffness) {
+  const Real crit = critical_time_step(sys, extra_stiffness);
+  if (!(crit > 0))
+    throw InputError(fmt::format(
+        "{}: the {} is 0: the sample's contact or bond stiffness is not finite (a modulus, or a parallel bond's "
+        "section, so large that k = E A / L overflows) or a particle's mass is 0; check dem.contact.*.emod, "
+        "dem.bond.*.emod, dem.bond.*.radius_multiplier, dem.bond.*.youngs_modulus and dem.group.*.density{}",
+        cfg.scenario_name(), what, extra_stiffness.empty() ? "" : ", and the coupled fluid's stiffness"));
+  return crit;
+}
+
 void choose_time_step(const Config& cfg, DemSystem& sys, std::span<const Real> extra_stiffness) {
   const Real safety = cfg.real("dem.time_step_safety");
   const Real dt_user = cfg.real("dem.time_step");
-  const Real crit = critical_time_step(sys, extra_stiffness);
+  const Real crit = checked_critical_time_step(cfg, sys, "critical time step", extra_stiffness);
   const char* with = extra_stiffness.empty() ? "" : " with the coupled fluid's stiffness";
-  if (!(crit > 0))
-    throw InputError(fmt::format(
-        "{}: the critical time step is 0: the sample's contact or bond stiffness is not finite (a modulus, or a "
-        "parallel bond's section, so large that k = E A / L overflows) or a particle's mass is 0; check "
-        "dem.contact.*.emod, dem.bond.*.emod, dem.bond.*.radius_multiplier, dem.bond.*.youngs_modulus and "
-        "dem.group.*.density{}",
-        cfg.scenario_name(), extra_stiffness.empty() ? "" : ", and the coupled fluid's stiffness"));
   if (dt_user <= 0) {
     sys.settings.dt = safety * crit;
   } else if (cfg.boolean("dem.mass_scaling")) {

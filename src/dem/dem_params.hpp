@@ -20,6 +20,11 @@ DemSettings build_settings(const Config& cfg);
 // on, which then scales inertial masses), else dem.time_step_safety x critical. The critical step
 // counts `extra_stiffness` (critical_time_step's: what a coupled physics module adds per particle).
 void choose_time_step(const Config& cfg, DemSystem& sys, std::span<const Real> extra_stiffness = {});
+// critical_time_step, refused (InputError naming the stiffness and density keys) when it is 0: a
+// stiffness that overflows (inf, or NaN from 0 x inf) or a mass that underflows. `what` names the
+// step in the message ("critical time step", "genesis's time step").
+Real checked_critical_time_step(const Config& cfg, const DemSystem& sys, std::string_view what,
+                                std::span<const Real> extra_stiffness = {});
 // A boundary (platen, grip, servo wall) that moves a good part of a grain in one step is an impact:
 // its contacts jump through each other. Largest travel per time step, as a fraction of the smallest radius.
 constexpr double kMaxWallStep = 0.05;

@@ -531,14 +531,7 @@ SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
   sys.initialise();
   // A density so small that the masses underflow (1e-300 kg/m^3), or a contact modulus that
   // overflows, gives no step: the packing went NaN at step 0, advised to lower the time step.
-  auto genesis_step = [&] {
-    const Real dt = 0.8 * critical_time_step(sys);
-    if (!(dt > 0) || !std::isfinite(dt))
-      throw InputError(fmt::format("{}: the genesis's time step is {:g}: a particle's mass is 0 or its contact "
-                                   "stiffness is not finite; check dem.group.*.density and dem.contact.*.emod",
-                                   cfg.scenario_name(), dt));
-    return dt;
-  };
+  auto genesis_step = [&] { return 0.8 * checked_critical_time_step(cfg, sys, "genesis's time step"); };
   sys.settings.dt = genesis_step();
   const Real tol = cfg.real("sample.genesis_tolerance");
   const long max_steps = cfg.integer("sample.genesis_max_steps");
