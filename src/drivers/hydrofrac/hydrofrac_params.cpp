@@ -73,7 +73,8 @@ void declare_params(ParamTable& t) {
   t.real("network.b2_gamma", 0.02, "-",
          "network, 2D: factor of the geometric pore-to-pore aperture (Eq. B2; 1 = the free gap between the grains: a "
          "permeable packing; 0.02: a tight rock the fluid penetrates over a few grains during the ramp)")
-      .positive();
+      .positive()
+      .at_most(1);
   t.real("network.throat_factor", 1e-7, "-",
          "network, 3D: factor on the throats' geometric (PFV) conductance: 1 = the packing's own throats, through which "
          "the whole block fills within a few DEM steps; 1e-7: a tight rock the fluid penetrates over a few grains")

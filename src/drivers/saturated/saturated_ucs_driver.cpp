@@ -71,7 +71,10 @@ void declare(ParamTable& t) {
       .fallback();
   t.real("fluid.aperture_hinf", 1e-7, "m", "2D: Eq. B1 aperture at infinite normal stress").positive()
       .fallback();
-  t.real("fluid.aperture_gamma", 0.01, "-", "2D: Eq. B2 reduction factor of pore-to-pore channel apertures").positive()
+  t.real("fluid.aperture_gamma", 0.01, "-",
+         "2D: Eq. B2 reduction factor of pore-to-pore channel apertures (1: the free gap between the grains)")
+      .positive()
+      .at_most(1)
       .fallback();
   t.real("fluid.pfv_factor", 1.0, "-",
          "3D: factor on the PFV throat conductance A_f R_h^2 / (2 mu L) (Chareyre et al. 2012; < 1: tighter, "

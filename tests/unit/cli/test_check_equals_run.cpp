@@ -224,6 +224,11 @@ std::vector<Bad> bad_scenarios() {
       {"network_b1_aperture_widening_under_stress",
        kHydrofrac2d + "injection.fluid = \"network\"\nnetwork.aperture_hinf = 1e-3\n",
        {"network.aperture_hinf", "above network.aperture_h0"}},
+      // Eq. B2's gamma is a reduction factor (seed 004): above 1 a pore-to-pore channel was wider than the gap
+      // between its grains (2^31: wider than the block), taken without a word (session 48)
+      {"b2_reduction_factor_above_one", kSaturated2d + "fluid.aperture_gamma = 2\n", {"fluid.aperture_gamma", "(0, 1]"}},
+      {"network_b2_reduction_factor_above_one",
+       kHydrofrac2d + "injection.fluid = \"network\"\nnetwork.b2_gamma = 2147483648\n", {"network.b2_gamma", "(0, 1]"}},
       // the run started at a pressure past its stop: NaN grains, blamed on the DEM step
       {"injection_starting_past_its_stop",
        kHydrofrac2d + "injection.initial_pressure = 1e300\n",
