@@ -183,8 +183,9 @@ Real checked_critical_time_step(const Config& cfg, const DemSystem& sys, std::st
   if (!(crit > 0))
     throw InputError(fmt::format(
         "{}: the {} is 0: the sample's contact or bond stiffness is not finite (a modulus, or a parallel bond's "
-        "section, so large that k = E A / L overflows) or a particle's mass is 0; check dem.contact.*.emod, "
-        "dem.bond.*.emod, dem.bond.*.radius_multiplier, dem.bond.*.youngs_modulus and dem.group.*.density{}",
+        "section, so large that k = E A / L overflows, or a normal-to-shear ratio kn/ks so small that ks does) or a "
+        "particle's mass is 0; check dem.contact.*.emod, dem.contact.*.kratio, dem.contact.*.nu_c, dem.bond.*.emod, "
+        "dem.bond.*.kratio, dem.bond.*.radius_multiplier, dem.bond.*.youngs_modulus and dem.group.*.density{}",
         cfg.scenario_name(), what, extra_stiffness.empty() ? "" : ", and the coupled fluid's stiffness"));
   return crit;
 }

@@ -159,7 +159,7 @@ Real critical_time_step(const DemSystem& s, std::span<const Real> extra_stiffnes
     const int pt = materials.pair(grp[a], grp[b]);
     const Real k = pair_stiffness(s, pt, r[a], r[b], -gap);
     kt[a] += k; kt[b] += k;
-    kr[a] += k * r[a] * r[a]; kr[b] += k * r[b] * r[b];  // shear springs' lever arms (ks <= kn)
+    kr[a] += k * r[a] * r[a]; kr[b] += k * r[b] * r[b];  // shear springs' lever arms (k >= ks)
   }
   const BondSet& bs = s.bonds;
   materials.with_bond_law([&]<class Law>(std::type_identity<Law>) {

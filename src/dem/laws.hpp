@@ -11,7 +11,7 @@
 //   L::elastic(E, nu)                       Params of an elastic material (particle membrane), fric 0;
 //   L::force(p, g, state, dt, dim, fn)      force on B;
 //   L::normal_stiffness_at(p, rA, rB, overlap, dim)   kn at this overlap (dashpot, walls, membrane);
-//   L::time_step_stiffness(p, rA, rB, overlap, dim)   kn for the critical time step;
+//   L::time_step_stiffness(p, rA, rB, overlap, dim)   max(kn, ks) for the critical time step;
 //   L::normal_force(p, rA, rB, overlap, dim)          |Fn| at this overlap (genesis);
 //   L::strain_energy(p, rA, rB, overlap, state, dim)  energy stored in the contact [J].
 // A bond law `B` provides (see parallel_bond.hpp):

@@ -82,8 +82,9 @@ struct CohesiveContact {
   static Real normal_stiffness_at(const Params& p, Real rA, Real rB, Real, int) {
     return cohesive::normal_stiffness(p.ec, rA, rB);
   }
+  // The stiffer of Kn and Ks = nu_c Kn (nu_c > 1: the shear spring).
   static Real time_step_stiffness(const Params& p, Real rA, Real rB, Real, int) {
-    return cohesive::normal_stiffness(p.ec, rA, rB);
+    return cohesive::normal_stiffness(p.ec, rA, rB) * std::max(Real(1), p.nu_c);
   }
   static Real normal_force(const Params& p, Real rA, Real rB, Real overlap, int) {
     return cohesive::normal_stiffness(p.ec, rA, rB) * overlap;
@@ -220,7 +221,7 @@ struct CohesiveBond {
   }
   // The bond adds at most Kn (tension, when the contact is open) or Ks to a pair.
   static void time_step_stiffness(const Material& m, const State&, Real rA, Real rB, int, Real& k, Real& krot) {
-    k = cohesive::normal_stiffness(m.ec, rA, rB);
+    k = cohesive::normal_stiffness(m.ec, rA, rB) * std::max(Real(1), m.nu_c);
     krot = 0;
   }
   static Real crack_size(const Material&, Real rA, Real rB, int) { return std::min(rA, rB); }

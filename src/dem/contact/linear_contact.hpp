@@ -40,8 +40,9 @@ struct LinearContact {
   static Real normal_stiffness_at(const Params& p, Real rA, Real rB, Real /*overlap*/, int dim) {
     return normal_stiffness(p, rA, rB, dim);
   }
+  // The stiffer of the two springs: kratio < 1 makes ks = kn / kratio the larger one.
   static Real time_step_stiffness(const Params& p, Real rA, Real rB, Real /*overlap*/, int dim) {
-    return normal_stiffness(p, rA, rB, dim);
+    return normal_stiffness(p, rA, rB, dim) * std::max(Real(1), 1 / p.kratio);
   }
   static Real normal_force(const Params& p, Real rA, Real rB, Real overlap, int dim) {
     return normal_stiffness(p, rA, rB, dim) * overlap;

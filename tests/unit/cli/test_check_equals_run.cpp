@@ -211,6 +211,10 @@ std::vector<Bad> bad_scenarios() {
        "driver = \"ucs\"\n" + kOutput + "dem.group.rock.density = 1e-300\n" + kRock.substr(kRock.find('\n') + 1) +
            "sample.diameter = 5e-3\nsample.height = 10e-3\n",
        {"dem.group.*.density", "genesis's time step is 0"}},
+      // kn/ks = 1e-300: the shear spring's stiffness overflows; the critical step counted kn alone and the
+      // sample went NaN at step 0 with the advice to lower dem.time_step_safety (fuzzed, session 48)
+      {"contact_shear_spring_overflowing", kUcs2d + "dem.contact.rock-rock.kratio = 1e-300\n",
+       {"dem.contact.*.kratio", "time step is 0"}},
       // a contact modulus that overflows: the coupled DEM step skipped its NaN stiffness, took the LBM step and
       // the disks flew off at their first contact ("moves at inf m/s", blamed on gravity)
       {"sedimentation_contact_modulus_overflowing",

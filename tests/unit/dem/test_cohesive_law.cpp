@@ -183,3 +183,17 @@ TEST(CohesiveLaw, ScenarioSharesTheContactTable) {
 }
 
 }  // namespace
+
+// The critical time step counts the stiffer spring: Kn, or Ks = nu_c Kn when nu_c > 1 (A3). Before
+// (session 48) the contact and the bond gave Kn alone, so nu_c = 100 ran at 10x the stable step.
+TEST(CohesiveLaw, TimeStepStiffnessIsTheStifferSpring) {
+  for (Real nu : {0.2, 1.0, 3.0, 100.0}) {
+    const CohesiveContact::Params cp{kEc, nu, kFric};
+    const Real want = kKn * std::max(1.0, nu);
+    EXPECT_NEAR(CohesiveContact::time_step_stiffness(cp, kRA, kRB, 0, 2), want, kTol * want) << nu;
+    const CohesiveBond::Material bm{kEc, nu, kFric, kC, kT};
+    Real k = 0, krot = 0;
+    CohesiveBond::time_step_stiffness(bm, CohesiveBond::State{}, kRA, kRB, 2, k, krot);
+    EXPECT_NEAR(k, want, kTol * want) << nu;
+  }
+}

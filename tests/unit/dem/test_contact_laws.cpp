@@ -271,6 +271,49 @@ TEST(TwoSphereContact, ForceEqualsClosedFormAndIsEqualAndOpposite) {
   }
 }
 
+TEST(TwoSphereContact, CriticalStepCountsAShearSpringStifferThanTheNormalOne) {
+  // kratio = kn/ks < 1 makes the shear spring the stiffer one (ks = 100 kn here). The critical step
+  // must bound it: min(sqrt(m/ks), sqrt(I/(ks r^2))) (METHODS.md 1.6 with the stiffest spring), and
+  // the shear spring's oscillation during a slow collision, run at 0.8 of that step, must stay
+  // bounded (its energy is the bodies' initial kinetic energy). Before (session 48, fuzzed:
+  // `dem.contact.*.kratio = 1e-300` ended in NaN at step 0 with the advice to lower the safety
+  // factor) the step counted kn alone, 10x too long here, and the velocities grew 1e30-fold.
+  const Real kratio = 0.01;
+  const auto p = linear_params(5e9, kratio, 1e12);  // friction high enough that the contact never slips
+  const Real rA = 1e-3, rB = 1.5e-3, delta = 1e-11;
+  for (int dim : {3, 2}) {
+    DemSystem s = two_bodies(dim, rA, rB, Vec3::Zero(), Vec3(rA + rB - delta, 0, 0), p);
+    const Real ks = LinearContact::normal_stiffness(p, rA, rB, dim) / kratio;
+    const Real dt_hand = std::min({std::sqrt(s.particles.mass[0] / ks), std::sqrt(s.particles.mass[1] / ks),
+                                   std::sqrt(s.particles.inertia[0] / (ks * rA * rA)),
+                                   std::sqrt(s.particles.inertia[1] / (ks * rB * rB))});
+    const Real dt = critical_time_step(s);
+    EXPECT_NEAR(dt, dt_hand, 1e-12 * dt_hand) << "dim " << dim;
+    s.settings.dt = 0.8 * dt;
+    const Real v0 = 1e-3;  // approach along x, slide along y
+    s.particles.vel[0] = Vec3(v0, 0, 0);
+    s.particles.vel[1] = Vec3(-v0, v0, 0);
+    const auto kinetic = [&s] {
+      Real e = 0;
+      for (int i = 0; i < 2; ++i)
+        e += 0.5 * (s.particles.mass[i] * s.particles.vel[i].squaredNorm() +
+                    s.particles.inertia[i] * s.particles.omega[i].squaredNorm());
+      return e;
+    };
+    const Real e0 = kinetic();
+    long touching_steps = 0;
+    for (int k = 0; k < 2000; ++k) {
+      s.step();
+      touching_steps += contacts_touching(s);
+    }
+    EXPECT_GT(touching_steps, 20) << "dim " << dim;  // the shear spring worked for many steps
+    EXPECT_EQ(contacts_touching(s), 0) << "dim " << dim;  // and the bodies parted again
+    // with the energy they had (elastic, no damping), up to the leapfrog's error near its stability limit
+    // (+1.1 % in 2D; an unstable step multiplies it by orders of magnitude)
+    EXPECT_LT(kinetic(), 1.05 * e0) << "dim " << dim;
+  }
+}
+
 TEST(TwoSphereContact, HeadOnCollisionRestitutionAndDuration) {
   // Head-on collision of two equal spheres with the linear spring (and optional normal dashpot,
   // zeta = fraction of critical damping with m* = m/2): the closed form of the damped oscillator
