@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <string_view>
 
 #include "core/error.hpp"
@@ -190,6 +192,52 @@ Real checked_critical_time_step(const Config& cfg, const DemSystem& sys, std::st
   return crit;
 }
 
+// The critical step counts the contacts that touch now; a bonded sample with a bond gap has few, and a
+// pair of groups may have none yet. A contact of such a pair that would be unstable alone at the chosen
+// step makes the run blow up when the first one forms, with advice about the safety factor: say so
+// now. Checked per pair of groups present, between each group's lightest particles (the shortest
+// period), with the same bound as critical_time_step.
+namespace {
+void check_contacts_to_come(const Config& cfg, const DemSystem& sys) {
+  const auto& P = sys.particles;
+  const auto& M = sys.materials;
+  const int ng = M.groups();
+  std::vector<Index> lightest(static_cast<std::size_t>(ng), -1);
+  for (std::size_t i = 0; i < P.size(); ++i) {  // the largest inverse mass (masses may be scaled)
+    Index& l = lightest[static_cast<std::size_t>(P.group[i])];
+    if (l < 0 || P.inv_mass[i] > P.inv_mass[l]) l = static_cast<Index>(i);
+  }
+  const Real dt = sys.settings.dt;
+  for (int a = 0; a < ng; ++a) {
+    for (int b = a; b < ng; ++b) {
+      const Index i = lightest[static_cast<std::size_t>(a)], j = lightest[static_cast<std::size_t>(b)];
+      if (i < 0 || j < 0) continue;
+      const Real ri = P.radius[i], rj = P.radius[j];
+      const Real k = pair_stiffness(sys, M.pair(a, b), ri, rj, 0.01 * std::min(ri, rj));
+      Real bound = std::numeric_limits<Real>::infinity();
+      for (const Index p : {i, j})
+        bound = std::min({bound, std::sqrt(1 / (P.inv_mass[p] * k)),
+                          std::sqrt(1 / (P.inv_inertia[p] * k * P.radius[p] * P.radius[p]))});
+      const std::string &ga = M.group_names[a], &gb = M.group_names[b];
+      std::string table = fmt::format("dem.contact.{}-{}", ga, gb);  // as the scenario spells it
+      for (const auto& n : cfg.names("dem.contact"))
+        if (n == gb + "-" + ga) table = "dem.contact." + n;
+      if (!std::isfinite(k) || !(bound > 0))
+        throw InputError(fmt::format(
+            "{}: a contact of the group pair {}-{} allows no time step: its stiffness overflows (table [{}]: check "
+            "its modulus, emod, ec or shear_modulus, and its kratio or nu_c)",
+            cfg.scenario_name(), ga, gb, table));
+      if (dt > bound)
+        log::warn("{}: one contact between the lightest particles of groups {} and {} is stable only below {:.3g} s "
+                  "and the time step is {:.3g} s; none touches now (the critical step counts the contacts that do), "
+                  "so the run will go unstable once one forms: lower the stiffness in [{}], or set dem.time_step "
+                  "below {:.3g} s",
+                  cfg.scenario_name(), ga, gb, bound, dt, table, bound);
+    }
+  }
+}
+}  // namespace
+
 void choose_time_step(const Config& cfg, DemSystem& sys, std::span<const Real> extra_stiffness) {
   const Real safety = cfg.real("dem.time_step_safety");
   const Real dt_user = cfg.real("dem.time_step");
@@ -210,6 +258,7 @@ void choose_time_step(const Config& cfg, DemSystem& sys, std::span<const Real> e
   }
   log::info("time step {:.4g} s (critical {:.4g} s{}{})", sys.settings.dt, crit, with,
             cfg.boolean("dem.mass_scaling") && dt_user > 0 ? ", inertial masses scaled" : "");
+  check_contacts_to_come(cfg, sys);
 }
 
 void refuse_wall_jump(const Config& cfg, const std::string& key, const DemSystem& sys, std::string_view wall,
