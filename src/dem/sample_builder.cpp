@@ -71,16 +71,22 @@ void declare_sample_params(ParamTable& t) {
 
 namespace {
 
+// The regions' names in [[sample.region]] order (0, 1, ..., 10: by length, then text).
+std::vector<std::string> sorted_region_names(const Config& cfg) {
+  auto names = cfg.names("sample.region");
+  std::sort(names.begin(), names.end(), [](const std::string& a, const std::string& b) {
+    return a.size() != b.size() ? a.size() < b.size() : a < b;
+  });
+  return names;
+}
+
 std::vector<Region> read_regions(const Config& cfg, const Materials& mat, std::vector<int>& region_group) {
   std::vector<Region> regions;
-  auto names = cfg.names("sample.region");
+  auto names = sorted_region_names(cfg);
   if (names.size() > kMaxRegions)
     throw InputError(fmt::format("{}: the scenario has {} [[sample.region]] entries; the limit is {} (every particle is "
                                  "tested against every region; merge inclusions into one STL surface)",
                                  cfg.scenario_name(), names.size(), kMaxRegions));
-  std::sort(names.begin(), names.end(), [](const std::string& a, const std::string& b) {
-    return a.size() != b.size() ? a.size() < b.size() : a < b;  // [[sample.region]] order
-  });
   const std::filesystem::path base = std::filesystem::path(cfg.scenario_name()).parent_path();
   for (auto& n : names) {
     const std::string k = "sample.region." + n + ".";
@@ -455,7 +461,17 @@ SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
   // Groups: default, then regions (the last containing region wins), then voxel windows.
   std::vector<int> region_group;
   const auto regions = read_regions(cfg, sys.materials, region_group);
-  auto groups = geom::assign_groups(pk.position, regions, region_group, default_group(cfg, sys.materials));
+  std::vector<std::size_t> assigned;
+  auto groups = geom::assign_groups(pk.position, regions, region_group, default_group(cfg, sys.materials), &assigned);
+  // A region in the wrong place or units (mm for m) would leave its inclusion out without a word.
+  const auto region_names = sorted_region_names(cfg);
+  for (std::size_t k = 0; k < assigned.size(); ++k)
+    if (assigned[k] == 0)
+      log::warn("sample.region.{} (group '{}', {}): no particle centre took its group: it lies outside the sample, "
+                "holds no centre (smaller than a particle) or later regions cover it; check its position and size "
+                "(in m)",
+                region_names[k], sys.materials.group_names[static_cast<std::size_t>(region_group[k])],
+                cfg.string("sample.region." + region_names[k] + ".shape"));
   constexpr int kUnlabelled = -2;
   if (!voxels.empty()) {
     const auto label = geom::label_points(voxels.image, pk.position, voxels.windows, kUnlabelled);

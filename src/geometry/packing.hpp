@@ -80,9 +80,11 @@ struct Packing {
 Packing dense_random_packing(const PackingSpec& spec);
 
 // Material group of each centre: region_group[k] for the last region k containing it, else
-// default_group. Throws ff::InputError if the two spans differ in length.
+// default_group. Throws ff::InputError if the two spans differ in length. With `assigned`, its
+// k-th entry is the number of centres region k gave its group to.
 std::vector<int> assign_groups(std::span<const Vec3> centres, std::span<const Region> regions,
-                               std::span<const int> region_group, int default_group);
+                               std::span<const int> region_group, int default_group,
+                               std::vector<std::size_t>* assigned = nullptr);
 
 }  // namespace ff::geom
 

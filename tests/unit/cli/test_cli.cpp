@@ -141,8 +141,9 @@ TEST(Cli, KeysTheScenarioDoesNotUseAreNamed) {
 // the critical step counts only touching contacts, so a rock-inclusion contact far stiffer than the
 // rest went unstable when the first one formed (session 48: ucs_c1_voxels with that modulus at 1e13
 // "peaked" at 60.9 MPa at 0.009 % strain with 5,305 cracks, no word). Now `check` (as `run`) warns,
-// naming the table as the scenario spells it; an overflowing one is refused.
-TEST(Cli, ContactsThatDoNotTouchYetAreCheckedForTheTimeStep) {
+// naming the table as the scenario spells it; an overflowing one is refused. A region that gives its
+// group to no particle is warned about.
+TEST(Cli, InclusionsAreCheckedForTheirTimeStepAndPlace) {
   const auto f = write("two_groups",
                        "driver = \"ucs\"\noutput.vtk = false\noutput.plots = false\ndem.dim = 2\n"
                        "dem.group.rock.density = 2600\ndem.group.incl.density = 2600\n"
@@ -161,6 +162,12 @@ TEST(Cli, ContactsThatDoNotTouchYetAreCheckedForTheTimeStep) {
   EXPECT_EQ(stiff.code, 0) << stiff.output;
   EXPECT_NE(stiff.output.find(warning), std::string::npos) << stiff.output;
   EXPECT_NE(stiff.output.find("[dem.contact.rock-incl]"), std::string::npos) << stiff.output;
+  // The same inclusion in millimetres where metres are meant: it holds no particle (session 48: taken silently).
+  const std::string empty = "sample.region.core (group 'incl', sphere): no particle centre took its group";
+  EXPECT_EQ(plain.output.find(empty), std::string::npos) << plain.output;
+  const auto mm = run("check " + f.string() + " --set 'sample.region.core.center=[3, 6, 0]'");
+  EXPECT_EQ(mm.code, 0) << mm.output;
+  EXPECT_NE(mm.output.find(empty), std::string::npos) << mm.output;
   const auto inf = run("check " + f.string() + " --set dem.contact.rock-incl.emod=1e300");
   EXPECT_EQ(inf.code, 2) << inf.output;
   EXPECT_NE(inf.output.find("allows no time step"), std::string::npos) << inf.output;

@@ -96,7 +96,13 @@ TEST(Shapes, AssignGroupsLastRegionWins) {
   EXPECT_EQ(assign_groups(centres, regions, groups, 0), (std::vector<int>{9, 7, 0}));
   const std::vector<int> reversed_groups = {9, 7};
   const std::vector<Region> reversed = {regions[1], regions[0]};
-  EXPECT_EQ(assign_groups(centres, reversed, reversed_groups, -1), (std::vector<int>{7, 7, -1}));
+  // How many centres each region gave its group to: the sphere inside the box, listed first, gives
+  // none (the sample builder warns about such a region).
+  std::vector<std::size_t> assigned;
+  EXPECT_EQ(assign_groups(centres, reversed, reversed_groups, -1, &assigned), (std::vector<int>{7, 7, -1}));
+  EXPECT_EQ(assigned, (std::vector<std::size_t>{0, 2}));
+  assign_groups(centres, regions, groups, 0, &assigned);
+  EXPECT_EQ(assigned, (std::vector<std::size_t>{1, 1}));
   const std::vector<int> too_few = {1};
   EXPECT_THROW(assign_groups(centres, regions, too_few, 0), InputError);
 }
