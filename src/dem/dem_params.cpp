@@ -259,6 +259,7 @@ void choose_time_step(const Config& cfg, DemSystem& sys, std::span<const Real> e
   log::info("time step {:.4g} s (critical {:.4g} s{}{})", sys.settings.dt, crit, with,
             cfg.boolean("dem.mass_scaling") && dt_user > 0 ? ", inertial masses scaled" : "");
   check_contacts_to_come(cfg, sys);
+  refuse_gravity_jump(cfg, sys);
 }
 
 void refuse_wall_jump(const Config& cfg, const std::string& key, const DemSystem& sys, std::string_view wall,
@@ -270,6 +271,17 @@ void refuse_wall_jump(const Config& cfg, const std::string& key, const DemSystem
     cfg.fail(key, fmt::format("{:.4g} m/s moves the {} {:.3g} m in one time step ({:.4g} s), {:.3g} of the smallest "
                               "particle radius ({:.4g} m); the limit is {}: {}",
                               v, wall, v * dt, dt, v * dt / r_min, r_min, kMaxWallStep, usual));
+}
+
+void refuse_gravity_jump(const Config& cfg, const DemSystem& sys) {
+  const auto& r = sys.particles.radius;
+  if (r.empty()) return;
+  const Real g = sys.settings.gravity.stableNorm(), dt = sys.settings.dt, r_min = *std::min_element(r.begin(), r.end());
+  if (g * dt * dt > kMaxWallStep * r_min)
+    cfg.fail("dem.gravity", fmt::format("|g| = {:.4g} m/s^2 moves a grain at rest {:.3g} m in one time step ({:.4g} s), "
+                                        "{:.3g} of the smallest particle radius ({:.4g} m); the limit is {}: the grains "
+                                        "would fall through each other (Earth: 9.81; a centrifuge: a few hundred g)",
+                                        g, g * dt * dt, dt, g * dt * dt / r_min, r_min, kMaxWallStep));
 }
 
 }  // namespace ff::dem

@@ -32,5 +32,8 @@ constexpr double kMaxWallStep = 0.05;
 // kMaxWallStep x the smallest radius in one of sys's time steps; `usual` ends the message (what is usual).
 void refuse_wall_jump(const Config& cfg, const std::string& key, const DemSystem& sys, std::string_view wall,
                       std::string_view usual);
+// Refuses dem.gravity when it alone moves a grain at rest by more than kMaxWallStep x the smallest
+// radius in one of sys's time steps (|g| dt^2): the grains then fall through each other.
+void refuse_gravity_jump(const Config& cfg, const DemSystem& sys);
 
 }  // namespace ff::dem

@@ -549,6 +549,7 @@ SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
   // overflows, gives no step: the packing went NaN at step 0, advised to lower the time step.
   auto genesis_step = [&] { return 0.8 * checked_critical_time_step(cfg, sys, "genesis's time step"); };
   sys.settings.dt = genesis_step();
+  refuse_gravity_jump(cfg, sys);
   const Real tol = cfg.real("sample.genesis_tolerance");
   const long max_steps = cfg.integer("sample.genesis_max_steps");
   const Real target = cfg.real("sample.locked_in_stress");
@@ -572,6 +573,7 @@ SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
       }
       sys.rebuild_neighbors();
       sys.settings.dt = genesis_step();
+  refuse_gravity_jump(cfg, sys);
     }
     steps += equilibrate(sys, tol, max_steps, floor, ratio, progress);
     p = mean_stress(sys, info.volume, dim);
