@@ -10,6 +10,10 @@ namespace ff::lbm {
 
 namespace {
 constexpr double kMachWarn = 0.1, kMachError = 0.3, kTauWarn = 0.01, kTauLarge = 3.0;
+// Beyond this the collision hardly relaxes (omega = 1/tau) and the walls slip by ~tau^2: not a flow
+// solution. Reached by a speed of nothing in particular (1e-300 m/s at a fixed Mach number: dt and tau
+// of 1e298, and a drag coefficient of 0/0 in series.csv).
+constexpr double kTauMax = 1e4;
 const double kCs = 1.0 / std::sqrt(3.0);
 }  // namespace
 
@@ -101,6 +105,13 @@ StabilityCheck Units::check(double u, int resolution, const std::string& resolut
     r.error = fmt::format("relaxation time tau = {:.6g} must be above 1/2 (nu_lb = {:.3g} <= 0): set lbm.time_step = "
                           "{:.4g} s or more (tau = 0.55), or raise {} (finer cells: tau - 1/2 = 3 nu dt / dx^2)",
                           tau_, nu_lb(), dt_needed, resolution_key);
+    return r;
+  }
+  if (tau_ > kTauMax) {
+    const double f = (2.0 - 0.5) / (tau_ - 0.5);
+    r.error = fmt::format("relaxation time tau = {:.4g} is above {:g}: the collision hardly relaxes and the walls slip; "
+                          "set {}, or check the flow's speed and viscosity",
+                          tau_, kTauMax, time_fix(f));
     return r;
   }
   if (ma > kMachError) {

@@ -224,6 +224,9 @@ std::vector<Bad> bad_scenarios() {
       {"sedimentation_contact_modulus_overflowing",
        "driver = \"sedimentation\"\n" + kOutput + "fluid.sound_speed = 1.0\ndem.contact_modulus = 1e300\n",
        {"dem.contact_modulus", "DEM sub-steps per LBM step"}},
+      // an inflow of 1e-300 m/s at the default Mach number: tau 3.5e298, a warning, and a drag coefficient of 0/0
+      // in series.csv (fuzzed, session 48)
+      {"relaxation_time_past_any_flow", kCylinder + "lbm.mach = 0.1\ninlet.velocity = 1e-300\n", {"lbm.mach", "hardly relaxes"}},
       // a TRT magic parameter of 1e300: LBM unstable at step 13,152, blamed on the resolution
       {"trt_magic_above_one", kCavity + "lbm.trt_magic = 1e300\n", {"lbm.trt_magic", "(0, 1]"}},
       // Eq. B1 with h_inf above h0 opened the contact channels as they were squeezed (fuzzed 2026-11-30)
