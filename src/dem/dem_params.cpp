@@ -198,6 +198,7 @@ Real checked_critical_time_step(const Config& cfg, const DemSystem& sys, std::st
 // now. Checked per pair of groups present, between each group's lightest particles (the shortest
 // period), with the same bound as critical_time_step.
 namespace {
+
 void check_contacts_to_come(const Config& cfg, const DemSystem& sys) {
   const auto& P = sys.particles;
   const auto& M = sys.materials;
@@ -236,6 +237,7 @@ void check_contacts_to_come(const Config& cfg, const DemSystem& sys) {
     }
   }
 }
+
 }  // namespace
 
 void choose_time_step(const Config& cfg, DemSystem& sys, std::span<const Real> extra_stiffness) {

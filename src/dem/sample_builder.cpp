@@ -573,7 +573,7 @@ SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
       }
       sys.rebuild_neighbors();
       sys.settings.dt = genesis_step();
-  refuse_gravity_jump(cfg, sys);
+      refuse_gravity_jump(cfg, sys);
     }
     steps += equilibrate(sys, tol, max_steps, floor, ratio, progress);
     p = mean_stress(sys, info.volume, dim);
