@@ -340,12 +340,19 @@ void Runner<L, T>::read_checkpoint() {
 template <class L, class T>
 void Runner<L, T>::unstable(const std::string& what) {
   write_checkpoint(opt_.out_dir / "checkpoint_failed");
+  // With TRT already on, its magic parameter is the other knob (near 0 the antisymmetric rate sits at 1/2).
+  const std::string collision = cfg_.string("lbm.collision") == "trt"
+                                    ? fmt::format("a relaxation time further from 1/2 (now tau = {:.4g}) or lbm.trt_magic "
+                                                  "nearer 1/4 (now {:.4g})",
+                                                  units_.tau(), cfg_.real("lbm.trt_magic"))
+                                    : fmt::format("use lbm.collision = \"trt\" with a relaxation time further from 1/2 "
+                                                  "(now tau = {:.4g})",
+                                                  units_.tau());
   throw NumericalError(fmt::format(
       "the LBM became unstable at step {} (t = {:.6g} s): {}. The state is saved in {}. To fix it, raise {} (finer "
-      "cells, lower Mach number) or lower the time step, or use lbm.collision = \"trt\" with a relaxation time further "
-      "from 1/2 (now tau = {:.4g})",
+      "cells, lower Mach number) or lower the time step, or {}",
       sol_->time_step(), double(sol_->time_step()) * units_.dt(), what, (opt_.out_dir / "checkpoint_failed").string(),
-      fc_.resolution_key(), units_.tau()));
+      fc_.resolution_key(), collision));
 }
 
 template <class L, class T>

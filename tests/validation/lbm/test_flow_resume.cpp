@@ -91,7 +91,18 @@ TEST(LbmFlowResume, UnstableRunStopsWithAFix) {
     FAIL() << "expected a numerical error";
   } catch (const ff::NumericalError& e) {
     EXPECT_NE(std::string(e.what()).find("lbm.resolution"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("use lbm.collision = \"trt\""), std::string::npos) << e.what();
     EXPECT_TRUE(std::filesystem::exists(ff::testing::flow_test_dir("unstable_run") / "checkpoint_failed" / "state.ffcp"));
+  }
+  // With TRT on and its magic parameter near 0 (the antisymmetric rate at 1/2) the advice names
+  // lbm.trt_magic; it used to advise switching to the TRT that was running (fuzzed, session 48).
+  try {
+    ff::testing::run_flow_driver_status("unstable_trt", kCylinder,
+                                        {"lbm.trt_magic=1e-300", "fluid.viscosity=1.0e-8", "run.inflow_ramp_time=0"});
+    FAIL() << "expected a numerical error";
+  } catch (const ff::NumericalError& e) {
+    EXPECT_NE(std::string(e.what()).find("lbm.trt_magic"), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find("use lbm.collision"), std::string::npos) << e.what();
   }
 }
 
