@@ -324,8 +324,8 @@ class PoreFluid {
       else c2_.step(sys);
     } catch (const NumericalError& e) {  // the pore network's own words name no keys: add them
       throw NumericalError(fmt::format(
-          "{}. The pore fluid's inputs to check: {}, fluid.liquid_bulk_modulus (the liquid's stiffness), "
-          "fluid.initial_pressure{}",
+          "{}. The pore fluid's inputs to check: {}, fluid.liquid_viscosity and fluid.gas_viscosity (the flow's "
+          "mobility), fluid.liquid_bulk_modulus (the liquid's stiffness), fluid.initial_pressure{}",
           e.what(),
           dim3_ ? "fluid.pfv_factor (the throats' conductance)"
                 : "fluid.aperture_h0, fluid.aperture_hinf and fluid.aperture_gamma (the channels' conductance)",
