@@ -107,11 +107,12 @@ StabilityCheck Units::check(double u, int resolution, const std::string& resolut
                           tau_, nu_lb(), dt_needed, resolution_key);
     return r;
   }
+  // A large tau's fix: the step that makes tau 2 (the Mach number only drops).
+  const auto time_fix_to_tau_2 = [&] { return time_fix((2.0 - 0.5) / (tau_ - 0.5)); };
   if (tau_ > kTauMax) {
-    const double f = (2.0 - 0.5) / (tau_ - 0.5);
     r.error = fmt::format("relaxation time tau = {:.4g} is above {:g}: the collision hardly relaxes and the walls slip; "
                           "set {}, or check the flow's speed and viscosity",
-                          tau_, kTauMax, time_fix(f));
+                          tau_, kTauMax, time_fix_to_tau_2());
     return r;
   }
   if (ma > kMachError) {
@@ -144,12 +145,11 @@ StabilityCheck Units::check(double u, int resolution, const std::string& resolut
                                      tau_, kTauWarn, model, risk, fix));
   }
   if (tau_ > kTauLarge) {
-    const double tau_target = 2.0, f = (tau_target - 0.5) / (tau_ - 0.5);
     const std::string risk = bgk ? "BGK walls slip (an error growing as tau^2)"
                                  : "open-face corners can become unstable with TRT";
     r.warnings.push_back(fmt::format("relaxation time tau = {:.4g} is large with the {} collision: {}; set {} (the Mach "
                                      "number only drops)",
-                                     tau_, model, risk, time_fix(f)));
+                                     tau_, model, risk, time_fix_to_tau_2()));
   }
   return r;
 }

@@ -46,6 +46,10 @@ namespace ff::dem {
 namespace cohesive {
 // A3: Kn = Ec 2 RA RB / (RA + RB); against a wall (rB = 0) Kn = Ec 2 RA (the limit RB -> inf).
 inline Real normal_stiffness(Real ec, Real rA, Real rB) { return rB > 0 ? ec * 2 * rA * rB / (rA + rB) : ec * 2 * rA; }
+// The stiffer of Kn and Ks = nu_c Kn (nu_c > 1: the shear spring), for the critical time step.
+inline Real stiffest_spring(Real ec, Real nu_c, Real rA, Real rB) {
+  return normal_stiffness(ec, rA, rB) * std::max(Real(1), nu_c);
+}
 
 // The frictional spring (A2, A5) shared by the contact and the bond's copy of it: fn >= 0 the
 // contact's compressive force. Returns the updated shear force on B.
@@ -82,9 +86,8 @@ struct CohesiveContact {
   static Real normal_stiffness_at(const Params& p, Real rA, Real rB, Real, int) {
     return cohesive::normal_stiffness(p.ec, rA, rB);
   }
-  // The stiffer of Kn and Ks = nu_c Kn (nu_c > 1: the shear spring).
   static Real time_step_stiffness(const Params& p, Real rA, Real rB, Real, int) {
-    return cohesive::normal_stiffness(p.ec, rA, rB) * std::max(Real(1), p.nu_c);
+    return cohesive::stiffest_spring(p.ec, p.nu_c, rA, rB);
   }
   static Real normal_force(const Params& p, Real rA, Real rB, Real overlap, int) {
     return cohesive::normal_stiffness(p.ec, rA, rB) * overlap;
@@ -221,7 +224,7 @@ struct CohesiveBond {
   }
   // The bond adds at most Kn (tension, when the contact is open) or Ks to a pair.
   static void time_step_stiffness(const Material& m, const State&, Real rA, Real rB, int, Real& k, Real& krot) {
-    k = cohesive::normal_stiffness(m.ec, rA, rB) * std::max(Real(1), m.nu_c);
+    k = cohesive::stiffest_spring(m.ec, m.nu_c, rA, rB);
     krot = 0;
   }
   static Real crack_size(const Material&, Real rA, Real rB, int) { return std::min(rA, rB); }

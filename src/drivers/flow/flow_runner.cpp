@@ -341,10 +341,11 @@ template <class L, class T>
 void Runner<L, T>::unstable(const std::string& what) {
   write_checkpoint(opt_.out_dir / "checkpoint_failed");
   // With TRT already on, its magic parameter is the other knob (near 0 the antisymmetric rate sits at 1/2).
-  const std::string collision = cfg_.string("lbm.collision") == "trt"
+  const lbm::SolverSettings& solver = sol_->settings();
+  const std::string collision = solver.collision == lbm::CollisionModel::Trt
                                     ? fmt::format("a relaxation time further from 1/2 (now tau = {:.4g}) or lbm.trt_magic "
                                                   "nearer 1/4 (now {:.4g})",
-                                                  units_.tau(), cfg_.real("lbm.trt_magic"))
+                                                  units_.tau(), solver.magic)
                                     : fmt::format("use lbm.collision = \"trt\" with a relaxation time further from 1/2 "
                                                   "(now tau = {:.4g})",
                                                   units_.tau());
