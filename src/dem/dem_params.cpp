@@ -199,7 +199,7 @@ Real checked_critical_time_step(const Config& cfg, const DemSystem& sys, std::st
 // period), with the same bound as critical_time_step.
 namespace {
 
-void check_contacts_to_come(const Config& cfg, const DemSystem& sys) {
+void check_contacts_to_come(const Config& cfg, DemSystem& sys) {
   const auto& P = sys.particles;
   const auto& M = sys.materials;
   const int ng = M.groups();
@@ -209,6 +209,7 @@ void check_contacts_to_come(const Config& cfg, const DemSystem& sys) {
     if (l < 0 || P.inv_mass[i] > P.inv_mass[l]) l = static_cast<Index>(i);
   }
   const Real dt = sys.settings.dt;
+  sys.untouched_unstable_contacts.clear();
   for (int a = 0; a < ng; ++a) {
     for (int b = a; b < ng; ++b) {
       const Index i = lightest[static_cast<std::size_t>(a)], j = lightest[static_cast<std::size_t>(b)];
@@ -234,6 +235,10 @@ void check_contacts_to_come(const Config& cfg, const DemSystem& sys) {
                   "so the run will go unstable once one forms: lower the stiffness in [{}], or set dem.time_step "
                   "below {:.3g} s",
                   cfg.scenario_name(), ga, gb, bound, dt, table, bound);
+      if (dt > bound)
+        sys.untouched_unstable_contacts.push_back(fmt::format(
+            "groups {} and {}, stable only below {:.3g} s: lower the stiffness in [{}] or set dem.time_step below {:.3g} s",
+            ga, gb, bound, table, bound));
     }
   }
 }

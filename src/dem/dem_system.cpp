@@ -430,16 +430,37 @@ void DemSystem::integrate_particles() {
     q.normalize();
     if (!std::isfinite(x[i].x() + x[i].y() + x[i].z() + w[i].x() + w[i].y() + w[i].z())) bad = 1;
   }
-  if (bad)
-    throw DemNotFiniteError(fmt::format(
-        "DEM state became NaN/inf at step {} (t = {:.6g} s): the time step {:.3g} s is too large for the stiffness "
-        "and mass of the sample; lower dem.time_step_safety (or dem.time_step), or enable mass scaling",
-        step_count, time, dt));
+  if (bad) throw DemNotFiniteError(not_finite_message());
   if constexpr (kEnergy) {
     const Vec3 sum = blocked_sum(n, settings.parallel_min, block_sums_, [&](std::size_t i) { return particle_work_[i]; });
     energy.boundary_work += sum.x();
     energy.damping += sum.y();
   }
+}
+
+std::string DemSystem::not_finite_message() const {
+  const auto& x = particles.pos;
+  const auto& w = particles.omega;
+  std::size_t first = 0;  // the lowest index, whatever the thread count
+  while (first < x.size() && std::isfinite(x[first].x() + x[first].y() + x[first].z() + w[first].x() + w[first].y() +
+                                           w[first].z()))
+    ++first;
+  std::string who;
+  if (first < x.size())
+    who = fmt::format(" (first particle: id {} of group {})", particles.id[first],
+                      materials.group_names.at(static_cast<std::size_t>(particles.group[first])));
+  const std::string head = fmt::format("DEM state became NaN/inf at step {} (t = {:.6g} s){}", step_count, time, who);
+  if (!untouched_unstable_contacts.empty()) {
+    std::string list;
+    for (const auto& a : untouched_unstable_contacts) list += (list.empty() ? "" : "; ") + a;
+    return fmt::format("{}: the time step {:.3g} s was chosen for the contacts that touched at the start; the set-up "
+                       "warned that contacts formed later are unstable at it: {} (lowering dem.time_step_safety "
+                       "also works, it scales the whole step)",
+                       head, settings.dt, list);
+  }
+  return fmt::format("{}: the time step {:.3g} s is too large for the stiffness and mass of the sample; lower "
+                     "dem.time_step_safety (or dem.time_step), or enable mass scaling",
+                     head, settings.dt);
 }
 
 namespace {

@@ -15,6 +15,7 @@
 // step with the system (the triaxial flexible membrane) behind the Boundary interface.
 #pragma once
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "dem/bond_set.hpp"
@@ -63,6 +64,9 @@ class DemSystem {
   Real time = 0;
   long step_count = 0;
   EnergyBook energy;  // cumulative, while settings.track_energy (energy.hpp)
+  // Set-up advice for contacts that did not touch when the step was chosen but are unstable at it
+  // (dem_params.cpp, check_contacts_to_come): a blow-up names these rather than the safety factor.
+  std::vector<std::string> untouched_unstable_contacts;
 
   // Installs bonds between every pair whose gap is <= max_gap (stress-free).
   std::size_t install_bonds(Real max_gap);
@@ -113,6 +117,7 @@ class DemSystem {
   template <class Law> void bond_forces(const std::vector<typename Law::Prepared>& mats, std::vector<typename Law::State>& st);
   template <class Law> void wall_forces(const std::vector<typename Law::Params>& params);
   void record_bond_failures();
+  std::string not_finite_message() const;  // which particle went first, and the advice that fits
   friend void reorder_particles(DemSystem& sys, const std::vector<Index>& order);
 
   NeighborList nl_;
