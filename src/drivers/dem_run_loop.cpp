@@ -196,6 +196,31 @@ void DemRun::check_finite(const DemRowReport& r) const {
       instability_advice().empty() ? "" : ". " + instability_advice()));
 }
 
+// A platen at speed v launches a compression wave that strains the sample by v/c, c its wave speed;
+// where that is a good part of a rock's peak strain (0.1-1 %) the sample fails at its face before the
+// load spreads through it: a dynamic test, not a strength test. c <= r/t_c, with t_c the critical step
+// (of the stiffest-loaded grain) and r the smallest radius: t_c ~ r sqrt(rho/E) and a chain of grains
+// carries waves at 2 r / (t_c sqrt(Z)), Z its springs per grain. So v t_c / r is a lower bound of v/c
+// (ucs_2d.toml: v/c = 3.4 v t_c / r from its E and density). Measured on ucs_2d.toml (one packing),
+// UCS against v t_c / r: 5.97 MPa at 1e-5, 6.89 at 3.8e-5 (the example), 6.84 at 1.1e-4, 9.45 at
+// 3.0e-4, 16.3 at 9.9e-4 (session 49); the examples lie at 0.5-5e-5. Inertial masses: mass scaling
+// counts.
+void DemRun::warn_dynamic_loading() const {
+  if (spec.rate_key.empty() || sys.particles.size() == 0) return;
+  const auto& r = sys.particles.radius;
+  const Real tc = dem::critical_time_step(sys), r_min = *std::min_element(r.begin(), r.end());
+  const Real v = cfg.real(spec.rate_key), wave_strain = v * tc / r_min;
+  constexpr Real kDynamicStrain = 2e-4;
+  if (wave_strain > kDynamicStrain)
+    log::warn("{} = {:.4g} m/s is at least {:.2g} of the sample's compression-wave speed (at most {:.4g} m/s, from the "
+              "critical step {:.3g} s and the smallest radius {:.3g} m): the wave each platen launches strains the "
+              "sample by that much, a good part of a rock's peak strain, so the test is dynamic and its peak above the "
+              "quasi-static strength; quasi-static loading keeps this below {} ({} <= {:.3g} m/s){}",
+              spec.rate_key, v, wave_strain, r_min / tc, tc, r_min, kDynamicStrain, spec.rate_key,
+              kDynamicStrain * r_min / tc,
+              cfg.boolean("dem.mass_scaling") ? "; dem.mass_scaling slowed the waves too" : "");
+}
+
 // A platen that moves a good part of a grain in one step is an impact, not a loading test (at 1e300 m/s
 // the strain left the double range).
 void DemRun::refuse_loading_jump() const {
@@ -225,6 +250,7 @@ RunStatus DemRun::run() {
     set_up();
     refuse_endless_run(planned_steps(), spec.long_run_keys, sys.settings.dt);
     refuse_loading_jump();
+    warn_dynamic_loading();
     begin_output(opt);  // the sample is built: from here on files go into out_dir
   }
   ready();

@@ -82,6 +82,7 @@ class DemRun {
   // Fresh run: sample, boundaries, time step, loading velocities (nothing written yet).
   virtual void set_up() = 0;
   void refuse_loading_jump() const;
+  void warn_dynamic_loading() const;  // a platen speed that is a good part of the wave speed
   // The driver's checkpoint sections, before and after the DEM system's (restoring what
   // load_dem needs first, e.g. a membrane).
   virtual void save_before_dem(CheckpointWriter&) const {}
