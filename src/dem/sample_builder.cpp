@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
+#include <limits>
 #include <numeric>
 
 #include "core/error.hpp"
@@ -485,6 +487,23 @@ SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
     }
     if (inside == 0)
       log::warn("sample.voxels: no particle centre lies in the image (check sample.voxels.origin and spacing, in m)");
+    // A spacing far too large (km for mm) puts the whole sample in one voxel layer: every grain
+    // then takes the groups of one row of the image, without a word (fuzzed, session 49).
+    const int n_axis[3] = {voxels.image.nx, voxels.image.ny, voxels.image.nz};
+    for (int a = 0; a < dim && inside > 0; ++a) {
+      if (n_axis[a] < 2) continue;
+      Real lo = std::numeric_limits<Real>::infinity(), hi = -lo;
+      for (const auto& x : pk.position)
+        if (voxels.image.contains(x)) {
+          const Real layer = std::floor((x[a] - voxels.image.origin[a]) / voxels.image.spacing[a] + 0.5);
+          lo = std::min(lo, layer);
+          hi = std::max(hi, layer);
+        }
+      if (lo == hi)
+        log::warn("sample.voxels: every particle centre in the image lies in one voxel layer along {} (spacing {:.4g} "
+                  "m, {} layers): the image does not resolve the sample along {}; check sample.voxels.spacing (in m)",
+                  "xyz"[a], voxels.image.spacing[a], n_axis[a], "xyz"[a]);
+    }
     log::info("sample.voxels: {} of {} particle centres in the image, {} assigned a group from it", inside,
               groups.size(), regrouped);
   }

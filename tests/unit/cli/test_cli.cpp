@@ -242,6 +242,19 @@ TEST(Cli, EveryExampleScenarioIsValid) {
   EXPECT_GE(n, 3);
 }
 
+TEST(Cli, AVoxelImageThatDoesNotResolveTheSampleIsWarned) {
+  // sample.voxels.spacing off by orders of magnitude upwards (1e300 m fuzzed; km for mm) put every
+  // grain in one voxel layer: all took the groups of one image row, without a word until session 49.
+  const std::string ex = std::string(FRACFLOW_SOURCE_DIR) + "/examples/ucs_c1_voxels.toml";
+  const std::string warning = "lies in one voxel layer along";
+  const auto plain = run("check " + ex);
+  EXPECT_EQ(plain.code, 0) << plain.output;
+  EXPECT_EQ(plain.output.find(warning), std::string::npos) << plain.output;
+  const auto coarse = run("check " + ex + " --set 'sample.voxels.spacing=[0.00025, 0.00025, 1]'");
+  EXPECT_EQ(coarse.code, 0) << coarse.output;
+  EXPECT_NE(coarse.output.find(warning + std::string(" z")), std::string::npos) << coarse.output;
+}
+
 TEST(Cli, APlatenFastAgainstTheWaveSpeedIsWarned) {
   // A platen at speed v strains the sample by v/c in the wave it launches (c: the compression-wave
   // speed); ucs_2d.toml's UCS rose from 6.9 MPa at 0.1 m/s to 9.4 at 0.8 and 16.3 at 2.6 (session 49,
