@@ -267,6 +267,13 @@ void validate_scenario(const Config& cfg) {
              fmt::format("{} Pa is not below injection.max_pressure = {} Pa, where the run stops: lower it (or raise "
                          "injection.max_pressure)",
                          cfg.real("injection.initial_pressure"), cfg.real("injection.max_pressure")));
+  // The pressurised elastic-state snapshot is taken once the hole reaches measure.pressure: at or
+  // above the stop it never was, and summary.json had no word of it (fuzzed, session 49).
+  if (cfg.real("measure.pressure") > 0 && !(cfg.real("measure.pressure") < cfg.real("injection.max_pressure")))
+    cfg.fail("measure.pressure",
+             fmt::format("{} Pa is not below injection.max_pressure = {} Pa, where the run stops: the pressurised "
+                         "elastic-state snapshot would never be taken; lower it (0: the in-situ snapshot only)",
+                         cfg.real("measure.pressure"), cfg.real("injection.max_pressure")));
   if (cfg.string("network.walls") == "on" && cfg.integer("dem.dim") != 3)
     cfg.fail("network.walls", "walls in the network are 3D (PFV's boundary spheres): dem.dim = 3, or network.walls = "
                               "\"auto\" / \"off\"");

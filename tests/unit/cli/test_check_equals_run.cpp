@@ -240,6 +240,9 @@ std::vector<Bad> bad_scenarios() {
       {"b2_reduction_factor_above_one", kSaturated2d + "fluid.aperture_gamma = 2\n", {"fluid.aperture_gamma", "(0, 1]"}},
       {"network_b2_reduction_factor_above_one",
        kHydrofrac2d + "injection.fluid = \"network\"\nnetwork.b2_gamma = 2147483648\n", {"network.b2_gamma", "(0, 1]"}},
+      // a pressurised snapshot at 1e300 Pa, above the run's stop: never taken, without a word (session 49)
+      {"snapshot_pressure_past_the_stop", kHydrofrac2d + "measure.pressure = 1e300\n",
+       {"measure.pressure", "not below injection.max_pressure"}},
       // the run started at a pressure past its stop: NaN grains, blamed on the DEM step
       {"injection_starting_past_its_stop",
        kHydrofrac2d + "injection.initial_pressure = 1e300\n",
