@@ -229,16 +229,16 @@ void check_contacts_to_come(const Config& cfg, DemSystem& sys) {
             "{}: a contact of the group pair {}-{} allows no time step: its stiffness overflows (table [{}]: check "
             "its modulus, emod, ec or shear_modulus, and its kratio or nu_c)",
             cfg.scenario_name(), ga, gb, table));
-      if (dt > bound)
+      if (dt > bound) {
         log::warn("{}: one contact between the lightest particles of groups {} and {} is stable only below {:.3g} s "
                   "and the time step is {:.3g} s; none touches now (the critical step counts the contacts that do), "
                   "so the run will go unstable once one forms: lower the stiffness in [{}], or set dem.time_step "
                   "below {:.3g} s",
                   cfg.scenario_name(), ga, gb, bound, dt, table, bound);
-      if (dt > bound)
         sys.untouched_unstable_contacts.push_back(fmt::format(
             "groups {} and {}, stable only below {:.3g} s: lower the stiffness in [{}] or set dem.time_step below {:.3g} s",
             ga, gb, bound, table, bound));
+      }
     }
   }
 }
