@@ -62,20 +62,30 @@ FluidScales derive_scales(const FluidSpec& s) {
   // tau - 1/2 = 3 nu dt / dx^2, and with the step from the sound speed dt = dx / (sqrt(3) c_s): a finer
   // lattice raises tau either way, a longer step (lower sound speed or bulk modulus) too.
   const std::string dx_key = s.dx_key.empty() ? key("dx") : s.dx_key;
+  // The viscosity as the scenario gives it, and the density where the bulk modulus sets the sound
+  // speed (c = sqrt(K / rho): a density of 1e-12 gave tau - 1/2 = 2e-9 with advice that left it out).
+  const std::string visc_key = s.dynamic_viscosity > 0 ? key("dynamic_viscosity") : key("viscosity");
+  const bool by_modulus = std::string(set[0]) == "bulk_modulus";
+  auto density_way = [&](const char* way) {
+    return by_modulus ? fmt::format(", or a {} {}: c = sqrt({} / {})", way, key("density"), key("bulk_modulus"),
+                                    key("density"))
+                      : std::string();
+  };
   if (tau - 0.5 < kMinTauMinusHalf && std::string(set[0]) == "tau")
     fail("tau", fmt::format("{} is too close to 1/2 (tau - 1/2 = {:.3g} < {}): the LBM is unstable there; raise it",
                             tau, tau - 0.5, kMinTauMinusHalf));
   if (tau - 0.5 < kMinTauMinusHalf)
     fail(set[0], fmt::format("gives tau = {:.6g}, too close to 1/2 (tau - 1/2 = {:.3g} < {}): the LBM is unstable there. "
-                             "To fix it, raise the time step (a larger {}, or a lower {} or {}), raise {} or use a finer "
-                             "{} (tau - 1/2 = 3 nu dt / dx^2)",
+                             "To fix it, raise the time step (a larger {}, or a lower {} or {}{}), raise {} (nu = {:.4g} m^2/s "
+                             "now) or use a finer {} (tau - 1/2 = 3 nu dt / dx^2)",
                              tau, tau - 0.5, kMinTauMinusHalf, key("time_step"), key("sound_speed"), key("bulk_modulus"),
-                             key("viscosity"), dx_key));
+                             density_way("higher"), visc_key, nu, dx_key));
   if (tau > kMaxTau)
     fail(set[0], fmt::format("gives tau = {:.6g} > {}: the partially saturated cells' drag error grows with tau "
-                             "(docs/lbm.md); use a shorter time step (a smaller {}, or a higher {} or {}), a less viscous "
-                             "fluid or a coarser {}",
-                             tau, kMaxTau, key("time_step"), key("sound_speed"), key("bulk_modulus"), dx_key));
+                             "(docs/lbm.md); use a shorter time step (a smaller {}, or a higher {} or {}{}), a less "
+                             "viscous fluid ({}; nu = {:.4g} m^2/s now) or a coarser {}",
+                             tau, kMaxTau, key("time_step"), key("sound_speed"), key("bulk_modulus"),
+                             density_way("lower"), visc_key, nu, dx_key));
   if (tau - 0.5 < kWarnTauMinusHalf)
     r.warnings.push_back(fmt::format("tau = {:.5g} is close to 1/2: TRT stays stable there, but under-resolved flow may "
                                      "ring",

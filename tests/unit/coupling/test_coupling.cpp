@@ -87,6 +87,17 @@ TEST(FluidScales, ErrorsNameTheKey) {
   EXPECT_NE(m.find("a finer fluid.dx"), std::string::npos) << m;
   EXPECT_NE(m.find("a lower fluid.sound_speed or fluid.bulk_modulus"), std::string::npos) << m;
   EXPECT_EQ(m.find("coarser"), std::string::npos) << m;
+  // With the bulk modulus setting the step, the density sets the sound speed too (c = sqrt(K / rho)); and
+  // the viscosity is named by the key the scenario set (session 49: a density of 1e-12 and a dynamic
+  // viscosity of 1e300 were refused with advice that named neither).
+  EXPECT_NE(m.find("or a higher fluid.density: c = sqrt(fluid.bulk_modulus / fluid.density)"), std::string::npos) << m;
+  EXPECT_NE(m.find("raise fluid.viscosity (nu = 1e-06 m^2/s now)"), std::string::npos) << m;
+  FluidSpec thick = water(1e-3);
+  thick.viscosity = 0;
+  thick.dynamic_viscosity = 1e300;
+  thick.bulk_modulus = 2.2e9;
+  const std::string mt = message_of(thick);
+  EXPECT_NE(mt.find("a less viscous fluid (fluid.dynamic_viscosity; nu = 1e+297 m^2/s now)"), std::string::npos) << mt;
   FluidSpec fine = water(1e-7);  // 0.1 um cells at c_s = 2 m/s: tau - 1/2 = 3 nu / (sqrt(3) c_s dx) = 4.3
   fine.sound_speed = 2;
   const std::string mf = message_of(fine);
