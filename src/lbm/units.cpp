@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "core/error.hpp"
+#include "lbm/lattice_budget.hpp"
 
 namespace ff::lbm {
 
@@ -90,13 +91,19 @@ StabilityCheck Units::check(double u, int resolution, const std::string& resolut
   // the Mach number fixed only its own key changes it.
   auto mach_fix = [&](double target) {
     const double f = ma / target;
-    const int n_needed = int(std::ceil(resolution * f));
+    // A speed far off can need more cells than a side may have (it overflowed an int: "set
+    // lbm.resolution = -2147483648 or more", fuzzed with a lid velocity of 1e300).
+    const double n_needed = std::ceil(resolution * f);
+    const std::string finer = n_needed <= kMaxLatticeSide
+                                  ? fmt::format("{} = {:.0f} or more", resolution_key, n_needed)
+                                  : fmt::format("{} = {:.3g} (beyond the 2^30 cells a side may have: check the speed)",
+                                                resolution_key, n_needed);
     switch (mode) {
       case UnitsMode::Tau:
-        return fmt::format("set {} = {} or more (same lbm.tau), or {}", resolution_key, n_needed, time_fix(1 / f));
+        return fmt::format("set {} (same lbm.tau), or {}", finer, time_fix(1 / f));
       case UnitsMode::TimeStep:
-        return fmt::format("set {} or less, or {} = {} or more with lbm.time_step scaled by (old/new resolution)^2",
-                           time_fix(1 / f), resolution_key, n_needed);
+        return fmt::format("set {} or less, or {} with lbm.time_step scaled by (old/new resolution)^2",
+                           time_fix(1 / f), finer);
       default: return fmt::format("set {} or less", time_fix(1 / f));
     }
   };

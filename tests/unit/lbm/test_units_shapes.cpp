@@ -47,6 +47,11 @@ TEST(LbmUnits, StabilityChecksNameTheFix) {
   // Ma = 0.52: an error.
   const auto e = u.check(9.0, 50, "lbm.resolution", UnitsMode::Tau, "trt", 1.0);
   EXPECT_NE(e.error.find("Mach number"), std::string::npos);
+  // A speed that no lattice resolves: the advice said "lbm.resolution = -2147483648 or more" (an int
+  // overflow; fuzzed with a lid velocity of 1e300, session 49).
+  const auto absurd = u.check(1e300, 50, "lbm.resolution", UnitsMode::Tau, "trt", 1.0);
+  EXPECT_NE(absurd.error.find("beyond the 2^30 cells a side may have"), std::string::npos) << absurd.error;
+  EXPECT_EQ(absurd.error.find("-2147483648"), std::string::npos) << absurd.error;
   // In time-step mode the fix is a smaller time step.
   const Units d = Units::from_time_step(1e-3, u.dt(), 1e-3, 1000);
   EXPECT_NE(d.check(3.0, 50, "lbm.resolution", UnitsMode::TimeStep, "trt", 1.0).warnings[0].find("set lbm.time_step = "), std::string::npos);
