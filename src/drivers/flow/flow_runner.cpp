@@ -376,7 +376,14 @@ RunStatus Runner<L, T>::run() {
     for (auto& w : chk.warnings) log::warn("{}", w);
     for (auto& w : fc_.warnings()) log::warn("{}", w);
   }
-  const std::string shorten = fmt::format("run.end_time, a smaller {} or a larger {}", fc_.resolution_key(), fu_.key());
+  // With lbm.tau setting the step, dt = (tau - 1/2) dx^2 / (3 nu): a viscosity far off (1e300 m^2/s
+  // fuzzed) makes it tiny, and the advice named only the resolution and tau.
+  const std::string shorten =
+      std::string_view(fu_.key()) == "lbm.tau"
+          ? fmt::format("run.end_time, a smaller {}, a larger lbm.tau or a lower fluid.viscosity (now {:.4g} m^2/s; the "
+                        "step is (tau - 1/2) dx^2 / (3 nu))",
+                        fc_.resolution_key(), cfg_.real("fluid.viscosity"))
+          : fmt::format("run.end_time, a smaller {} or a larger {}", fc_.resolution_key(), fu_.key());
   refuse_endless_run(cfg_.real("run.end_time") / units_.dt(), shorten);
   // A ramp that outlasts the run leaves nothing at full inflow to measure (and 1e300 s overflowed
   // the step count into a negative sample index: a crash).

@@ -157,6 +157,9 @@ std::vector<Bad> bad_scenarios() {
       {"run_that_cannot_end", kUcs2d + "ucs.platen_velocity = 1e-12\n", {"ucs.platen_velocity", "time steps of"}},
       {"platen_jumping_grains", kUcs2d + "ucs.platen_velocity = 1e6\n", {"ucs.platen_velocity", "in one time step"}},
       {"lbm_end_time_overflowing", kCavity + "lbm.tau = 0.52\nrun.end_time = 1e300\n", {"run.end_time", "time steps"}},
+      // with lbm.tau fixed the step is (tau - 1/2) dx^2 / (3 nu): a viscosity of 1e300 made it 2.5e-310 s and the
+      // refusal named the resolution and tau only (session 49)
+      {"lbm_viscosity_shrinking_the_step", kCavity + "fluid.viscosity = 1e300\n", {"time steps", "a lower fluid.viscosity"}},
       // every pair bonded: memory past 6 GB on a 3D block
       {"bond_gap_beyond_the_grains", kUcs2d + "sample.bond_gap = 1\n", {"sample.bond_gap", "largest particle radius"}},
       // 1e300 s overflowed the ramp's step count into a negative sample index: a segmentation fault
