@@ -276,7 +276,9 @@ void refuse_wall_jump(const Config& cfg, const std::string& key, const DemSystem
   const Real v = cfg.real(key), dt = sys.settings.dt, r_min = *std::min_element(r.begin(), r.end());
   if (v * dt > kMaxWallStep * r_min)
     cfg.fail(key, fmt::format("{:.4g} m/s moves the {} {:.3g} m in one time step ({:.4g} s), {:.3g} of the smallest "
-                              "particle radius ({:.4g} m); the limit is {}: {}",
+                              "particle radius ({:.4g} m); the limit is {}: {} (the step is the grains' own, ~sqrt(m/k): "
+                              "a density far too high or a stiffness far too low lengthens it; see the time step line "
+                              "above)",
                               v, wall, v * dt, dt, v * dt / r_min, r_min, kMaxWallStep, usual));
 }
 

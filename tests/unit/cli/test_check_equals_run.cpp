@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -156,6 +157,11 @@ std::vector<Bad> bad_scenarios() {
        {"dem.time_step", "above the stable limit"}},
       {"run_that_cannot_end", kUcs2d + "ucs.platen_velocity = 1e-12\n", {"ucs.platen_velocity", "time steps of"}},
       {"platen_jumping_grains", kUcs2d + "ucs.platen_velocity = 1e6\n", {"ucs.platen_velocity", "in one time step"}},
+      // grains 1e300 times too dense: a step of 1e141 s, refused for the platen's speed alone (session 49: the
+      // refusal now says where the step comes from)
+      {"density_lengthening_the_step",
+       std::regex_replace(kUcs2d, std::regex("rock.density = 2600"), "rock.density = 1e300"),
+       {"ucs.platen_velocity", "a density far too high"}},
       {"lbm_end_time_overflowing", kCavity + "lbm.tau = 0.52\nrun.end_time = 1e300\n", {"run.end_time", "time steps"}},
       // with lbm.tau fixed the step is (tau - 1/2) dx^2 / (3 nu): a viscosity of 1e300 made it 2.5e-310 s and the
       // refusal named the resolution and tau only (session 49)
