@@ -640,6 +640,16 @@ void validate(const Config& cfg) {
                          "vapour pressure at 20 C is 2.34e3 Pa; 0 lets the liquid take any tension)",
                          cfg.real("fluid.cavitation_pressure"), cfg.real("fluid.initial_pressure")));
   if (!dim3) refuse_widening_aperture(cfg, "fluid");
+  // A barotropic liquid no stiffer than the ideal gas beside it (an isothermal gas's modulus is its
+  // pressure) is not a liquid: 1e-12 Pa was taken silently and no pore pressure ever built up; a modulus
+  // in GPa where Pa are meant (2.2) does the same (fuzzed, session 49).
+  if (cfg.string("fluid.liquid_eos") == "barotropic" &&
+      !(cfg.real("fluid.liquid_bulk_modulus") > cfg.real("fluid.initial_pressure")))
+    cfg.fail("fluid.liquid_bulk_modulus",
+             fmt::format("{:.4g} Pa is not above fluid.initial_pressure = {:.4g} Pa: the liquid would be softer than the "
+                         "gas beside it (an ideal gas's isothermal modulus is its pressure); water is 2.2e9 Pa (a modulus "
+                         "in GPa where Pa are meant?)",
+                         cfg.real("fluid.liquid_bulk_modulus"), cfg.real("fluid.initial_pressure")));
 }
 
 RunStatus run(const Config& cfg, const RunOptions& opt) {

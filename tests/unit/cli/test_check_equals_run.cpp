@@ -246,6 +246,9 @@ std::vector<Bad> bad_scenarios() {
        {"network.aperture_hinf", "above network.aperture_h0"}},
       // Eq. B2's gamma is a reduction factor (seed 004): above 1 a pore-to-pore channel was wider than the gap
       // between its grains (2^31: wider than the block), taken without a word (session 48)
+      // a liquid softer than its gas (1e-12 Pa): no pore pressure ever built up, without a word (session 49)
+      {"liquid_softer_than_its_gas", kSaturated2d + "fluid.liquid_bulk_modulus = 2.2\n",
+       {"fluid.liquid_bulk_modulus", "softer than the gas"}},
       {"b2_reduction_factor_above_one", kSaturated2d + "fluid.aperture_gamma = 2\n", {"fluid.aperture_gamma", "(0, 1]"}},
       {"network_b2_reduction_factor_above_one",
        kHydrofrac2d + "injection.fluid = \"network\"\nnetwork.b2_gamma = 2147483648\n", {"network.b2_gamma", "(0, 1]"}},

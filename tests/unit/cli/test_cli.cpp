@@ -255,6 +255,19 @@ TEST(Cli, AVoxelImageThatDoesNotResolveTheSampleIsWarned) {
   EXPECT_NE(coarse.output.find(warning + std::string(" z")), std::string::npos) << coarse.output;
 }
 
+TEST(Cli, AHoleFluidSofterThanAnyLiquidIsWarned) {
+  // injection.fluid_bulk_modulus in GPa where Pa are meant (2.2): the pumped volume raises the hole's
+  // pressure by nothing (dp/dt = K_f / V (Q - dV/dt)), without a word until session 49.
+  const std::string ex = std::string(FRACFLOW_SOURCE_DIR) + "/examples/hydrofrac_2d.toml";
+  const std::string warning = "far below any liquid's";
+  const auto water = run("check " + ex + " --skip-set-up --set injection.mode=rate");
+  EXPECT_EQ(water.code, 0) << water.output;
+  EXPECT_EQ(water.output.find(warning), std::string::npos) << water.output;
+  const auto soft = run("check " + ex + " --skip-set-up --set injection.mode=rate --set injection.fluid_bulk_modulus=2.2");
+  EXPECT_EQ(soft.code, 0) << soft.output;
+  EXPECT_NE(soft.output.find(warning), std::string::npos) << soft.output;
+}
+
 TEST(Cli, APlatenFastAgainstTheWaveSpeedIsWarned) {
   // A platen at speed v strains the sample by v/c in the wave it launches (c: the compression-wave
   // speed); ucs_2d.toml's UCS rose from 6.9 MPa at 0.1 m/s to 9.4 at 0.8 and 16.3 at 2.6 (session 49,
