@@ -194,20 +194,20 @@ Real critical_time_step(const DemSystem& s, std::span<const Real> extra_stiffnes
       kr[cp[c]] += ck[c] * r[cp[c]] * r[cp[c]];
     }
   }
-  if (!extra_stiffness.empty()) {
-    if (extra_stiffness.size() != n)
-      throw Error(fmt::format("critical_time_step: {} extra stiffnesses for {} particles", extra_stiffness.size(), n));
-    for (std::size_t i = 0; i < n; ++i) kt[i] += extra_stiffness[i];
-  }
+  if (!extra_stiffness.empty() && extra_stiffness.size() != n)
+    throw Error(fmt::format("critical_time_step: {} extra stiffnesses for {} particles", extra_stiffness.size(), n));
   Real dt = std::numeric_limits<Real>::infinity();
   for (std::size_t i = 0; i < n; ++i) {
     // A particle with no contact yet still meets one like itself (free particles otherwise
-    // give no bound at all).
+    // give no bound at all); a coupled module's stiffness adds to that, never replaces it (until
+    // session 49 a floater's pore-fluid stiffness did, and the "critical step with the fluid" came
+    // out 100 x longer than the solid's own for a sample with tiny grains).
     // A stiffness that overflowed (a modulus or bond radius multiplier of 1e300: inf, or NaN from
     // 0 x inf) allows no step; the fallback below and std::min would skip the NaN.
     if (!std::isfinite(kt[i]) || !std::isfinite(kr[i])) return 0;
-    const Real k = kt[i] > 0 ? kt[i] : pair_stiffness(s, materials.pair(grp[i], grp[i]), r[i], r[i], 0.01 * r[i]);
-    const Real kk = kr[i] > 0 ? kr[i] : k * r[i] * r[i];
+    const Real k_solid = kt[i] > 0 ? kt[i] : pair_stiffness(s, materials.pair(grp[i], grp[i]), r[i], r[i], 0.01 * r[i]);
+    const Real k = k_solid + (extra_stiffness.empty() ? 0 : extra_stiffness[i]);
+    const Real kk = kr[i] > 0 ? kr[i] : k_solid * r[i] * r[i];
     if (!std::isfinite(k) || !std::isfinite(kk)) return 0;
     dt = std::min({dt, std::sqrt(1.0 / (particles.inv_mass[i] * k)), std::sqrt(1.0 / (particles.inv_inertia[i] * kk))});
   }

@@ -277,6 +277,30 @@ TEST(DemTimeStep, CriticalStepOfTwoBondedBodies) {
   }
 }
 
+TEST(DemTimeStep, ACoupledStiffnessAddsToAFreeGrainsOwnBound) {
+  // A grain with no contact is bounded by a contact with one like itself (METHODS.md 1.6); a coupled
+  // module's stiffness per grain (the pore fluid's) adds to that bound and never loosens it. Until
+  // session 49 a free grain's fluid stiffness replaced its own contact: a tiny free grain beside a soft
+  // pore fluid gave a "critical step with the fluid" 100 x longer than without (fuzzed:
+  // saturated_ucs_3d.toml with sample.radius_min = 1e-300). Two free grains of unequal size.
+  for (int dim : {3, 2}) {
+    DemSystem s = empty_system(dim);
+    add_particle(s, Vec3::Zero(), kRadius);
+    add_particle(s, Vec3(10 * kRadius, 0, 0), 0.1 * kRadius);
+    s.initialise();
+    const Real dt_own = critical_time_step(s);
+    const Real k_self = LinearContact::normal_stiffness(s.materials.contact_params<LinearContact>()[0], 0.1 * kRadius,
+                                                        0.1 * kRadius, dim);
+    const std::vector<Real> soft = {1e-6 * k_self, 1e-6 * k_self}, stiff = {0.0, 3 * k_self};
+    EXPECT_LE(critical_time_step(s, soft), dt_own) << "dim " << dim;
+    EXPECT_NEAR(critical_time_step(s, soft), dt_own, 1e-5 * dt_own) << "dim " << dim;
+    // A stiffness as large as three self-contacts on the small grain: its translational bound shrinks by 2.
+    const Real m = s.particles.mass[1];
+    EXPECT_NEAR(critical_time_step(s, stiff), std::min(dt_own, std::sqrt(m / (4 * k_self))), 1e-12 * dt_own)
+        << "dim " << dim;
+  }
+}
+
 TEST(DemTimeStep, MassScalingReachesTheTargetStep) {
   // Density scaling (METHODS.md 1.6): after scale_masses_for(dt, s) the critical step of the
   // inertial masses allows dt, i.e. s x dt_crit >= dt (equal to 1e-12 relative with the engine's
