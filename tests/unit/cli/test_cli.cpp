@@ -266,6 +266,9 @@ TEST(Cli, AHoleFluidSofterThanAnyLiquidIsWarned) {
   const auto soft = run("check " + ex + " --skip-set-up --set injection.mode=rate --set injection.fluid_bulk_modulus=2.2");
   EXPECT_EQ(soft.code, 0) << soft.output;
   EXPECT_NE(soft.output.find(warning), std::string::npos) << soft.output;
+  // The ramp counts the injected volume V (1 + p / K_f): warned alike.
+  const auto ramp = run("check " + ex + " --skip-set-up --set injection.fluid_bulk_modulus=2.2");
+  EXPECT_NE(ramp.output.find(warning), std::string::npos) << ramp.output;
 }
 
 TEST(Cli, APlatenFastAgainstTheWaveSpeedIsWarned) {
