@@ -428,11 +428,20 @@ class SaturatedUcsRun final : public UcsRun {
         at_relative += f == porenet::VoidFloor::Relative;
         at_fraction += f == porenet::VoidFloor::Fraction;
       }
+      const Real stable = fluid_.flow().stable_dt();
       log::info("pore network: {} pores, {} channels ({} pairs); DEM step {:.3g} s, flow stable step {:.3g} s; {} pores "
                 "at the void floor (fluid.min_void_relative x the mean cell), {} at {} of their triangle (overlapping "
                 "discs)",
-                net.n_pores(), net.n_channels(), fluid_.c2().pairs().size(), sys.settings.dt, fluid_.flow().stable_dt(),
-                at_relative, at_fraction, net.params.min_void_fraction);
+                net.n_pores(), net.n_channels(), fluid_.c2().pairs().size(), sys.settings.dt, stable, at_relative,
+                at_fraction, net.params.min_void_fraction);
+      // Known here, before anything is written: `check` passed fluid.aperture_h0 = 1e300 and the run
+      // then stopped at its first step (fuzzed, session 49).
+      if (!(stable > 0))
+        throw InputError(fmt::format(
+            "{}: the pore network's flow allows no time step (its stable step is {} s: a channel's conductance, ~h^3 / "
+            "mu, is infinite or not a number); check fluid.aperture_h0, fluid.aperture_hinf and fluid.aperture_gamma "
+            "(the channels' apertures, micrometres: 1e-6 m) and fluid.liquid_viscosity and fluid.gas_viscosity",
+            cfg.scenario_name(), stable));
     }
     Real p;
     fluid_.mean_pressure(p, ex_.void0);
@@ -640,6 +649,16 @@ void validate(const Config& cfg) {
                          "vapour pressure at 20 C is 2.34e3 Pa; 0 lets the liquid take any tension)",
                          cfg.real("fluid.cavitation_pressure"), cfg.real("fluid.initial_pressure")));
   if (!dim3) refuse_widening_aperture(cfg, "fluid");
+  // Peng-Robinson water below its vapour pressure is steam: at 1e-300 Pa the EOS gave the gas root
+  // (7e-306 kg/m^3) and the 3D run stopped at once blaming the time step (fuzzed, session 49). The 2D
+  // coupling's cavitation floor must lie below the initial pressure (above); 3D models none.
+  constexpr Real kWaterVapourPressure = 2.34e3;  // Pa at 20 C
+  if (dim3 && cfg.string("fluid.liquid_eos") == "peng_robinson" && cfg.real("fluid.saturation") > 0 &&
+      cfg.real("fluid.initial_pressure") < kWaterVapourPressure)
+    cfg.fail("fluid.initial_pressure",
+             fmt::format("{:.4g} Pa is below water's vapour pressure ({} Pa at 20 C): the Peng-Robinson water would "
+                         "start as steam, and 3D samples model no cavitation; use 1e5 (atmospheric) or more",
+                         cfg.real("fluid.initial_pressure"), kWaterVapourPressure));
   // A barotropic liquid no stiffer than the ideal gas beside it (an isothermal gas's modulus is its
   // pressure) is not a liquid: 1e-12 Pa was taken silently and no pore pressure ever built up; a modulus
   // in GPa where Pa are meant (2.2) does the same (fuzzed, session 49).

@@ -246,6 +246,15 @@ std::vector<Bad> bad_scenarios() {
        {"network.aperture_hinf", "above network.aperture_h0"}},
       // Eq. B2's gamma is a reduction factor (seed 004): above 1 a pore-to-pore channel was wider than the gap
       // between its grains (2^31: wider than the block), taken without a word (session 48)
+      // channels 1e300 m wide: check passed, the run stopped at its first step (session 49)
+      {"channels_without_a_flow_step", kSaturated2d + "fluid.aperture_h0 = 1e300\n",
+       {"allows no time step", "fluid.aperture_h0"}},
+      // Peng-Robinson water at 1e-300 Pa: the EOS's gas root, the 3D run stopped at once (session 49)
+      {"water_below_its_vapour_pressure",
+       "driver = \"saturated_ucs\"\n" + kOutput + kRock +
+           "sample.diameter = 5e-3\nsample.height = 10e-3\nfluid.liquid_eos = \"peng_robinson\"\n"
+           "fluid.initial_pressure = 1e-300\n",
+       {"fluid.initial_pressure", "vapour pressure"}},
       // a liquid softer than its gas (1e-12 Pa): no pore pressure ever built up, without a word (session 49)
       {"liquid_softer_than_its_gas", kSaturated2d + "fluid.liquid_bulk_modulus = 2.2\n",
        {"fluid.liquid_bulk_modulus", "softer than the gas"}},
