@@ -147,7 +147,9 @@ void FlexibleMembrane::update_geometry() {
     const Real len = cr.norm();
     if (!(len > 0))
       throw NumericalError(fmt::format(
-          "flexible membrane: element {} collapsed to zero area; lower the membrane v_max or the time step", k));
+          "flexible membrane: element {} collapsed to zero area; lower its servo speed cap (triaxial.servo_velocity) or "
+          "the time step (dem.time_step_safety)",
+          k));
     area_[k] = 0.5 * len;
     centroid_[k] = (a + b + c) / 3.0;
     Vec3 n = cr / len;

@@ -65,7 +65,10 @@ void declare(ParamTable& t) {
       .non_negative();
   t.integer("membrane.n_theta", 24, "-", "membrane: square units around the circumference (seed 000 demo: 16)").at_least(6);
   t.integer("membrane.n_z", 0, "-", "membrane: rows of units along the axis (0: nearly square units)").non_negative();
-  t.real("membrane.length_factor", 1.2, "-", "membrane sleeve length / sample height (longer than the sample)").at_least(1);
+  t.real("membrane.length_factor", 1.2, "-",
+         "membrane sleeve length / sample height (longer than the sample; up to 10: a longer sleeve's elements "
+         "degenerate)")
+      .range(1, 10);
   t.real("membrane.clearance", 0.01, "-",
          "initial gap between sample and membrane facets (particle membrane: its inner surface), as a fraction of the "
          "sample radius")

@@ -246,6 +246,10 @@ std::vector<Bad> bad_scenarios() {
        {"network.aperture_hinf", "above network.aperture_h0"}},
       // Eq. B2's gamma is a reduction factor (seed 004): above 1 a pore-to-pore channel was wider than the gap
       // between its grains (2^31: wider than the block), taken without a word (session 48)
+      // a sleeve 2^31 sample heights long: its elements collapsed to zero area in the run, with advice naming
+      // no key (session 49)
+      {"membrane_sleeve_degenerate", kTriaxial + "membrane.length_factor = 2147483648\n",
+       {"membrane.length_factor", "[1, 10]"}},
       // channels 1e300 m wide: check passed, the run stopped at its first step (session 49)
       {"channels_without_a_flow_step", kSaturated2d + "fluid.aperture_h0 = 1e300\n",
        {"allows no time step", "fluid.aperture_h0"}},
