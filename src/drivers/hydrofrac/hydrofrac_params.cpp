@@ -177,7 +177,10 @@ void declare_params(ParamTable& t) {
            "the rate exact) or velocity_box (seed 003 Sec. 4.1: a square box of half the hole's radius on its axis "
            "whose cells carry the outward velocity that pumps the rate; docs/hydrofrac.md)")
       .one_of({"mass", "velocity_box"});
-  t.real("injection.fluid_bulk_modulus", 2.2e9, "Pa", "fluid bulk modulus K_f (water 2.2e9): dp/dt = K_f/V (Q - dV/dt)").positive();
+  t.real("injection.fluid_bulk_modulus", 2.2e9, "Pa",
+         "fluid bulk modulus K_f (water 2.2e9; at most 1e12, stiffer than diamond): dp/dt = K_f/V (Q - dV/dt)")
+      .positive()
+      .at_most(1e12);
   t.boolean("injection.penetration", false,
             "fluid enters cracks connected to the hole (pressure on their faces); false: sleeve test, the wall only");
   t.integer("injection.update_interval", 20, "steps", "steps between searches for cracks newly connected to the hole").positive();

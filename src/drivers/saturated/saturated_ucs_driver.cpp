@@ -56,7 +56,10 @@ void declare(ParamTable& t) {
            "liquid equation of state: barotropic (constant bulk modulus) or peng_robinson (PR + Peneloux water, seed 004 "
            "B10-B22; ~3.3x stiffer than real water)")
       .one_of({"barotropic", "peng_robinson"});
-  t.real("fluid.liquid_bulk_modulus", 2.2e9, "Pa", "bulk modulus of the barotropic liquid (water: 2.2e9)").positive();
+  t.real("fluid.liquid_bulk_modulus", 2.2e9, "Pa",
+         "bulk modulus of the barotropic liquid (water: 2.2e9; at most 1e12, stiffer than diamond)")
+      .positive()
+      .at_most(1e12);
   t.string("fluid.gas_eos", "ideal", "gas equation of state: ideal (air) or peng_robinson (PR air)")
       .one_of({"ideal", "peng_robinson"});
   t.real("fluid.initial_pressure", 1e5, "Pa",

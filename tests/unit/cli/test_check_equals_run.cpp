@@ -259,6 +259,12 @@ std::vector<Bad> bad_scenarios() {
            "sample.diameter = 5e-3\nsample.height = 10e-3\nfluid.liquid_eos = \"peng_robinson\"\n"
            "fluid.initial_pressure = 1e-300\n",
        {"fluid.initial_pressure", "vapour pressure"}},
+      // a hole fluid stiffer than any material (1e300 Pa): a fluid-grain spring period of 1.5e-152 s against a DEM
+      // step of 3.8e-8 s, and the network run stopped at injection (CG without convergence; session 49)
+      {"hole_fluid_stiffer_than_diamond", kHydrofrac2d + "injection.fluid_bulk_modulus = 1e300\n",
+       {"injection.fluid_bulk_modulus", "out of range"}},
+      {"liquid_stiffer_than_diamond", kSaturated2d + "fluid.liquid_bulk_modulus = 1e300\n",
+       {"fluid.liquid_bulk_modulus", "out of range"}},
       // a liquid softer than its gas (1e-12 Pa): no pore pressure ever built up, without a word (session 49)
       {"liquid_softer_than_its_gas", kSaturated2d + "fluid.liquid_bulk_modulus = 2.2\n",
        {"fluid.liquid_bulk_modulus", "softer than the gas"}},
