@@ -477,9 +477,21 @@ SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
   constexpr int kUnlabelled = -2;
   if (!voxels.empty()) {
     const auto label = geom::label_points(voxels.image, pk.position, voxels.windows, kUnlabelled);
+    // The voxel layers (rounded index per axis) that the centres inside the image span: a spacing far
+    // too large (km for mm) puts the whole sample in one layer, so every grain took the groups of one
+    // row of the image, without a word (fuzzed, session 49).
+    const auto& img = voxels.image;
+    Vec3 layer_lo = Vec3::Constant(std::numeric_limits<Real>::infinity()), layer_hi = -layer_lo;
     std::size_t inside = 0, regrouped = 0;
     for (std::size_t i = 0; i < groups.size(); ++i) {
-      inside += voxels.image.contains(pk.position[i]);
+      if (img.contains(pk.position[i])) {
+        ++inside;
+        for (int a = 0; a < 3; ++a) {
+          const Real layer = std::floor((pk.position[i][a] - img.origin[a]) / img.spacing[a] + 0.5);
+          layer_lo[a] = std::min(layer_lo[a], layer);
+          layer_hi[a] = std::max(layer_hi[a], layer);
+        }
+      }
       if (label[i] >= 0) {
         groups[i] = label[i];
         ++regrouped;
@@ -487,23 +499,12 @@ SampleInfo build_sample(const Config& cfg, DemSystem& sys) {
     }
     if (inside == 0)
       log::warn("sample.voxels: no particle centre lies in the image (check sample.voxels.origin and spacing, in m)");
-    // A spacing far too large (km for mm) puts the whole sample in one voxel layer: every grain
-    // then takes the groups of one row of the image, without a word (fuzzed, session 49).
-    const int n_axis[3] = {voxels.image.nx, voxels.image.ny, voxels.image.nz};
-    for (int a = 0; a < dim && inside > 0; ++a) {
-      if (n_axis[a] < 2) continue;
-      Real lo = std::numeric_limits<Real>::infinity(), hi = -lo;
-      for (const auto& x : pk.position)
-        if (voxels.image.contains(x)) {
-          const Real layer = std::floor((x[a] - voxels.image.origin[a]) / voxels.image.spacing[a] + 0.5);
-          lo = std::min(lo, layer);
-          hi = std::max(hi, layer);
-        }
-      if (lo == hi)
+    const int n_axis[3] = {img.nx, img.ny, img.nz};
+    for (int a = 0; a < dim && inside > 0; ++a)
+      if (n_axis[a] >= 2 && layer_lo[a] == layer_hi[a])
         log::warn("sample.voxels: every particle centre in the image lies in one voxel layer along {} (spacing {:.4g} "
                   "m, {} layers): the image does not resolve the sample along {}; check sample.voxels.spacing (in m)",
-                  "xyz"[a], voxels.image.spacing[a], n_axis[a], "xyz"[a]);
-    }
+                  "xyz"[a], img.spacing[a], n_axis[a], "xyz"[a]);
     log::info("sample.voxels: {} of {} particle centres in the image, {} assigned a group from it", inside,
               groups.size(), regrouped);
   }
