@@ -295,11 +295,12 @@ void NetworkLoad::flow_step(const dem::DemSystem& sys) {
     network_flow_step(sys);
   } catch (const NumericalError& e) {  // the pore network's own words name no keys: add them
     throw NumericalError(fmt::format(
-        "{}. The network fluid's inputs to check: network.aperture_h0, network.aperture_hinf, network.throat_factor "
-        "and network.max_conductance_ratio (the channels' conductance), network.viscosity and network.density, "
-        "injection.fluid_bulk_modulus (the liquid's stiffness), network.pore_pressure, injection.ramp_rate / "
-        "injection.rate",
-        e.what()));
+        "{}. The network fluid's inputs to check: {} (the channels' conductance), network.viscosity and "
+        "network.density, injection.fluid_bulk_modulus (the liquid's stiffness), network.pore_pressure, "
+        "injection.ramp_rate / injection.rate",
+        e.what(),
+        c2_ ? "network.aperture_h0, network.aperture_hinf and network.b2_gamma"
+            : "network.throat_factor and network.max_conductance_ratio"));
   }
 }
 

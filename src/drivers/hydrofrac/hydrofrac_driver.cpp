@@ -96,23 +96,29 @@ void HydrofracRun::make_fluid() {
     n.viscosity = cfg.real("network.viscosity");
     n.pore_pressure = cfg.real("network.pore_pressure");
     n.vapour_pressure = cfg.real("network.vapour_pressure");
-    n.network.b1_h0 = cfg.real("network.aperture_h0");
-    n.network.b1_h_inf = cfg.real("network.aperture_hinf");
-    n.network.b2_gamma = cfg.real("network.b2_gamma");
-    n.network.max_cond_ratio = cfg.real("network.max_conductance_ratio");
-    n.pfv_factor = cfg.real("network.throat_factor");
+    // Keys of one dimension are read in it alone, so that one set in the other is named as unused
+    // (network.aperture_h0 on a 3D block had no effect without a word; fuzzed, session 50).
+    const bool dim3 = sys.settings.dim == 3;
+    if (!dim3) {
+      n.network.b1_h0 = cfg.real("network.aperture_h0");
+      n.network.b1_h_inf = cfg.real("network.aperture_hinf");
+      n.network.b2_gamma = cfg.real("network.b2_gamma");
+    } else {
+      n.network.max_cond_ratio = cfg.real("network.max_conductance_ratio");
+      n.pfv_factor = cfg.real("network.throat_factor");
+      n.predict_pressures = cfg.boolean("network.predict_pressures");
+      n.crack_channels = cfg.boolean("network.crack_channels");
+    }
     n.retriangulation_tolerance = cfg.real("network.retriangulation_tolerance");
     n.remap = cfg.string("network.remap") == "pressure" ? porenet::RemapConserve::Pressure : porenet::RemapConserve::Mass;
     n.pressure_force = cfg.string("network.pressure_forces") == "void_gradient" ? coupling::PressureForce::VoidGradient
                                                                                 : coupling::PressureForce::Surface;
     n.flow_every = cfg.integer("network.flow_every");
-    n.predict_pressures = cfg.boolean("network.predict_pressures");
     const std::string faces = cfg.string("network.faces");
-    n.drained_faces = faces == "drained" || (faces == "auto" && sys.settings.dim == 3);
-    n.walls = sys.settings.dim == 3 && cfg.string("network.walls") != "off";
-    n.crack_channels = cfg.boolean("network.crack_channels");
+    n.drained_faces = faces == "drained" || (faces == "auto" && dim3);
+    n.walls = dim3 && cfg.string("network.walls") != "off";
     const std::string pre = cfg.string("network.preconditioner");
-    n.amg = pre == "amg" || (pre == "auto" && sys.settings.dim == 3);
+    n.amg = pre == "amg" || (pre == "auto" && dim3);
     n.cell = s.cell;
     n.inflate = s.inflate;
     n.reach = s.reach;

@@ -79,7 +79,11 @@ void declare_params(ParamTable& t) {
          "network, 3D: factor on the throats' geometric (PFV) conductance: 1 = the packing's own throats, through which "
          "the whole block fills within a few DEM steps; 1e-7: a tight rock the fluid penetrates over a few grains")
       .positive();
-  t.real("network.max_conductance_ratio", 100, "-", "network, 3D: throat conductance cap, x the median at a triangulation").positive();
+  t.real("network.max_conductance_ratio", 100, "-",
+         "network, 3D: throat conductance cap, x the median at a triangulation (cf. YADE's maxKdivKmean), for the "
+         "outliers of flat tetrahedra; at least 1: below the median it would clip most throats to one value (a tighter "
+         "rock: lower network.throat_factor)")
+      .at_least(1);
   t.real("network.retriangulation_tolerance", 0.25, "-",
          "network: retriangulate when a particle moved this many mean radii since the last triangulation")
       .positive();

@@ -271,6 +271,10 @@ std::vector<Bad> bad_scenarios() {
       {"b2_reduction_factor_above_one", kSaturated2d + "fluid.aperture_gamma = 2\n", {"fluid.aperture_gamma", "(0, 1]"}},
       {"network_b2_reduction_factor_above_one",
        kHydrofrac2d + "injection.fluid = \"network\"\nnetwork.b2_gamma = 2147483648\n", {"network.b2_gamma", "(0, 1]"}},
+      // a throat conductance cap at 1e-300 x the median clipped every throat to one value, without a word (session 50)
+      {"network_conductance_cap_below_the_median",
+       kHydrofrac2d + "injection.fluid = \"network\"\nnetwork.max_conductance_ratio = 0.5\n",
+       {"network.max_conductance_ratio", "out of range"}},
       // a pressurised snapshot at 1e300 Pa, above the run's stop: never taken, without a word (session 49)
       {"snapshot_pressure_past_the_stop", kHydrofrac2d + "measure.pressure = 1e300\n",
        {"measure.pressure", "not below injection.max_pressure"}},

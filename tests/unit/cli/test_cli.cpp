@@ -117,10 +117,19 @@ TEST(Cli, KeysTheScenarioDoesNotUseAreNamed) {
   EXPECT_NE(box.output.find("--set: key 'sample.diameter' is set but this scenario does not use it"), std::string::npos)
       << box.output;
   EXPECT_EQ(box.output.find("key 'sample.width' is set but"), std::string::npos) << box.output;
-  const auto net = run("check " + ex + "hydrofrac_2d_network.toml --set fluid.tau=0.9 --set network.aperture_h0=2e-5");
+  const auto net = run("check " + ex +
+                       "hydrofrac_2d_network.toml --set fluid.tau=0.9 --set network.aperture_h0=2e-5 "
+                       "--set network.throat_factor=1e-6");
   EXPECT_EQ(net.code, 0) << net.output;
   EXPECT_NE(net.output.find("key 'fluid.tau' is set but"), std::string::npos) << net.output;
   EXPECT_EQ(net.output.find("key 'network.aperture_h0' is set but"), std::string::npos) << net.output;
+  // The network's keys of one dimension, set in the other (session 50: read whatever the dimension).
+  EXPECT_NE(net.output.find("key 'network.throat_factor' is set but"), std::string::npos) << net.output;
+  const auto net3 = run("check " + ex +
+                        "hydrofrac_3d_network.toml --set network.aperture_h0=2e-5 --set network.throat_factor=1e-6");
+  EXPECT_EQ(net3.code, 0) << net3.output;
+  EXPECT_NE(net3.output.find("key 'network.aperture_h0' is set but"), std::string::npos) << net3.output;
+  EXPECT_EQ(net3.output.find("key 'network.throat_factor' is set but"), std::string::npos) << net3.output;
   // In a file: named with its line; run warns as check does.
   std::string text = read_file(ex + "ucs_2d.toml");
   const auto shape = text.find("shape = \"box\"\n");
