@@ -323,6 +323,11 @@ int main(int argc, char** argv) {
     }
     if (*resume) {
       const fs::path dir(resume_dir);
+      if (!fs::exists(dir))
+        throw InputError(fmt::format("'{}' does not exist: no run wrote it (a run creates its folder once its sample or "
+                                     "lattice is built; one stopped before that left nothing); start it with fracflow "
+                                     "run SCENARIO --out {}",
+                                     resume_dir, resume_dir));
       if (!fs::exists(dir / "scenario.toml"))
         throw InputError(fmt::format("'{}' is not a fracflow results folder (no scenario.toml)", resume_dir));
       if (!fs::exists(dir / "checkpoint"))

@@ -245,6 +245,7 @@ RunStatus DemRun::run() {
       log::info("this run had already finished; nothing to resume");
       return RunStatus::Finished;
     }
+    if (control_.resumed_at_max_steps(sys.step_count)) return RunStatus::Interrupted;
     log::info("resuming at step {} (t = {:.6g} s){}", sys.step_count, sys.time, resume_note());
   } else {
     set_up();

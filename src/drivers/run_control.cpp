@@ -37,6 +37,13 @@ std::string RunControl::stop_reason(long step) const {
   return {};
 }
 
+bool RunControl::resumed_at_max_steps(long step) const {
+  if (!opt_.resume || opt_.max_steps <= 0 || step < opt_.max_steps) return false;
+  log::info("the checkpoint is at step {}, at or past --max-steps {}: nothing to do (the folder is unchanged)", step,
+            opt_.max_steps);
+  return true;
+}
+
 void log_interruption(const std::string& reason, long step) {
   log::info("{}: checkpoint written at step {}; the run stops here", reason, step);
 }

@@ -20,6 +20,10 @@ class RunControl {
   // Why the run must checkpoint and stop now at `step` (empty: go on). A stop signal is
   // named (SIGINT, SIGTERM); the reason is logged by the caller's status line.
   std::string stop_reason(long step) const;
+  // True (and logged) when a resumed run's checkpoint is already at or past --max-steps: the run
+  // must stop before stepping and write nothing (it ran on to its next row and saved a checkpoint
+  // past the asked step; session 50).
+  bool resumed_at_max_steps(long step) const;
   // True when output.checkpoint_wall_interval seconds have passed since the last checkpoint.
   bool checkpoint_due() const;
   // Restarts the wall-clock interval (call after every checkpoint written).

@@ -439,6 +439,7 @@ RunStatus Runner<L, T>::run() {
       log::info("this run had already finished; nothing to resume");
       return RunStatus::Finished;
     }
+    if (control.resumed_at_max_steps(sol_->time_step())) return RunStatus::Interrupted;
     series.reopen(opt_.out_dir / "series.csv", columns, history_.size() / ncols_);
     log::info("resuming at step {} (t = {:.6g} s)", sol_->time_step(), double(sol_->time_step()) * units_.dt());
   } else {
@@ -476,12 +477,6 @@ RunStatus Runner<L, T>::run() {
     }
     return false;
   };
-  // A resumed run already at or past --max-steps stops before stepping (else it would run on
-  // to the next poll or sample).
-  if (opt_.max_steps > 0 && sol_->time_step() >= opt_.max_steps && stop_now(sol_->time_step())) {
-    series.close();
-    return status;
-  }
   while (sol_->time_step() < steps_total) {
     const long next_sample = std::min((sol_->time_step() / sample_every + 1) * sample_every, steps_total);
     bool stopped = false;

@@ -468,6 +468,7 @@ RunStatus HydrofracRun::run() {
       log::info("this run had already finished; nothing to resume");
       return RunStatus::Finished;
     }
+    if (control_.resumed_at_max_steps(sys.step_count)) return RunStatus::Interrupted;
     log::info("resuming at step {} (t = {:.6g} s), {}", sys.step_count, sys.time, st_.stage == 0 ? "in-situ stage" : "injecting");
   } else {
     set_up();

@@ -368,6 +368,7 @@ RunStatus SedimentationRun::run() {
       log::info("this run had already finished; nothing to resume");
       return RunStatus::Finished;
     }
+    if (control.resumed_at_max_steps(fluid_->time_step())) return RunStatus::Interrupted;
     series.reopen(opt_.out_dir / "series.csv", columns_, history_.size() / columns_.size());
     log::info("resuming at step {} (t = {:.6g} s)", fluid_->time_step(), double(fluid_->time_step()) * sc_.dt());
   } else {

@@ -328,3 +328,53 @@ TEST(CliRuns, ARunThatBlowsUpStopsWithAdviceAndKeepsItsCheckpoints) {
   EXPECT_TRUE(fs::exists(dir / "checkpoint_failed" / "state.ffcp")) << "the failing state is kept for inspection";
   EXPECT_FALSE(fs::exists(dir / "summary.json")) << "no result from a broken run";
 }
+
+// `resume --max-steps N` of a run whose checkpoint is already at or past step N ran on to its next
+// row and saved a checkpoint there ("step 2000 reached: checkpoint written at step 2100"; the kill
+// and resume sweep of session 50). Now it stops before stepping and the folder is unchanged, for
+// the DEM drivers' loop (ucs), the hydrofrac's and the sedimentation's (the flow drivers':
+// FlowCli.MaxStepsStopsAndATimeStepRunResumesBitForBit).
+TEST(CliRuns, AResumeAlreadyAtMaxStepsChangesNothing) {
+  Scratch s;
+  const std::string quiet = " --set output.vtk=false --set output.plots=false --set output.progress_interval=0 -j1";
+  const fs::path hydrofrac = s / "hydrofrac.toml";
+  std::ofstream(hydrofrac) << "driver = \"hydrofrac\"\ndem.dim = 2\ndem.group.rock.density = 2600\n"
+                              "dem.contact.rock-rock.friction = 0.5\ndem.bond.rock-rock.cohesion = 5e6\n"
+                              "sample.shape = \"box\"\nsample.width = 12e-3\nsample.height = 12e-3\n"
+                              "sample.porosity = 0.25\nborehole.radius = 1.5e-3\n";
+  struct Case {
+    std::string name, run_args;
+    long steps;
+  };
+  const std::vector<Case> cases = {
+      {"ucs", kTiny, 300},
+      {"hydrofrac", hydrofrac.string() + quiet, 400},
+      {"sedimentation", std::string(FRACFLOW_SOURCE_DIR) + "/examples/sedimentation_dkt.toml" + quiet, 64}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const fs::path dir = s / c.name;
+    const auto first = run("run --out " + dir.string() + " " + c.run_args + " --max-steps " + std::to_string(c.steps));
+    ASSERT_EQ(first.code, 0) << first.output;
+    ASSERT_TRUE(fs::exists(dir / "checkpoint")) << first.output;
+    ASSERT_FALSE(fs::exists(dir / "summary.json")) << first.output;
+    const std::string series = slurp(dir / "series.csv"), state = slurp(dir / "checkpoint" / "state.ffcp");
+    ASSERT_FALSE(state.empty());
+    for (const long n : {c.steps, c.steps / 2}) {  // at, and past, the asked step
+      const auto again = run("resume " + dir.string() + " -j1 --max-steps " + std::to_string(n));
+      EXPECT_EQ(again.code, 0) << again.output;
+      EXPECT_NE(again.output.find("nothing to do"), std::string::npos) << again.output;
+      EXPECT_NE(again.output.find("fracflow resume " + dir.string()), std::string::npos) << again.output;
+      EXPECT_EQ(slurp(dir / "series.csv"), series) << "resume --max-steps " << n << " advanced the run";
+      EXPECT_EQ(slurp(dir / "checkpoint" / "state.ffcp"), state) << "resume --max-steps " << n << " rewrote the checkpoint";
+    }
+  }
+}
+
+// A folder that does not exist (a run killed before its set-up was built leaves none) is named so.
+TEST(CliRuns, ResumeOfAFolderThatDoesNotExistSaysSo) {
+  Scratch s;
+  const auto r = run("resume " + (s / "never").string());
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("does not exist: no run wrote it"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(s / "never"));
+}
