@@ -163,10 +163,14 @@ void HydrofracRun::set_up() {
   hole_.centre = b.centre;
   hole_.radius = cfg.real("borehole.radius");
   hole_.perforation_length = cfg.real("borehole.perforation_length");
-  hole_.perforation_width =
-      cfg.real("borehole.perforation_width") > 0 ? cfg.real("borehole.perforation_width") : 2 * cfg.real("sample.radius_max");
-  hole_.perforation_azimuth = cfg.real("borehole.perforation_azimuth") * kPi / 180;
-  hole_.perforation_sides = static_cast<int>(cfg.integer("borehole.perforation_sides"));
+  // The slot's width, azimuth and sides are read only when there is a slot, so that one set without
+  // borehole.perforation_length is named as unused (the hole had no perforation without a word).
+  if (hole_.perforation_length > 0) {
+    hole_.perforation_width = cfg.real("borehole.perforation_width") > 0 ? cfg.real("borehole.perforation_width")
+                                                                          : 2 * cfg.real("sample.radius_max");
+    hole_.perforation_azimuth = cfg.real("borehole.perforation_azimuth") * kPi / 180;
+    hole_.perforation_sides = static_cast<int>(cfg.integer("borehole.perforation_sides"));
+  }
   std::vector<char> remove(P.size(), 0);
   for (std::size_t i = 0; i < P.size(); ++i) remove[i] = hydrofrac::in_hole(hole_, P.pos[i], 0) ? 1 : 0;
   const std::size_t removed = hydrofrac::remove_particles(sys, remove);

@@ -101,7 +101,8 @@ void HydrofracRun::finish(const std::string& stop) {
                    {"effective_radius_m", st_.effective_radius},
                    {"centre_m", {hole_.centre.x(), hole_.centre.y()}},
                    {"perforation_length_m", hole_.perforation_length},
-                   {"perforation_azimuth_deg", cfg.real("borehole.perforation_azimuth")},
+                   {"perforation_azimuth_deg",
+                    hole_.perforation_length > 0 ? cfg.real("borehole.perforation_azimuth") : 0.0},
                    {"natural_fracture_bonds", joints_.size()}};
   j["insitu"] = {{"targets_Pa", {{"sigma_H", targets_.x()}, {"sigma_h", targets_.y()}}},
                  {"equilibrium_reached", st_.equilibrium != 0},

@@ -130,6 +130,15 @@ TEST(Cli, KeysTheScenarioDoesNotUseAreNamed) {
   EXPECT_EQ(net3.code, 0) << net3.output;
   EXPECT_NE(net3.output.find("key 'network.aperture_h0' is set but"), std::string::npos) << net3.output;
   EXPECT_EQ(net3.output.find("key 'network.throat_factor' is set but"), std::string::npos) << net3.output;
+  // A perforation's width and azimuth without its length: the hole had no slot, without a word (session 50).
+  const auto slot = run("check " + ex + "hydrofrac_2d.toml --set borehole.perforation_azimuth=60 "
+                                        "--set borehole.perforation_width=1e-3");
+  EXPECT_EQ(slot.code, 0) << slot.output;
+  EXPECT_NE(slot.output.find("key 'borehole.perforation_azimuth' is set but"), std::string::npos) << slot.output;
+  EXPECT_NE(slot.output.find("key 'borehole.perforation_width' is set but"), std::string::npos) << slot.output;
+  const auto cut = run("check " + ex + "hydrofrac_2d_perforated.toml --set borehole.perforation_azimuth=30");
+  EXPECT_EQ(cut.code, 0) << cut.output;
+  EXPECT_EQ(cut.output.find("key 'borehole.perforation_azimuth' is set but"), std::string::npos) << cut.output;
   // In a file: named with its line; run warns as check does.
   std::string text = read_file(ex + "ucs_2d.toml");
   const auto shape = text.find("shape = \"box\"\n");
