@@ -66,13 +66,18 @@ HydrofracRun::HydrofracRun(const Config& c, const RunOptions& o) : cfg(c), opt(o
 
 void HydrofracRun::make_fluid() {
   hydrofrac::SleeveSettings s;
+  // Keys of one mode or fluid are read in it alone, so that one set for another is named as unused
+  // (injection.rate without injection.mode = "rate" ran a pressure ramp without a word; session 50).
+  const std::string fluid = cfg.string("injection.fluid");
   s.rate_mode = cfg.string("injection.mode") == "rate";
-  s.ramp_rate = cfg.real("injection.ramp_rate");
+  if (s.rate_mode) s.flow_rate = cfg.real("injection.rate");
+  else s.ramp_rate = cfg.real("injection.ramp_rate");
   s.initial_pressure = cfg.real("injection.initial_pressure");
-  s.flow_rate = cfg.real("injection.rate");
-  s.bulk_modulus = cfg.real("injection.fluid_bulk_modulus");
-  s.penetration = cfg.boolean("injection.penetration");
-  s.update_interval = cfg.integer("injection.update_interval");
+  if (fluid != "lbm") s.bulk_modulus = cfg.real("injection.fluid_bulk_modulus");  // (the LBM's: fluid.*)
+  if (fluid == "sleeve") {
+    s.penetration = cfg.boolean("injection.penetration");
+    s.update_interval = cfg.integer("injection.update_interval");
+  }
   // Flood-fill cells of a quarter of the smallest radius (at most ~4e6 cells); particles are
   // inflated by half the bond gap so that bonded neighbours close the wall; the flood stays
   // within 1.5 radius_max of the carved region.

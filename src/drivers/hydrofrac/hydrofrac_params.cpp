@@ -182,12 +182,14 @@ void declare_params(ParamTable& t) {
            "whose cells carry the outward velocity that pumps the rate; docs/hydrofrac.md)")
       .one_of({"mass", "velocity_box"});
   t.real("injection.fluid_bulk_modulus", 2.2e9, "Pa",
-         "fluid bulk modulus K_f (water 2.2e9; at most 1e12, stiffer than diamond): dp/dt = K_f/V (Q - dV/dt)")
+         "sleeve and network: fluid bulk modulus K_f (water 2.2e9; at most 1e12, stiffer than diamond): dp/dt = K_f/V "
+         "(Q - dV/dt) (the LBM fluid's: fluid.bulk_modulus)")
       .positive()
       .at_most(1e12);
   t.boolean("injection.penetration", false,
-            "fluid enters cracks connected to the hole (pressure on their faces); false: sleeve test, the wall only");
-  t.integer("injection.update_interval", 20, "steps", "steps between searches for cracks newly connected to the hole").positive();
+            "sleeve: fluid enters cracks connected to the hole (pressure on their faces); false: sleeve test, the wall only");
+  t.integer("injection.update_interval", 20, "steps", "sleeve: steps between searches for cracks newly connected to the hole")
+      .positive();
   t.real("injection.breakdown_length", 0, "m",
          "ramp mode: breakdown = pressure when the connected fracture first reaches this far beyond the hole's wall (0: one "
          "borehole radius)")

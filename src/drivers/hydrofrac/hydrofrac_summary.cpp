@@ -55,7 +55,7 @@ void HydrofracRun::finish(const std::string& stop) {
   const bool rate_mode = cfg.string("injection.mode") == "rate";
   j["injection"] = {{"fluid", cfg.string("injection.fluid")},
                     {"mode", cfg.string("injection.mode")},
-                    {"penetration", cfg.boolean("injection.penetration")},
+                    {"penetration", cfg.string("injection.fluid") == "sleeve" && cfg.boolean("injection.penetration")},
                     {"final_pressure_Pa", f.pressure},
                     {"injected_volume_m3", f.injected_volume},
                     {"borehole_volume_m3", f.borehole_volume},

@@ -131,9 +131,19 @@ TEST(Cli, KeysTheScenarioDoesNotUseAreNamed) {
   EXPECT_NE(net3.output.find("key 'network.aperture_h0' is set but"), std::string::npos) << net3.output;
   EXPECT_EQ(net3.output.find("key 'network.throat_factor' is set but"), std::string::npos) << net3.output;
   // A perforation's width and azimuth without its length: the hole had no slot, without a word (session 50).
+  // So were a pumped rate without injection.mode = "rate" (a pressure ramp ran), and the sleeve's keys
+  // with the LBM fluid.
   const auto slot = run("check " + ex + "hydrofrac_2d.toml --set borehole.perforation_azimuth=60 "
-                                        "--set borehole.perforation_width=1e-3");
+                                        "--set borehole.perforation_width=1e-3 --set injection.rate=1e-3 "
+                                        "--set injection.ramp_rate=1e10");
   EXPECT_EQ(slot.code, 0) << slot.output;
+  EXPECT_NE(slot.output.find("key 'injection.rate' is set but"), std::string::npos) << slot.output;
+  EXPECT_EQ(slot.output.find("key 'injection.ramp_rate' is set but"), std::string::npos) << slot.output;
+  const auto lbm = run("check " + ex + "hydrofrac_2d_lbm.toml --set injection.fluid_bulk_modulus=3e9 "
+                                       "--set injection.penetration=true");
+  EXPECT_EQ(lbm.code, 0) << lbm.output;
+  EXPECT_NE(lbm.output.find("key 'injection.fluid_bulk_modulus' is set but"), std::string::npos) << lbm.output;
+  EXPECT_NE(lbm.output.find("key 'injection.penetration' is set but"), std::string::npos) << lbm.output;
   EXPECT_NE(slot.output.find("key 'borehole.perforation_azimuth' is set but"), std::string::npos) << slot.output;
   EXPECT_NE(slot.output.find("key 'borehole.perforation_width' is set but"), std::string::npos) << slot.output;
   const auto cut = run("check " + ex + "hydrofrac_2d_perforated.toml --set borehole.perforation_azimuth=30");
@@ -224,9 +234,18 @@ TEST(Cli, ExistingResultsAreNotOverwritten) {
 }
 
 TEST(Cli, ResumeOfAFolderWithoutCheckpointIsAClearError) {
-  const auto r = run("resume /nonexistent/folder");
+  // A folder that does not exist (a run killed before its set-up was built leaves none) is named so
+  // (session 50; it was called "not a fracflow results folder"), one that holds no run as before.
+  auto r = run("resume /nonexistent/folder");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("does not exist: no run wrote it"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists("/nonexistent/folder"));
+  const auto empty = scratch("not_a_run");
+  fs::create_directories(empty);
+  r = run("resume " + empty.string());
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("not a fracflow results folder"), std::string::npos) << r.output;
+  fs::remove_all(empty);
 }
 
 TEST(Cli, ReadmeParameterReferenceIsCurrent) {

@@ -370,11 +370,3 @@ TEST(CliRuns, AResumeAlreadyAtMaxStepsChangesNothing) {
   }
 }
 
-// A folder that does not exist (a run killed before its set-up was built leaves none) is named so.
-TEST(CliRuns, ResumeOfAFolderThatDoesNotExistSaysSo) {
-  Scratch s;
-  const auto r = run("resume " + (s / "never").string());
-  EXPECT_EQ(r.code, 2) << r.output;
-  EXPECT_NE(r.output.find("does not exist: no run wrote it"), std::string::npos) << r.output;
-  EXPECT_FALSE(fs::exists(s / "never"));
-}
