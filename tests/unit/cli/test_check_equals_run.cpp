@@ -271,6 +271,10 @@ std::vector<Bad> bad_scenarios() {
       {"b2_reduction_factor_above_one", kSaturated2d + "fluid.aperture_gamma = 2\n", {"fluid.aperture_gamma", "(0, 1]"}},
       {"network_b2_reduction_factor_above_one",
        kHydrofrac2d + "injection.fluid = \"network\"\nnetwork.b2_gamma = 2147483648\n", {"network.b2_gamma", "(0, 1]"}},
+      // a vapour pressure of 1e-300 Pa: cavitated pores became a gas of ~1e-305 kg/m^3 and the pressure solve
+      // stopped without converging (session 50)
+      {"vapour_pressure_of_no_liquid", kSaturated2d + "fluid.cavitation_pressure = 1e-300\n",
+       {"fluid.cavitation_pressure", "or 0 to switch cavitation off"}},
       // a throat conductance cap at 1e-300 x the median clipped every throat to one value, without a word (session 50)
       {"network_conductance_cap_below_the_median",
        kHydrofrac2d + "injection.fluid = \"network\"\nnetwork.max_conductance_ratio = 0.5\n",
