@@ -231,7 +231,7 @@ void Config::note_read(const std::string& key) const {
 bool read_by_every_run(const std::string& key) {
   static const std::unordered_set<std::string> kLate = {
       "driver",          "title",          "measure.pressure",    "measure.angles",
-      "insitu.tolerance", "injection.stop_fraction", "injection.peak_drop", "injection.stop_extent",
+      "insitu.tolerance", "injection.stop_extent",
       "dem.energy_tracking", "run.steady_tolerance", "reference.terminal_velocity",
       "triaxial.measurement_sphere_radius"};
   auto ends = [&](std::string_view s) { return key.size() >= s.size() && key.compare(key.size() - s.size(), s.size(), s) == 0; };

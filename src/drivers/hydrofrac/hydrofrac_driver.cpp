@@ -142,8 +142,9 @@ void HydrofracRun::make_fluid() {
   l.scheme = scheme == "psm"         ? lbm::ParticleScheme::Psm
              : scheme == "stairwise" ? lbm::ParticleScheme::StairwiseBounceBack
                                      : lbm::ParticleScheme::InterpolatedBounceBack;
-  l.psm_weighting =
-      cfg.string("fluid.psm_weighting") == "linear" ? lbm::PsmWeighting::Linear : lbm::PsmWeighting::TauDependent;
+  if (l.scheme == lbm::ParticleScheme::Psm)  // (read with the PSM alone: named as unused with the others)
+    l.psm_weighting =
+        cfg.string("fluid.psm_weighting") == "linear" ? lbm::PsmWeighting::Linear : lbm::PsmWeighting::TauDependent;
   l.moving_walls = cfg.boolean("fluid.moving_walls");
   l.drained_faces = cfg.string("fluid.faces") == "drained";
   l.rate_mode = s.rate_mode;
@@ -469,8 +470,20 @@ double HydrofracRun::planned_steps() const {
              sys.settings.dt;
 }
 
+// Read before the set-up ends (run and resume alike), each in its mode alone, so that one set for
+// the other mode is named as unused (injection.stop_fraction in ramp mode never stopped a run; session 50).
+void HydrofracRun::read_mode_rules() {
+  if (cfg.string("injection.mode") == "rate") {
+    peak_drop_ = cfg.real("injection.peak_drop");
+    stop_fraction_ = cfg.real("injection.stop_fraction");
+  } else {
+    breakdown_length_ = cfg.real("injection.breakdown_length");
+  }
+}
+
 RunStatus HydrofracRun::run() {
   make_fluid();
+  read_mode_rules();
   if (opt.resume) {
     load();
     if (st_.finished) {
@@ -518,11 +531,10 @@ RunStatus HydrofracRun::run() {
   const Real tol = cfg.real("insitu.tolerance");
   const long insitu_max = cfg.integer("insitu.max_steps");
   const bool rate_mode = cfg.string("injection.mode") == "rate";
-  const Real bd_len = cfg.real("injection.breakdown_length") > 0 ? cfg.real("injection.breakdown_length") : hole_.radius;
+  const Real bd_len = breakdown_length_ > 0 ? breakdown_length_ : hole_.radius;
   const Real probe_p = cfg.real("measure.pressure");
   const Real max_p = cfg.real("injection.max_pressure"), max_t = cfg.real("injection.max_time");
-  const Real stop_extent = cfg.real("injection.stop_extent"), stop_fraction = cfg.real("injection.stop_fraction");
-  const Real peak_drop = cfg.real("injection.peak_drop");
+  const Real stop_extent = cfg.real("injection.stop_extent"), stop_fraction = stop_fraction_, peak_drop = peak_drop_;
   auto wall_list = [&](const Vec3& v) {
     return sys.settings.dim == 3 ? fmt::format("{:.4g} / {:.4g} / {:.4g}", 1e-6 * v.x(), 1e-6 * v.y(), 1e-6 * v.z())
                                  : fmt::format("{:.4g} / {:.4g}", 1e-6 * v.x(), 1e-6 * v.y());

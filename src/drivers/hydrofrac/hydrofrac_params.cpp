@@ -341,7 +341,10 @@ void validate_scenario(const Config& cfg) {
                          cfg.real("borehole.perforation_width"), 2 * R));
   // Ramp mode: a breakdown length the fracture cannot reach before the run stops at stop_extent of the
   // way to the faces left the breakdown pressure null for ever (1 m in a 38 mm block).
-  const Real gap = 0.5 * lmin - R, bd = cfg.real("injection.breakdown_length") > 0 ? cfg.real("injection.breakdown_length") : R;
+  const Real gap = 0.5 * lmin - R;
+  const Real bd = cfg.string("injection.mode") != "ramp"             ? 0.0
+                  : cfg.real("injection.breakdown_length") > 0 ? cfg.real("injection.breakdown_length")
+                                                                   : R;
   if (cfg.string("injection.mode") == "ramp" && bd >= cfg.real("injection.stop_extent") * gap)
     cfg.fail("injection.breakdown_length",
              fmt::format("{} m{} is not below injection.stop_extent x the distance from the hole's wall to the nearest "

@@ -95,6 +95,10 @@ class HydrofracRun {
   HfState st_;
   Vec3 targets_;
   Real servo_v_ = 0, servo_alpha_ = 0;
+  // The injection mode's rules (read_mode_rules): rate mode, the breakdown's pressure drop and the
+  // stop's fraction of the peak; ramp mode, the breakdown's fracture length (0: one hole radius).
+  Real peak_drop_ = 0, stop_fraction_ = 0, breakdown_length_ = 0;
+  void read_mode_rules();
   std::vector<CircleRecord> insitu_, probe_;
   fs::path cp_dir_;
   CsvWriter series_;

@@ -68,8 +68,7 @@ void HydrofracRun::finish(const std::string& stop) {
   bd["definition"] = rate_mode ? "first pressure peak followed by a drop of injection.peak_drop once a crack has reached the hole"
                                : fmt::format("pressure when the fracture connected to the hole first reached {} m beyond its wall "
                                              "(injection.breakdown_length)",
-                                             cfg.real("injection.breakdown_length") > 0 ? cfg.real("injection.breakdown_length")
-                                                                                        : hole_.radius);
+                                             breakdown_length_ > 0 ? breakdown_length_ : hole_.radius);
   if (st_.breakdown_found) {
     bd["pressure_Pa"] = st_.breakdown_pressure;
     bd["time_s"] = st_.breakdown_time;

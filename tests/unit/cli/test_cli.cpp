@@ -144,6 +144,18 @@ TEST(Cli, KeysTheScenarioDoesNotUseAreNamed) {
   EXPECT_EQ(lbm.code, 0) << lbm.output;
   EXPECT_NE(lbm.output.find("key 'injection.fluid_bulk_modulus' is set but"), std::string::npos) << lbm.output;
   EXPECT_NE(lbm.output.find("key 'injection.penetration' is set but"), std::string::npos) << lbm.output;
+  // The rate mode's stop and breakdown rules in ramp mode (and the ramp's breakdown length in rate mode),
+  // and the PSM's weighting with another scheme.
+  const auto ramp = run("check " + ex + "hydrofrac_2d_lbm.toml --set injection.stop_fraction=0.4 "
+                                        "--set injection.peak_drop=0.1 --set fluid.psm_weighting=\"linear\"");
+  EXPECT_EQ(ramp.code, 0) << ramp.output;
+  for (const char* key : {"injection.stop_fraction", "injection.peak_drop", "fluid.psm_weighting"})
+    EXPECT_NE(ramp.output.find("key '" + std::string(key) + "' is set but"), std::string::npos) << key << "\n" << ramp.output;
+  const auto rate = run("check " + ex + "hydrofrac_2d_perforated_lbm.toml --set injection.breakdown_length=1e-3 "
+                                        "--set injection.stop_fraction=0.4");
+  EXPECT_EQ(rate.code, 0) << rate.output;
+  EXPECT_NE(rate.output.find("key 'injection.breakdown_length' is set but"), std::string::npos) << rate.output;
+  EXPECT_EQ(rate.output.find("key 'injection.stop_fraction' is set but"), std::string::npos) << rate.output;
   EXPECT_NE(slot.output.find("key 'borehole.perforation_azimuth' is set but"), std::string::npos) << slot.output;
   EXPECT_NE(slot.output.find("key 'borehole.perforation_width' is set but"), std::string::npos) << slot.output;
   const auto cut = run("check " + ex + "hydrofrac_2d_perforated.toml --set borehole.perforation_azimuth=30");
