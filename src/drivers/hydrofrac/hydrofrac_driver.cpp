@@ -90,7 +90,7 @@ void HydrofracRun::make_fluid() {
   s.cell = cell;
   s.inflate = std::min(0.5 * cfg.real("sample.bond_gap"), 0.5 * rmin);
   s.reach = 1.5 * rmax;
-  if (cfg.string("injection.fluid") == "network") {
+  if (fluid == "network") {
     hydrofrac::NetworkSettings n;
     n.rate_mode = s.rate_mode;
     n.ramp_rate = s.ramp_rate;
@@ -132,7 +132,7 @@ void HydrofracRun::make_fluid() {
     fluid_ = std::move(nl);
     return;
   }
-  if (cfg.string("injection.fluid") != "lbm") {
+  if (fluid != "lbm") {
     fluid_ = std::make_unique<hydrofrac::SleeveLoad>(s);
     return;
   }
@@ -534,7 +534,7 @@ RunStatus HydrofracRun::run() {
   const Real bd_len = breakdown_length_ > 0 ? breakdown_length_ : hole_.radius;
   const Real probe_p = cfg.real("measure.pressure");
   const Real max_p = cfg.real("injection.max_pressure"), max_t = cfg.real("injection.max_time");
-  const Real stop_extent = cfg.real("injection.stop_extent"), stop_fraction = stop_fraction_, peak_drop = peak_drop_;
+  const Real stop_extent = cfg.real("injection.stop_extent");
   auto wall_list = [&](const Vec3& v) {
     return sys.settings.dim == 3 ? fmt::format("{:.4g} / {:.4g} / {:.4g}", 1e-6 * v.x(), 1e-6 * v.y(), 1e-6 * v.z())
                                  : fmt::format("{:.4g} / {:.4g}", 1e-6 * v.x(), 1e-6 * v.y());
@@ -590,7 +590,7 @@ RunStatus HydrofracRun::run() {
         if (!st_.breakdown_found) {
           // Rate mode: a drop counts once a crack has reached the hole; before, the pressure of the hole's
           // pores also rises and falls as the rock settles (a "breakdown" of 35 kPa with no crack at all).
-          const bool bd = rate_mode ? (st_.peak_pressure > 0 && st_.initiation_found && p < (1 - peak_drop) * st_.peak_pressure)
+          const bool bd = rate_mode ? (st_.peak_pressure > 0 && st_.initiation_found && p < (1 - peak_drop_) * st_.peak_pressure)
                                     : extent_ >= bd_len;
           if (bd) {
             st_.breakdown_found = 1;
@@ -616,8 +616,8 @@ RunStatus HydrofracRun::run() {
           stop = fmt::format("the borehole pressure reached injection.max_pressure = {} Pa", max_p);
         else if (injected_time >= max_t)
           stop = fmt::format("the injection time reached injection.max_time = {} s", max_t);
-        else if (rate_mode && st_.breakdown_found && p < stop_fraction * st_.peak_pressure)
-          stop = fmt::format("the pressure fell below injection.stop_fraction = {} of its peak", stop_fraction);
+        else if (rate_mode && st_.breakdown_found && p < stop_fraction_ * st_.peak_pressure)
+          stop = fmt::format("the pressure fell below injection.stop_fraction = {} of its peak", stop_fraction_);
         fraction = 0.5 + 0.5 * std::min(1.0, rate_mode ? injected_time / max_t : std::max(extent_ / (stop_extent * gap), p / max_p));
       }
       progress.update(sys.step_count, sys.time, fraction, status_);

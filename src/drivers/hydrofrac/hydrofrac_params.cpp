@@ -341,17 +341,16 @@ void validate_scenario(const Config& cfg) {
                          cfg.real("borehole.perforation_width"), 2 * R));
   // Ramp mode: a breakdown length the fracture cannot reach before the run stops at stop_extent of the
   // way to the faces left the breakdown pressure null for ever (1 m in a 38 mm block).
-  const Real gap = 0.5 * lmin - R;
-  const Real bd = cfg.string("injection.mode") != "ramp"             ? 0.0
-                  : cfg.real("injection.breakdown_length") > 0 ? cfg.real("injection.breakdown_length")
-                                                                   : R;
-  if (cfg.string("injection.mode") == "ramp" && bd >= cfg.real("injection.stop_extent") * gap)
-    cfg.fail("injection.breakdown_length",
-             fmt::format("{} m{} is not below injection.stop_extent x the distance from the hole's wall to the nearest "
-                         "face ({} x {:.4g} m), where the run stops: the fracture could never reach it; use a shorter "
-                         "injection.breakdown_length (or a larger block)",
-                         bd, cfg.real("injection.breakdown_length") > 0 ? "" : " (0: one borehole radius)",
-                         cfg.real("injection.stop_extent"), gap));
+  // (Read in ramp mode alone, so that a breakdown length set in rate mode is named as unused.)
+  if (cfg.string("injection.mode") == "ramp") {
+    const Real gap = 0.5 * lmin - R, set = cfg.real("injection.breakdown_length"), bd = set > 0 ? set : R;
+    if (bd >= cfg.real("injection.stop_extent") * gap)
+      cfg.fail("injection.breakdown_length",
+               fmt::format("{} m{} is not below injection.stop_extent x the distance from the hole's wall to the nearest "
+                           "face ({} x {:.4g} m), where the run stops: the fracture could never reach it; use a shorter "
+                           "injection.breakdown_length (or a larger block)",
+                           bd, set > 0 ? "" : " (0: one borehole radius)", cfg.real("injection.stop_extent"), gap));
+  }
   const Real rho = cfg.real("measure.circle_radius");
   for (double r : cfg.real_list("measure.radii")) {
     if ((r - rho) * R < R + rmax)
